@@ -1,0 +1,189 @@
+"""The base class of every camera attack: a torchvision v2 ``Transform`` with explicit, seeded randomness.
+
+Contract (every attack in this package, and the mixer, eval and device-side step rely on it):
+
+* ``attack(img)`` - the torchvision path. ``make_params`` draws one parameter set per sample of the batch from
+  the attack's own ``torch.Generator`` (seeded from ``seed`` and the dataloader worker id, never the global RNG);
+  ``transform`` applies them.
+* ``attack.sample_params(batch_size, height, width, intensity=..., generator=..., device=...)`` - explicit
+  parameter draw (each value is a tensor with leading dim ``batch_size``, always including ``"intensity"``).
+* ``attack.apply_params(img, params)`` - deterministic application. A leading dim of 1 in ``params`` broadcasts
+  over the whole batch, which is how one sample's frames (``delta_timestamps``) share one attack.
+
+Images: uint8 (0-255) or floating (0-1) tensors, ``(C, H, W)`` or ``(B, C, H, W)`` (any further leading dims are
+flattened into the batch), C in {1, 3, 4}; output has the input's dtype, shape and device. Subclasses implement
+``_sample(s, height, width, generator, device)`` and ``_apply(x, params)`` on float32 ``(B, 3, H, W)`` in [0, 1].
+"""
+
+from __future__ import annotations
+
+import hashlib
+from typing import Any, ClassVar
+
+import torch
+from torch.utils.data import get_worker_info
+from torchvision import tv_tensors
+from torchvision.transforms import v2
+
+from lerobot_phantom.transforms.intensity import IntensitySpec, parse_intensity, sample_intensity
+
+REFERENCE_SIZE = 256
+"""Pixel-sized parameters (blur displacement, pattern offsets) are defined on a 256x256 image and scale with size."""
+
+SUPPORTED_CHANNELS = (1, 3, 4)
+
+
+def derive_seed(*parts: int | str) -> int:
+    """A 63-bit seed from any tuple of ints/strings, stable across processes and Python versions."""
+    digest = hashlib.blake2b(repr(parts).encode(), digest_size=8).digest()
+    return int.from_bytes(digest, "little") & ((1 << 63) - 1)
+
+
+def check_image(img: torch.Tensor) -> None:
+    if not isinstance(img, torch.Tensor):
+        raise TypeError(f"expected a torch.Tensor image, got {type(img).__name__}")
+    if img.ndim < 3:
+        raise ValueError(f"expected an image of shape (C, H, W) or (B, C, H, W), got shape {tuple(img.shape)}")
+    if img.shape[-3] not in SUPPORTED_CHANNELS:
+        raise ValueError(
+            f"expected {SUPPORTED_CHANNELS} channels in dim -3 (CHW layout), got shape {tuple(img.shape)}"
+        )
+    if img.numel() == 0:
+        raise ValueError(f"empty image of shape {tuple(img.shape)}")
+    if img.dtype == torch.bool or img.is_complex():
+        raise TypeError(f"unsupported image dtype {img.dtype}; use uint8 (0-255) or float (0-1)")
+    if img.is_floating_point() and not torch.isfinite(img).all():
+        raise ValueError("image contains NaN or infinite values")
+
+
+def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
+    """Any supported image -> (float32 (N, 3, H, W) in [0, 1], alpha channel or None)."""
+    x = img.reshape(-1, *img.shape[-3:])
+    x = x.to(torch.float32) / 255.0 if x.dtype == torch.uint8 else x.to(torch.float32)
+    alpha = None
+    if x.shape[1] == 4:
+        x, alpha = x[:, :3], x[:, 3:]
+    elif x.shape[1] == 1:
+        x = x.expand(-1, 3, -1, -1)
+    return x, alpha
+
+
+def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tensor) -> torch.Tensor:
+    """Inverse of ``to_float_rgb``: back to the dtype, channel count and shape of ``like``."""
+    if like.shape[-3] == 1:
+        x = x.mean(dim=1, keepdim=True)
+    elif alpha is not None:
+        x = torch.cat([x, alpha], dim=1)
+    x = x.clamp(0.0, 1.0)
+    if like.dtype == torch.uint8:
+        x = (x * 255.0).round().to(torch.uint8)
+    else:
+        x = x.to(like.dtype)
+    return x.reshape(like.shape)
+
+
+class CameraAttack(v2.Transform):
+    """Base class; see the module docstring for the contract."""
+
+    name: ClassVar[str] = ""
+    _transformed_types = (torch.Tensor, tv_tensors.Image, tv_tensors.Video)
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__()
+        self.intensity = intensity
+        self.intensity_range = parse_intensity(intensity)
+        self.seed = seed
+        self._generator = generator
+
+    # -- randomness -----------------------------------------------------------------------------------
+    def _get_generator(self) -> torch.Generator:
+        if self._generator is None:
+            worker = get_worker_info()
+            worker_id = worker.id if worker is not None else -1
+            self._generator = torch.Generator().manual_seed(
+                derive_seed(self.name, 0 if self.seed is None else self.seed, worker_id)
+            )
+        return self._generator
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        generator = state.pop("_generator", None)
+        state["_generator_state"] = None if generator is None else generator.get_state()
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        generator_state = state.pop("_generator_state", None)
+        self.__dict__.update(state)
+        self._generator = None
+        if generator_state is not None:
+            self._generator = torch.Generator()
+            self._generator.set_state(generator_state)
+
+    # -- torchvision v2 hooks -------------------------------------------------------------------------
+    def make_params(self, flat_inputs: list[Any]) -> dict[str, Any]:
+        image = next(x for x in flat_inputs if isinstance(x, torch.Tensor))
+        check_image(image)
+        batch = int(torch.tensor(image.shape[:-3]).prod().item()) if image.ndim > 3 else 1
+        height, width = image.shape[-2:]
+        return self.sample_params(batch, height, width, generator=self._get_generator(), device=image.device)
+
+    def transform(self, inpt: Any, params: dict[str, Any]) -> Any:
+        if not isinstance(inpt, torch.Tensor):
+            return inpt
+        return self.apply_params(inpt, params)
+
+    # -- explicit API -----------------------------------------------------------------------------------
+    def sample_params(
+        self,
+        batch_size: int,
+        height: int,
+        width: int,
+        *,
+        intensity: IntensitySpec | torch.Tensor | None = None,
+        generator: torch.Generator | None = None,
+        device: torch.device | str | None = None,
+    ) -> dict[str, torch.Tensor]:
+        """Draw ``batch_size`` parameter sets. ``intensity`` overrides the attack's own (a tensor: per sample)."""
+        if isinstance(intensity, torch.Tensor):
+            s = intensity.to(device=device, dtype=torch.float32).reshape(-1).expand(batch_size).clone()
+            if not ((s >= 0) & (s <= 1)).all():
+                raise ValueError(f"intensity must lie in [0, 1], got {s.tolist()}")
+        else:
+            rng = self.intensity_range if intensity is None else parse_intensity(intensity)
+            s = sample_intensity(rng, batch_size, generator, device)
+        params = self._sample(s, int(height), int(width), generator, device)
+        params["intensity"] = s
+        return params
+
+    def apply_params(self, img: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        check_image(img)
+        x, alpha = to_float_rgb(img)
+        try:
+            y = self._apply(x, params)
+        except Exception as err:  # re-raised with context: which attack, which parameters
+            shown = {k: (v.tolist() if isinstance(v, torch.Tensor) and v.numel() <= 8 else v) for k, v in params.items()}
+            raise RuntimeError(f"{type(self).__name__} failed on image {tuple(img.shape)} with {shown}") from err
+        return from_float_rgb(y, alpha, img)
+
+    # -- subclass hooks -----------------------------------------------------------------------------------
+    def _sample(
+        self,
+        s: torch.Tensor,
+        height: int,
+        width: int,
+        generator: torch.Generator | None,
+        device: torch.device | str | None,
+    ) -> dict[str, torch.Tensor]:
+        raise NotImplementedError
+
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        raise NotImplementedError
+
+    def extra_repr(self) -> str:
+        return f"intensity={self.intensity!r}, seed={self.seed!r}"
