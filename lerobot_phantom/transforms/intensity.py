@@ -60,7 +60,7 @@ def parse_intensity(intensity: IntensitySpec) -> tuple[float, float]:
         low = _check_unit(intensity[0], "intensity low")
         high = _check_unit(intensity[1], "intensity high")
         if low > high:
-            raise ValueError(f"intensity range needs low <= high, got ({low}, {high})")
+            raise ValueError(f"intensity range needs low <= high, got ({low}, {high}); intensity is {_VALID_TEXT}")
         return low, high
     raise ValueError(f"intensity must be {_VALID_TEXT}, got {intensity!r}")
 
