@@ -1,0 +1,119 @@
+"""EM truncation: electromagnetic interference corrupts the camera's frame-buffer addresses (paper, Method and
+Appendix A, Algorithm "EM Truncation Attack"; after GlitchHiker, Jiang et al. 2023).
+
+The paper's algorithm, for a truncation ratio ``r`` and an image of height ``h``::
+
+    start = int(h * r); num = int(h * r)
+    delete rows [start, start + num) and append the last ``num`` rows of the frame
+
+so a band of ``num`` rows vanishes, everything below it moves up and the bottom ``num`` rows appear twice.
+
+Deviations from the paper's code (and why):
+
+* **Band start clamped.** The paper's ``start = int(h*r)`` makes the deleted band coincide with the appended tail
+  at ``r = 0.5`` (the output equals the input), and for ``r > 0.5`` the output is *taller* than the input. Here
+  ``start = max(0, min(int(h*r), h - 2*num))``: identical to the paper for ``r <= 1/3`` (the paper's range, levels
+  0.1/0.2/0.3), and for ``1/3 < r <= 0.5`` the band slides up so that it never overlaps the appended tail. The
+  output always has height ``h``. Ratios above 0.5 are rejected: with at most ``h`` rows there is no way to lose
+  more than half of them and still append as many.
+* **Vectorised per sample.** The whole operation is one row-index gather, so a batch whose samples have
+  different ratios is a single op, exact for any dtype (no float round trip).
+
+Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
+the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
+band shrinks as ``r`` grows, so on texture-free noise images the paper's strong level differs from the clean image
+in fewer pixels than its weak level does.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import torch
+
+from lerobot_phantom.transforms.base import CameraAttack, check_image
+from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+
+MAX_RATIO = 0.5
+
+
+def _per_sample(value: float | torch.Tensor, batch: int, device: torch.device, what: str) -> torch.Tensor:
+    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> float64 ``(batch,)`` on ``device``."""
+    t = torch.as_tensor(value, dtype=torch.float64).to(device).reshape(-1)
+    if t.numel() == 1:
+        return t.expand(batch)
+    if t.numel() != batch:
+        raise ValueError(
+            f"{what} must be a scalar or have one value per sample ({batch}), got {t.numel()} values"
+        )
+    return t
+
+
+def truncation_row_index(height: int, ratio: torch.Tensor) -> torch.Tensor:
+    """Source row of every output row, ``(B, height)`` long, for per-sample ratios ``(B,)`` in [0, 0.5]."""
+    num = torch.floor(height * ratio).long()  # (B,)
+    start = torch.clamp(torch.minimum(num, height - 2 * num), min=0)
+    rows = torch.arange(height, device=ratio.device).unsqueeze(0)  # (1, H)
+    num, start = num.unsqueeze(1), start.unsqueeze(1)
+    shifted = (rows >= start) & (rows < height - num)
+    return torch.where(shifted, rows + num, rows)
+
+
+def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Tensor:
+    """EM truncation of ``image`` (``(..., C, H, W)``, any dtype) with truncation ratio ``ratio`` in [0, 0.5].
+
+    ``ratio`` is a float or a tensor with one value per image of the batch (leading dims flattened). Returns a
+    tensor of the input's shape, dtype and device. See the module docstring for the algorithm and the fix.
+    """
+    check_image(image)
+    flat = image.reshape(-1, *image.shape[-3:])
+    batch, channels, height, width = flat.shape
+    r = _per_sample(ratio, batch, flat.device, "ratio")
+    if not torch.isfinite(r).all() or (r < 0).any() or (r > MAX_RATIO).any():
+        raise ValueError(f"EM truncation ratio must lie in [0, {MAX_RATIO}], got {r.tolist()}")
+    index = truncation_row_index(height, r)  # (B, H)
+    gathered = flat.gather(2, index[:, None, :, None].expand(batch, channels, height, width))
+    return gathered.reshape(image.shape)
+
+
+class EMTruncation(CameraAttack):
+    """EM truncation attack as a torchvision v2 transform.
+
+    Intensity -> ratio: 0 (identity) / 0.1 (weak) / 0.2 (medium) / 0.3 (strong), piecewise linear in between
+    (paper, Table 2). ``ratio=`` fixes the physical ratio (in [0, 0.5]) whatever the intensity.
+    """
+
+    name: ClassVar[str] = "em_truncation"
+    LEVEL_RATIOS: ClassVar[tuple[float, float, float, float]] = (0.0, 0.1, 0.2, 0.3)
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        ratio: float | None = None,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__(intensity, seed=seed, generator=generator)
+        if ratio is not None and not (0.0 <= float(ratio) <= MAX_RATIO):
+            raise ValueError(f"ratio must lie in [0, {MAX_RATIO}], got {ratio!r}")
+        self.ratio = None if ratio is None else float(ratio)
+
+    def ratio_for(self, s: torch.Tensor) -> torch.Tensor:
+        """The truncation ratio used at intensity ``s`` (per sample)."""
+        if self.ratio is not None:
+            return torch.full_like(s, self.ratio, dtype=torch.float32)
+        return interpolate_levels(s, self.LEVEL_RATIOS)
+
+    def _sample(self, s, height, width, generator, device):
+        return {"ratio": self.ratio_for(s).to(device)}
+
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        return em_truncation(x, params["ratio"])
+
+    def apply_params(self, img: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        # A row gather is exact in any dtype and channel count, so skip the float RGB round trip of the base.
+        return em_truncation(img, params["ratio"])
+
+    def extra_repr(self) -> str:
+        return super().extra_repr() + ("" if self.ratio is None else f", ratio={self.ratio}")

@@ -1,0 +1,157 @@
+import os
+import pickle
+
+import numpy as np
+import pytest
+import torch
+from reference_em_blur import em_truncation_reference
+
+from lerobot_phantom.transforms.em_truncation import EMTruncation, em_truncation, truncation_row_index
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+
+def _random_uint8(shape, seed):
+    return torch.randint(0, 256, shape, dtype=torch.uint8, generator=torch.Generator().manual_seed(seed))
+
+
+def _hwc(chw: torch.Tensor) -> np.ndarray:
+    return chw.permute(1, 2, 0).numpy()
+
+
+def _chw(hwc: np.ndarray) -> torch.Tensor:
+    return torch.from_numpy(np.ascontiguousarray(hwc)).permute(2, 0, 1)
+
+
+@pytest.mark.parametrize("shape", [(3, 17, 23), (3, 32, 32), (3, 96, 96), (3, 101, 7)])
+@pytest.mark.parametrize("ratio", [0.1, 0.2, 0.3, 0.137, 1 / 3])
+def test_matches_paper_reference_in_paper_range(shape, ratio):
+    img = _random_uint8(shape, seed=shape[1] * 7 + int(ratio * 1000))
+    expected_paper = em_truncation_reference(_hwc(img), ratio, paper_start=True)
+    expected_fixed = em_truncation_reference(_hwc(img), ratio)
+    np.testing.assert_array_equal(expected_paper, expected_fixed)  # the fix changes nothing for r <= 1/3
+    torch.testing.assert_close(em_truncation(img, ratio), _chw(expected_paper), atol=0, rtol=0)
+
+
+@pytest.mark.parametrize("height", [10, 64, 100])  # even: int(h/2) * 2 == h
+def test_fix_at_half_ratio_paper_is_identity_ours_is_not(height):
+    img = _random_uint8((3, height, 9), seed=height)
+    paper = em_truncation_reference(_hwc(img), 0.5, paper_start=True)
+    np.testing.assert_array_equal(paper, _hwc(img))  # the paper's defect: ratio 0.5 does nothing
+    ours = em_truncation(img, 0.5)
+    assert not torch.equal(ours, img)
+    torch.testing.assert_close(ours, _chw(em_truncation_reference(_hwc(img), 0.5)), atol=0, rtol=0)
+    # the upper half is lost and the lower half appears twice
+    half = height // 2
+    torch.testing.assert_close(
+        ours[:, height - 2 * half : height - half], img[:, height - half :], atol=0, rtol=0
+    )
+
+
+def test_fix_paper_output_grows_above_half_ours_keeps_height():
+    img = _random_uint8((3, 40, 8), seed=3)
+    assert em_truncation_reference(_hwc(img), 0.45, paper_start=True).shape[0] == 40
+    # above 0.5 the released code returns a taller image; we reject such ratios with a clear error
+    assert em_truncation_reference(_hwc(img), 0.6, paper_start=True).shape[0] > 40
+    with pytest.raises(ValueError, match=r"\[0, 0.5\]"):
+        em_truncation(img, 0.6)
+    out = em_truncation(img, 0.45)
+    assert out.shape == img.shape
+    torch.testing.assert_close(out, _chw(em_truncation_reference(_hwc(img), 0.45)), atol=0, rtol=0)
+
+
+def test_batch_with_per_sample_ratios_is_one_call_equal_to_single_calls():
+    imgs = _random_uint8((5, 3, 31, 12), seed=11)
+    ratios = torch.tensor([0.0, 0.05, 0.1, 0.25, 0.5])
+    out = em_truncation(imgs, ratios)
+    for i in range(5):
+        torch.testing.assert_close(out[i], em_truncation(imgs[i], float(ratios[i])), atol=0, rtol=0)
+    torch.testing.assert_close(out[0], imgs[0], atol=0, rtol=0)
+
+
+def test_row_index_is_a_permutation_free_gather_of_existing_rows():
+    index = truncation_row_index(50, torch.tensor([0.0, 0.1, 0.3, 0.5], dtype=torch.float64))
+    assert index.shape == (4, 50)
+    assert int(index.min()) >= 0 and int(index.max()) < 50
+    torch.testing.assert_close(index[0], torch.arange(50))
+    lost = [50 - len(set(row.tolist())) for row in index]
+    assert lost == [0, 5, 15, 25]
+
+
+@pytest.mark.parametrize(("level", "ratio"), [("weak", 0.1), ("medium", 0.2), ("strong", 0.3)])
+def test_levels_map_to_paper_ratios(level, ratio):
+    attack = EMTruncation(level)
+    params = attack.sample_params(2, 64, 64)
+    torch.testing.assert_close(params["ratio"], torch.full((2,), ratio))
+    img = _random_uint8((3, 64, 48), seed=5)
+    torch.testing.assert_close(attack(img), _chw(em_truncation_reference(_hwc(img), ratio)), atol=0, rtol=0)
+
+
+def test_lost_rows_grow_with_intensity():
+    attack = EMTruncation()
+    s = torch.linspace(0, 1, 31)
+    ratios = attack.ratio_for(s).double()
+    lost = torch.floor(256 * ratios)
+    assert lost[0] == 0 and (lost[1:] >= lost[:-1]).all() and lost[-1] == int(256 * 0.3)
+
+
+def test_dtype_shape_layout_and_channels_preserved():
+    attack = EMTruncation("strong")
+    for img in (
+        _random_uint8((3, 21, 13), 0),
+        _random_uint8((2, 4, 21, 13), 1),
+        _random_uint8((2, 2, 3, 21, 13), 2),
+        torch.rand(1, 9, 9, generator=torch.Generator().manual_seed(0)),
+        torch.rand(2, 3, 9, 9, dtype=torch.float64, generator=torch.Generator().manual_seed(0)),
+        torch.zeros(3, 1, 1),
+    ):
+        out = attack(img)
+        assert out.shape == img.shape and out.dtype == img.dtype and out.device == img.device
+    gray = _random_uint8((1, 20, 5), 4)
+    # channel-agnostic: a grey image is truncated exactly like each channel of an RGB image
+    torch.testing.assert_close(attack(gray), em_truncation(gray.expand(3, -1, -1), 0.3)[:1], atol=0, rtol=0)
+
+
+def test_intensity_zero_is_identity_and_random_intensity_varies_per_sample():
+    img = _random_uint8((8, 3, 40, 40), 6)
+    torch.testing.assert_close(EMTruncation(0.0)(img), img, atol=0, rtol=0)
+    params = EMTruncation("random").sample_params(8, 40, 40, generator=torch.Generator().manual_seed(0))
+    assert len(set(params["ratio"].tolist())) == 8
+    assert ((params["ratio"] >= 0.1 - 1e-6) & (params["ratio"] <= 0.3 + 1e-6)).all()
+
+
+def test_same_seed_same_output_and_pickle_round_trip():
+    img = _random_uint8((4, 3, 30, 30), 7)
+    a, b = EMTruncation("random", seed=3), EMTruncation("random", seed=3)
+    torch.testing.assert_close(a(img), b(img), atol=0, rtol=0)
+    clone = pickle.loads(pickle.dumps(a))
+    torch.testing.assert_close(clone(img), a(img), atol=0, rtol=0)
+
+
+def test_explicit_ratio_overrides_intensity():
+    img = _random_uint8((3, 30, 30), 8)
+    torch.testing.assert_close(EMTruncation("weak", ratio=0.4)(img), em_truncation(img, 0.4), atol=0, rtol=0)
+    with pytest.raises(ValueError, match="ratio"):
+        EMTruncation(ratio=0.7)
+
+
+@pytest.mark.parametrize(
+    ("ratio", "match"),
+    [
+        (-0.1, r"\[0, 0.5\]"),
+        (float("nan"), r"\[0, 0.5\]"),
+        (torch.tensor([0.1, 0.2]), "one value per sample"),
+    ],
+)
+def test_bad_ratio_raises_clear_error(ratio, match):
+    with pytest.raises(ValueError, match=match):
+        em_truncation(_random_uint8((3, 3, 10, 10), 9), ratio)
+
+
+def test_bad_images_raise():
+    with pytest.raises(ValueError, match="shape"):
+        em_truncation(torch.zeros(10, 10), 0.1)
+    with pytest.raises(ValueError, match="channels"):
+        em_truncation(torch.zeros(5, 10, 10), 0.1)
+    with pytest.raises(ValueError, match="NaN"):
+        em_truncation(torch.full((3, 4, 4), float("nan")), 0.1)
