@@ -1,0 +1,261 @@
+"""Laser blinding: a laser aimed into the lens saturates the sensor (paper: Method, "Laser Blinding Attack";
+Appendix A, Algorithm "Laser Blinding Attack").
+
+Physics: the beam is spread by the lens into a saturated white core, a ring clipped in the laser's colour and a
+glare halo; the camera's exposure drops, darkening the rest of the scene. The paper blends a recorded pattern in
+linearly: ``out = clip(img * (1 - alpha) + pattern * alpha)``.
+
+Levels (Table 2, "weight of pattern"): alpha = 0 / 0.1 / 0.5 / 0.9 at s = 0 / weak / medium / strong, linear in
+between (``interpolate_levels``).
+
+Pattern: procedural by default (``patterns.laser_spot``: core radius, power-law halo exponent, laser colour
+red/green/blue/violet/white or an RGB triple, colour crosstalk, flare streaks; sizes relative to the shorter image
+side), or ``pattern=PATH`` for a user image such as a real laser capture (resized to the image, antialiased
+bicubic; the paper's code used LANCZOS). ``position`` places the spot centre at (x, y) fractions of the width and
+height (default the centre; the image pattern is shifted, black filling the uncovered part); ``"random"`` draws
+it per sample, uniformly in ``position_range`` on both axes, rounded to whole pixels. Only alpha (via the
+intensity) and, when asked, the position are random; the spot shape is fixed per instance.
+
+Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
+being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
+global RNG; uint8 output is rounded, not truncated (at most 1 grey level apart).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, ClassVar
+
+import torch
+
+from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
+from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.patterns import (
+    check_levels,
+    laser_spot,
+    load_pattern_image,
+    parse_color,
+    resize_pattern,
+)
+
+ALPHA_LEVELS: tuple[float, float, float, float] = (0.0, 0.1, 0.5, 0.9)
+_MAX_CACHED = 8
+
+
+def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.device) -> torch.Tensor:
+    """A scalar or per-sample value -> float32 ``(batch or 1, 1, 1, 1)`` for broadcasting."""
+    values = torch.as_tensor(value, dtype=torch.float32, device=device).reshape(-1)
+    if values.numel() not in (1, batch):
+        raise ValueError(f"expected 1 or {batch} per-sample values, got {values.numel()}")
+    return values.reshape(-1, 1, 1, 1)
+
+
+def blend(x: torch.Tensor, alpha: torch.Tensor | float, pattern: torch.Tensor) -> torch.Tensor:
+    """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding)."""
+    weight = _as_batch_values(alpha, x.shape[0], x.device)
+    return torch.lerp(x, pattern.to(x.dtype), weight).clamp_(0.0, 1.0)
+
+
+def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: torch.Tensor) -> torch.Tensor:
+    """Blend ``pattern`` into ``image`` with weight ``alpha`` (a float or one value per sample).
+
+    ``image``: uint8 or float [0, 1], ``(C, H, W)`` or ``(B, C, H, W)``. ``pattern``: ``(3, h, w)`` or
+    ``(B, 3, h, w)`` (1 or 4 channels accepted; alpha ignored), uint8 or float, resized to the image if needed.
+    Returns the image's dtype, shape and device.
+    """
+    check_image(image)
+    check_image(pattern)
+    if not torch.all((torch.as_tensor(alpha) >= 0) & (torch.as_tensor(alpha) <= 1)):
+        raise ValueError(f"alpha must lie in [0, 1], got {alpha!r}")
+    x, keep_alpha = to_float_rgb(image)
+    flat, _ = to_float_rgb(pattern.to(image.device))
+    resized = torch.stack([resize_pattern(p, *x.shape[-2:]) for p in flat])
+    return from_float_rgb(blend(x, alpha, resized), keep_alpha, image)
+
+
+def _parse_position(position: str | Sequence[float]) -> tuple[float, float] | None:
+    """``"center"`` / ``(x, y)`` fractions -> the pair; ``"random"`` -> None."""
+    if isinstance(position, str):
+        if position == "random":
+            return None
+        if position == "center":
+            return (0.5, 0.5)
+        raise ValueError(
+            f"unknown position {position!r}; valid: 'center', 'random' or an (x, y) pair in [0, 1]"
+        )
+    pair = tuple(float(v) for v in position)
+    if len(pair) != 2 or not all(0.0 <= v <= 1.0 for v in pair):
+        raise ValueError(f"position must be 'center', 'random' or an (x, y) pair in [0, 1], got {position!r}")
+    return pair
+
+
+class LaserBlinding(CameraAttack):
+    """Laser blinding; see the module docstring. ``levels`` overrides the alpha table (identity, weak, medium, strong)."""
+
+    name: ClassVar[str] = "laser_blinding"
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        pattern: str | Path | None = None,
+        color: str | Sequence[float] = "green",
+        position: str | Sequence[float] = "center",
+        position_range: Sequence[float] = (0.15, 0.85),
+        core_radius: float = 0.08,
+        halo_exponent: float = 2.0,
+        crosstalk: float = 0.25,
+        streaks: int = 4,
+        streak_strength: float = 0.3,
+        streak_width: float = 0.01,
+        streak_angle: float = 15.0,
+        levels: Sequence[float] = ALPHA_LEVELS,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__(intensity, seed=seed, generator=generator)
+        self.levels = check_levels(levels, "laser blinding alpha", upper=1.0)
+        self.pattern_path = None if pattern is None else str(pattern)
+        self.color = parse_color(color)
+        self.position = position
+        self._fixed_position = _parse_position(position)
+        low, high = (float(v) for v in position_range)
+        if not (0.0 <= low <= high <= 1.0):
+            raise ValueError(
+                f"position_range must be (low, high) with 0 <= low <= high <= 1, got {position_range!r}"
+            )
+        self.position_range = (low, high)
+        if streaks < 0:
+            raise ValueError(f"streaks must be >= 0, got {streaks}")
+        self.spot_kwargs: dict[str, Any] = {
+            "core_radius": float(core_radius),
+            "halo_exponent": float(halo_exponent),
+            "color": self.color,
+            "crosstalk": float(crosstalk),
+            "streaks": int(streaks),
+            "streak_strength": float(streak_strength),
+            "streak_width": float(streak_width),
+            "streak_angle": float(streak_angle),
+        }
+        laser_spot(1, 1, center=(0.0, 0.0), **self.spot_kwargs)  # validate the shape parameters now
+        # Loaded once here (not on every call, the paper code's defect); travels with the pickle.
+        self._user_pattern = None if pattern is None else load_pattern_image(pattern, keep_alpha=False)
+        self._cache: dict[tuple, torch.Tensor] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = super().__getstate__()
+        state["_cache"] = {}
+        return state
+
+    # -- parameters ---------------------------------------------------------------------------------------------
+    def _sample(
+        self,
+        s: torch.Tensor,
+        height: int,
+        width: int,
+        generator: torch.Generator | None,
+        device: torch.device | str | None,
+    ) -> dict[str, torch.Tensor]:
+        batch = s.shape[0]
+        if self._fixed_position is None:
+            if generator is None:
+                raise ValueError("position='random' needs a torch.Generator (pass generator= or seed=)")
+            low, high = self.position_range
+            u = torch.rand(batch, 2, generator=generator, device=generator.device)
+            position = (low + (high - low) * u).to(device)
+        else:
+            position = torch.tensor(self._fixed_position, dtype=torch.float32, device=device).expand(batch, 2)
+        return {"alpha": interpolate_levels(s, self.levels), "position": position.clone()}
+
+    # -- pattern ---------------------------------------------------------------------------------------------------
+    def _remember(self, key: tuple, make: Any) -> torch.Tensor:
+        if key not in self._cache:
+            if len(self._cache) >= _MAX_CACHED:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = make()
+        return self._cache[key]
+
+    def _resized_user_pattern(self, height: int, width: int, device: torch.device) -> torch.Tensor:
+        assert self._user_pattern is not None
+        return self._remember(
+            ("user", height, width, str(device)),
+            lambda: resize_pattern(self._user_pattern.to(device), height, width),
+        )
+
+    def spot_pixel(self, position: torch.Tensor, height: int, width: int) -> torch.Tensor:
+        """(x, y) fractions ``(B, 2)`` -> integer (row, col) pixel centres ``(B, 2)``."""
+        rows = torch.round(position[:, 1] * (height - 1))
+        cols = torch.round(position[:, 0] * (width - 1))
+        return torch.stack([rows, cols], dim=1).long()
+
+    def render_pattern(
+        self, height: int, width: int, row: int, col: int, device: torch.device
+    ) -> torch.Tensor:
+        """The pattern ``(3, height, width)`` with its centre at pixel (row, col); cached."""
+
+        def make() -> torch.Tensor:
+            if self._user_pattern is None:
+                return laser_spot(
+                    height, width, center=(float(row), float(col)), device=device, **self.spot_kwargs
+                )
+            base = self._resized_user_pattern(height, width, device)
+            shifted = torch.zeros_like(base)
+            dy, dx = row - round(0.5 * (height - 1)), col - round(0.5 * (width - 1))
+            src_r, dst_r = (
+                slice(max(0, -dy), min(height, height - dy)),
+                slice(max(0, dy), min(height, height + dy)),
+            )
+            src_c, dst_c = (
+                slice(max(0, -dx), min(width, width - dx)),
+                slice(max(0, dx), min(width, width + dx)),
+            )
+            shifted[:, dst_r, dst_c] = base[:, src_r, src_c]
+            return shifted
+
+        return self._remember(("single", height, width, row, col, str(device)), make)
+
+    def _canvas(self, height: int, width: int, device: torch.device) -> torch.Tensor:
+        """A ``(3, 2H-1, 2W-1)`` canvas with the pattern centred at (H-1, W-1): crops give every position."""
+
+        def make() -> torch.Tensor:
+            if self._user_pattern is None:
+                return laser_spot(
+                    2 * height - 1,
+                    2 * width - 1,
+                    center=(height - 1.0, width - 1.0),
+                    unit=min(height, width),
+                    device=device,
+                    **self.spot_kwargs,
+                )
+            canvas = torch.zeros(3, 2 * height - 1, 2 * width - 1, device=device)
+            top, left = height - 1 - round(0.5 * (height - 1)), width - 1 - round(0.5 * (width - 1))
+            canvas[:, top : top + height, left : left + width] = self._resized_user_pattern(
+                height, width, device
+            )
+            return canvas
+
+        return self._remember(("canvas", height, width, str(device)), make)
+
+    def patterns_for(
+        self, position: torch.Tensor, height: int, width: int, device: torch.device
+    ) -> torch.Tensor:
+        """Patterns ``(B or 1, 3, H, W)`` for per-sample positions ``(B, 2)``."""
+        pixels = self.spot_pixel(position.to(device), height, width)
+        if bool((pixels == pixels[:1]).all()):
+            row, col = (int(v) for v in pixels[0].tolist())
+            return self.render_pattern(height, width, row, col, device)[None]
+        canvas = self._canvas(height, width, device)
+        rows = (height - 1 - pixels[:, :1]) + torch.arange(height, device=device)
+        cols = (width - 1 - pixels[:, 1:]) + torch.arange(width, device=device)
+        return canvas[:, rows[:, :, None], cols[:, None, :]].permute(1, 0, 2, 3)
+
+    # -- application ----------------------------------------------------------------------------------------------
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        height, width = x.shape[-2:]
+        pattern = self.patterns_for(params["position"], height, width, x.device)
+        return blend(x, params["alpha"], pattern)
+
+    def extra_repr(self) -> str:
+        source = self.pattern_path or f"procedural color={self.color}"
+        return f"{super().extra_repr()}, pattern={source!r}, position={self.position!r}"

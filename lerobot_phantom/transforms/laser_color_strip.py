@@ -1,0 +1,154 @@
+"""Laser color strip: a switch-modulated laser paints coloured bands through the CMOS rolling shutter
+(paper: Method, "Laser Color Strip Attack", after Yan et al., "Rolling colors"; Appendix A, Algorithm
+"Laser Color Strip Attack").
+
+Physics: each sensor row is exposed at a slightly different time, so a laser switched on for part of the frame
+adds light to a horizontal band only; the laser's wavelength sets how the light splits over the colour channels.
+Algorithm (as the paper's code): rows ``h//3 .. (h//3)*2`` (end exclusive) get, at pixel (row p, col q),
+
+    I(p, q) = S * h * w / (2 pi sigma_p sigma_q sqrt(1 - rho^2))
+              * exp(-(a + b - c) / (2 (1 - rho^2))),     sigma_p = h/2, sigma_q = w/4, rho = 0,
+    a = (p - c_p)^2 / sigma_p^2,  b = (q - c_q)^2 / sigma_q^2,  c = 2 rho (p - c_p)(q - c_q) / (sigma_p sigma_q) = 0,
+    c_p = h//3 + h/2,  c_q = w/2,
+
+and channel k gets ``+ I * fraction_k`` (grey levels), clipped to [0, 255]. Note that the code measures ``p``
+from the band start plus ``h/2``, so the Gaussian's centre lies *below* the band (at ``h//3 + h/2``) and the band
+brightens towards its lower edge; this is kept as in the paper's code. The ``S h w`` factor cancels the Gaussian's
+normaliser up to ``4/pi``, so the peak gain ``4 S / pi`` does not depend on the image size.
+
+Levels: Table 2 lists the "weight" 0.5 / 1.5 / 2.5; the code's strength is that weight x 1000, S = 500 / 1500 /
+2500 grey-level units (of an 8-bit image; float images are handled as value x 255). S = 0 at s = 0, linear in
+between (``interpolate_levels``). Colour fractions (R, G, B) default to the paper's (0.6, 0.1, 0.1) (a red laser).
+Nothing else is random: the band is fixed by the image size.
+
+Deviations from the paper's code: vectorised; the (H, W) profile is computed once per (H, W, device) and cached
+(the loops recompute it per pixel); uint8 output is rounded instead of truncated by ``astype(uint8)``
+(at most 1 grey level apart).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Any, ClassVar
+
+import torch
+
+from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
+from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.patterns import check_levels
+
+STRENGTH_LEVELS: tuple[float, float, float, float] = (0.0, 500.0, 1500.0, 2500.0)
+PAPER_COLOR_FRACTIONS: tuple[float, float, float] = (0.6, 0.1, 0.1)
+_MAX_CACHED = 8
+
+
+def band_rows(height: int) -> tuple[int, int]:
+    """The attacked rows ``[start, end)`` of the paper's code."""
+    return height // 3, (height // 3) * 2
+
+
+def strip_profile(height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
+    """``I(p, q)`` for S = 1 over the band rows, float32 ``(end - start, width)`` in grey levels."""
+    start, end = band_rows(height)
+    rho = 0.0
+    sigma_p, sigma_q = height / 2.0, width / 4.0
+    p = torch.arange(start, end, dtype=torch.float64, device=device)[:, None]
+    q = torch.arange(width, dtype=torch.float64, device=device)[None, :]
+    a = (p - start - sigma_p) ** 2 / sigma_p**2
+    b = (q - width / 2.0) ** 2 / sigma_q**2
+    norm = 1.0 / (2.0 * math.pi * sigma_p * sigma_q * math.sqrt(1.0 - rho**2))
+    profile = norm * torch.exp(-(a + b) / (2.0 * (1.0 - rho**2))) * (height * width)
+    return profile.to(torch.float32)
+
+
+def add_strip(
+    x: torch.Tensor, strength: torch.Tensor, color_fractions: torch.Tensor, profile: torch.Tensor
+) -> torch.Tensor:
+    """Add ``strength * fraction * profile / 255`` to the band of float ``x`` ``(B, 3, H, W)``, clipped to [0, 1]."""
+    start, end = band_rows(x.shape[-2])
+    gain = strength.reshape(-1, 1).to(x.device, torch.float32) * color_fractions.reshape(-1, 3).to(x.device)
+    out = x.clone()
+    if end > start:
+        band = out[:, :, start:end]
+        band.add_(gain[:, :, None, None] * (profile / 255.0)).clamp_(0.0, 1.0)
+    return out
+
+
+def laser_color_strip(
+    image: torch.Tensor,
+    strength: float | torch.Tensor,
+    color_fractions: Sequence[float] | torch.Tensor = PAPER_COLOR_FRACTIONS,
+) -> torch.Tensor:
+    """Appendix A's laser color strip with strength ``S`` (grey-level units; float or one per sample) and colour
+    fractions (R, G, B) (``(3,)`` or one triple per sample). Returns the image's dtype, shape and device."""
+    check_image(image)
+    s = torch.as_tensor(strength, dtype=torch.float32).reshape(-1)
+    fractions = torch.as_tensor(color_fractions, dtype=torch.float32)
+    if not bool((s >= 0).all()) or not bool(torch.isfinite(s).all()):
+        raise ValueError(f"strength must be finite and >= 0, got {strength!r}")
+    if fractions.shape[-1] != 3 or not bool((fractions >= 0).all()):
+        raise ValueError(f"color_fractions must be non-negative (R, G, B) triples, got {color_fractions!r}")
+    x, keep_alpha = to_float_rgb(image)
+    profile = strip_profile(*x.shape[-2:], device=x.device)
+    return from_float_rgb(add_strip(x, s, fractions, profile), keep_alpha, image)
+
+
+class LaserColorStrip(CameraAttack):
+    """Laser color strip; see the module docstring. ``levels`` overrides the strength table (grey-level units)."""
+
+    name: ClassVar[str] = "laser_color_strip"
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        color_fractions: Sequence[float] = PAPER_COLOR_FRACTIONS,
+        levels: Sequence[float] = STRENGTH_LEVELS,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__(intensity, seed=seed, generator=generator)
+        self.levels = check_levels(levels, "laser color strip strength")
+        fractions = tuple(float(v) for v in color_fractions)
+        if len(fractions) != 3 or any(not (0.0 <= v <= 1.0) for v in fractions):
+            raise ValueError(
+                f"color_fractions must be three values in [0, 1] (R, G, B), got {color_fractions!r}"
+            )
+        self.color_fractions = fractions
+        self._cache: dict[tuple, torch.Tensor] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = super().__getstate__()
+        state["_cache"] = {}
+        return state
+
+    def _sample(
+        self,
+        s: torch.Tensor,
+        height: int,
+        width: int,
+        generator: torch.Generator | None,
+        device: torch.device | str | None,
+    ) -> dict[str, torch.Tensor]:
+        fractions = torch.tensor(self.color_fractions, dtype=torch.float32, device=device)
+        return {
+            "strength": interpolate_levels(s, self.levels),
+            "color_fractions": fractions.expand(s.shape[0], 3).clone(),
+        }
+
+    def profile(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
+        """The cached S = 1 band profile for this image size."""
+        key = (height, width, str(device))
+        if key not in self._cache:
+            if len(self._cache) >= _MAX_CACHED:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = strip_profile(height, width, device)
+        return self._cache[key]
+
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        profile = self.profile(*x.shape[-2:], device=x.device)
+        return add_strip(x, params["strength"], params["color_fractions"], profile)
+
+    def extra_repr(self) -> str:
+        return f"{super().extra_repr()}, color_fractions={self.color_fractions}"

@@ -1,0 +1,242 @@
+"""Light projection: a projector throws a fake image onto the scene or straight into the lens (paper: Method,
+"Light Projection Attack"; Appendix A, Algorithm "Light Projection Attack").
+
+Physics: the projected light replaces part of the scene's radiance where the image lands; the paper records the
+projected image and composites it over the frame as a watermark. Algorithm: the watermark's alpha is scaled by
+the transparency ``t`` (``int(a * t)`` on 8-bit alpha, as the paper's code), the watermark is placed centred plus
+an offset, ``pos = ((W - w) // 2 + x_off, (H - h) // 2 + y_off)``, and alpha-composited:
+``out = img * (1 - a t) + wm * a t``.
+
+Levels (Table 2, "weight of pattern"): t = 0 / 0.1 / 0.5 / 0.9 at s = 0 / weak / medium / strong, linear in
+between (``interpolate_levels``).
+
+Pattern: a procedural, text-free shape (``patterns.PROJECTION_SHAPES``: ``stop_sign`` octagon, ``arrow``, ``can``,
+``disk``) or ``pattern=PATH`` for a user image (RGBA keeps its alpha; RGB is opaque). ``size`` is the watermark's
+longer side as a fraction of the image's shorter side (aspect kept). Offsets ``x_offset``/``y_offset`` are pixels at
+the 256x256 reference (``base.REFERENCE_SIZE``), scaled by ``W/256`` and ``H/256`` and rounded; the watermark may
+hang over the border (clipped). ``position="random"`` draws both offsets per sample uniformly in
+``[-max_offset, max_offset]`` (reference pixels) instead. Only ``t`` (via the intensity) and, when asked, the
+offsets are random; the shape is fixed per instance.
+
+Deviations from the paper's code: the watermark is built (or read) once and cached per size instead of being
+loaded on every call; randomness comes from the attack's seeded ``torch.Generator``; compositing is done in float
+(at most 1 grey level from PIL's integer arithmetic).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, ClassVar
+
+import torch
+
+from lerobot_phantom.transforms.base import (
+    REFERENCE_SIZE,
+    CameraAttack,
+    check_image,
+    from_float_rgb,
+    to_float_rgb,
+)
+from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.patterns import (
+    PROJECTION_SHAPES,
+    check_levels,
+    fit_size,
+    load_pattern_image,
+    projection_shape,
+    resize_pattern,
+)
+
+TRANSPARENCY_LEVELS: tuple[float, float, float, float] = (0.0, 0.1, 0.5, 0.9)
+_ALPHA_EPS = 1e-4  # int(a * t) in float64 vs float32: keep exact products like 30 * 0.1 on the same side
+_MAX_CACHED = 8
+
+
+def _scaled_alpha(alpha: torch.Tensor, transparency: torch.Tensor) -> torch.Tensor:
+    """``int(a8 * t) / 255`` for 8-bit alpha ``a8``; ``transparency`` broadcasts from the left."""
+    alpha8 = torch.round(alpha * 255.0)
+    t = transparency.reshape(-1, *([1] * (alpha.ndim - 1))) if alpha.ndim > 1 else transparency
+    return torch.floor(alpha8 * t + _ALPHA_EPS) / 255.0
+
+
+def placement(
+    height: int, width: int, pattern_height: int, pattern_width: int, offset: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """Top-left (row, col) ``(B,)`` of the watermark for offsets ``(B, 2)`` = (x, y) reference pixels."""
+    dx = torch.round(offset[:, 0] * (width / REFERENCE_SIZE)).long()
+    dy = torch.round(offset[:, 1] * (height / REFERENCE_SIZE)).long()
+    return (height - pattern_height) // 2 + dy, (width - pattern_width) // 2 + dx
+
+
+def composite(
+    x: torch.Tensor,
+    pattern_rgba: torch.Tensor,
+    transparency: torch.Tensor,
+    top: torch.Tensor,
+    left: torch.Tensor,
+) -> torch.Tensor:
+    """Alpha-composite ``pattern_rgba`` ``(4, h, w)`` onto float ``x`` ``(B, 3, H, W)`` at per-sample top-left."""
+    batch, _, height, width = x.shape
+    ph, pw = pattern_rgba.shape[-2:]
+    t = transparency.to(x.device, torch.float32).reshape(-1).expand(batch)
+    top, left = top.to(x.device).expand(batch), left.to(x.device).expand(batch)
+    if bool((top == top[0]).all() and (left == left[0]).all()):
+        r0, c0 = int(top[0]), int(left[0])
+        rs, re = max(0, r0), min(height, r0 + ph)
+        cs, ce = max(0, c0), min(width, c0 + pw)
+        out = x.clone()
+        if rs >= re or cs >= ce:
+            return out
+        piece = pattern_rgba[:, rs - r0 : re - r0, cs - c0 : ce - c0]
+        a = _scaled_alpha(piece[3][None, None], t)  # (B, 1, h', w')
+        out[:, :, rs:re, cs:ce] = torch.lerp(x[:, :, rs:re, cs:ce], piece[None, :3], a)
+        return out
+    rows = torch.arange(height, device=x.device)[None] - top[:, None]  # (B, H) watermark row
+    cols = torch.arange(width, device=x.device)[None] - left[:, None]
+    inside = ((rows >= 0) & (rows < ph))[:, :, None] & ((cols >= 0) & (cols < pw))[:, None, :]
+    layer = pattern_rgba[
+        :, rows.clamp(0, ph - 1)[:, :, None], cols.clamp(0, pw - 1)[:, None, :]
+    ]  # (4, B, H, W)
+    a = _scaled_alpha(layer[3] * inside, t)[:, None]
+    return torch.lerp(x, layer[:3].permute(1, 0, 2, 3), a)
+
+
+def light_projection(
+    image: torch.Tensor,
+    pattern_rgba: torch.Tensor,
+    transparency: float | torch.Tensor,
+    x_offset: int | torch.Tensor = 0,
+    y_offset: int | torch.Tensor = 0,
+) -> torch.Tensor:
+    """Composite the watermark ``pattern_rgba`` (``(4, h, w)``, uint8 or float, used at its own size) onto ``image``.
+
+    ``transparency`` in [0, 1] (float or one per sample); offsets in *image* pixels from the centred position
+    (ints or one per sample), exactly Appendix A's algorithm. Returns the image's dtype, shape and device.
+    """
+    check_image(image)
+    if pattern_rgba.ndim != 3 or pattern_rgba.shape[0] != 4 or pattern_rgba.numel() == 0:
+        raise ValueError(
+            f"pattern_rgba must be a non-empty (4, h, w) RGBA tensor, got {tuple(pattern_rgba.shape)}"
+        )
+    t = torch.as_tensor(transparency, dtype=torch.float32).reshape(-1)
+    if not bool(((t >= 0) & (t <= 1)).all()):
+        raise ValueError(f"transparency must lie in [0, 1], got {transparency!r}")
+    x, keep_alpha = to_float_rgb(image)
+    pattern = pattern_rgba.to(x.device)
+    pattern = pattern.to(torch.float32) / 255.0 if pattern.dtype == torch.uint8 else pattern.to(torch.float32)
+    height, width = x.shape[-2:]
+    ph, pw = pattern.shape[-2:]
+    dx = torch.as_tensor(x_offset, device=x.device).reshape(-1).long()
+    dy = torch.as_tensor(y_offset, device=x.device).reshape(-1).long()
+    top, left = (height - ph) // 2 + dy, (width - pw) // 2 + dx
+    y = composite(x, pattern, t, top, left)
+    return from_float_rgb(y, keep_alpha, image)
+
+
+class LightProjection(CameraAttack):
+    """Light projection; see the module docstring. ``levels`` overrides the transparency table."""
+
+    name: ClassVar[str] = "light_projection"
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        pattern: str | Path = "stop_sign",
+        size: float = 0.5,
+        x_offset: float = 0.0,
+        y_offset: float = 0.0,
+        position: str = "fixed",
+        max_offset: float = 96.0,
+        levels: Sequence[float] = TRANSPARENCY_LEVELS,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__(intensity, seed=seed, generator=generator)
+        self.levels = check_levels(levels, "light projection transparency", upper=1.0)
+        if not (0.0 < float(size) <= 4.0):
+            raise ValueError(f"size (watermark side / image shorter side) must be in (0, 4], got {size!r}")
+        if position not in ("fixed", "random"):
+            raise ValueError(
+                f"unknown position {position!r}; valid: 'fixed' (x_offset, y_offset) or 'random'"
+            )
+        if max_offset < 0:
+            raise ValueError(f"max_offset must be >= 0, got {max_offset}")
+        self.size = float(size)
+        self.offset = (float(x_offset), float(y_offset))
+        self.position = position
+        self.max_offset = float(max_offset)
+        pattern_text = str(pattern)
+        if pattern_text in PROJECTION_SHAPES:
+            self.pattern = pattern_text
+            self._user_pattern = None
+        elif isinstance(pattern, Path) or Path(pattern_text).suffix:
+            self.pattern = pattern_text
+            # Loaded once here (not on every call, the paper code's defect); travels with the pickle.
+            self._user_pattern = load_pattern_image(pattern_text, keep_alpha=True)
+        else:
+            raise ValueError(
+                f"unknown projection pattern {pattern!r}; valid: {', '.join(PROJECTION_SHAPES)} or an image path"
+            )
+        self._cache: dict[tuple, torch.Tensor] = {}
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = super().__getstate__()
+        state["_cache"] = {}
+        return state
+
+    def _sample(
+        self,
+        s: torch.Tensor,
+        height: int,
+        width: int,
+        generator: torch.Generator | None,
+        device: torch.device | str | None,
+    ) -> dict[str, torch.Tensor]:
+        batch = s.shape[0]
+        if self.position == "random":
+            if generator is None:
+                raise ValueError("position='random' needs a torch.Generator (pass generator= or seed=)")
+            u = torch.rand(batch, 2, generator=generator, device=generator.device)
+            offset = ((2.0 * u - 1.0) * self.max_offset).to(device)
+        else:
+            offset = torch.tensor(self.offset, dtype=torch.float32, device=device).expand(batch, 2).clone()
+        return {"transparency": interpolate_levels(s, self.levels), "offset": offset}
+
+    def watermark(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
+        """The RGBA watermark ``(4, h, w)`` for an image of this size (alpha on the 1/255 grid); cached."""
+        box = max(1, round(self.size * min(height, width)))
+        key = (box, str(device))
+        if key not in self._cache:
+            if len(self._cache) >= _MAX_CACHED:
+                self._cache.pop(next(iter(self._cache)))
+            if self._user_pattern is None:
+                rgba = projection_shape(self.pattern, box)
+            else:
+                rgba = _resize_rgba(self._user_pattern, *fit_size(*self._user_pattern.shape[-2:], box))
+            self._cache[key] = rgba.to(device)
+        return self._cache[key]
+
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        height, width = x.shape[-2:]
+        rgba = self.watermark(height, width, x.device)
+        top, left = placement(height, width, rgba.shape[-2], rgba.shape[-1], params["offset"].to(x.device))
+        return composite(x, rgba, params["transparency"], top, left)
+
+    def extra_repr(self) -> str:
+        return (
+            f"{super().extra_repr()}, pattern={self.pattern!r}, size={self.size}, position={self.position!r}"
+        )
+
+
+def _resize_rgba(rgba: torch.Tensor, height: int, width: int) -> torch.Tensor:
+    """Resize premultiplied (no dark fringes at transparent edges), alpha back on the 1/255 grid."""
+    alpha = rgba[3:]
+    premultiplied = torch.cat([rgba[:3] * alpha, alpha])
+    resized = resize_pattern(premultiplied, height, width)
+    alpha = torch.round(resized[3:] * 255.0) / 255.0
+    rgb = torch.where(alpha > 0, resized[:3] / alpha.clamp_min(1e-6), torch.zeros_like(resized[:3])).clamp_(
+        0.0, 1.0
+    )
+    return torch.cat([rgb, alpha])
