@@ -1,0 +1,142 @@
+"""Rollouts under attack on a tiny LeRobot env (tests/eval/eval_testkit.py) with real LeRobot test policies."""
+
+import json
+
+import eval_testkit as kit
+import pytest
+from lerobot.configs.default import EvalConfig
+
+from lerobot_phantom.eval.config import EvalPhantomConfig, PhantomEvalConfig
+from lerobot_phantom.eval.eval import EVAL_FILENAME, evaluate
+from lerobot_phantom.eval.rollout import Condition, build_conditions
+
+CAMERA_STRONG = ["laser_blinding", "em_truncation", "laser_color_strip"]
+
+
+def make_cfg(tmp_path, n_episodes=8, batch_size=4, **phantom):
+    return PhantomEvalConfig(
+        env=kit.DotReachEnvConfig(),
+        eval=EvalConfig(n_episodes=n_episodes, batch_size=batch_size),
+        output_dir=tmp_path / "out",
+        seed=7,
+        phantom=EvalPhantomConfig(**phantom),
+    )
+
+
+def tsr(report, condition):
+    (row,) = [r for r in report["summary"] if r["condition"] == condition]
+    return row["tsr"]
+
+
+@pytest.fixture(scope="module")
+def colour_report(tmp_path_factory):
+    cfg = make_cfg(
+        tmp_path_factory.mktemp("colour"),
+        attacks=CAMERA_STRONG + ["voice_dos"],
+        intensities=["strong"],
+        videos=1,
+    )
+    return evaluate(cfg, policy=kit.make_toy_policy("colour")), cfg
+
+
+def test_oracle_policy_is_unhurt_by_camera_attacks(tmp_path):
+    cfg = make_cfg(tmp_path, attacks=CAMERA_STRONG, intensities=["weak", "strong"])
+    report = evaluate(cfg, policy=kit.make_toy_policy("oracle"))
+    assert [r["condition"] for r in report["summary"]] == [c.key for c in build_conditions(cfg.phantom)]
+    for row in report["summary"]:
+        assert row["episodes"] == 8
+        assert row["tsr"] == 1.0, row
+
+
+def test_image_policy_loses_success_under_strong_camera_attacks(colour_report):
+    report, _ = colour_report
+    assert tsr(report, "clean") == 1.0
+    assert tsr(report, "laser_blinding@strong") < 0.5
+    strong = [tsr(report, f"{a}@strong") for a in CAMERA_STRONG]
+    assert sum(strong) / len(strong) < 0.75
+    # The colour policy ignores the instruction, so removing it changes nothing.
+    assert tsr(report, "voice_dos") == 1.0
+
+
+def test_paired_seeds_identical_across_conditions_and_recorded(colour_report):
+    report, cfg = colour_report
+    on_disk = json.loads((cfg.output_dir / EVAL_FILENAME).read_text())
+    assert on_disk == json.loads(json.dumps(report))
+    expected = list(range(7, 7 + 8))
+    assert on_disk["metadata"]["episode_seeds"] == expected
+    for row in on_disk["results"]:
+        assert [e["seed"] for e in row["per_episode"]] == expected
+        assert row["successes"] == sum(e["success"] for e in row["per_episode"])
+        low, high = row["ci95"]
+        assert low <= row["tsr"] <= high
+    meta = on_disk["metadata"]
+    assert meta["env"]["type"] == "phantom_test_dot"
+    assert set(meta["versions"]) >= {"lerobot", "lerobot_phantom", "torch"}
+    assert meta["phantom"]["intensities"] == ["strong"]
+
+
+def test_attack_parameters_fixed_per_episode_and_reproducible(colour_report, tmp_path):
+    report, cfg = colour_report
+    first = {r["condition"]: [e["attack_params"] for e in r["per_episode"]] for r in report["results"]}
+    assert first["clean"][0] == {}
+    assert set(first["laser_blinding@strong"][0]) == {"front"}  # the front camera only, as in the paper
+    again = evaluate(
+        make_cfg(tmp_path, n_episodes=8, batch_size=8, attacks=["laser_blinding"], intensities=["strong"]),
+        policy=kit.make_toy_policy("colour"),
+    )
+    # Same seeds, another batch size: the same per-episode attack and the same outcomes.
+    rerun = {r["condition"]: r for r in again["results"]}["laser_blinding@strong"]
+    original = {r["condition"]: r for r in report["results"]}["laser_blinding@strong"]
+    assert [e["attack_params"] for e in rerun["per_episode"]] == [
+        e["attack_params"] for e in original["per_episode"]
+    ]
+    assert [e["success"] for e in rerun["per_episode"]] == [e["success"] for e in original["per_episode"]]
+
+
+def test_videos_written_for_first_episodes_of_each_condition(colour_report):
+    _, cfg = colour_report
+    videos = sorted(
+        p.relative_to(cfg.output_dir / "videos").as_posix()
+        for p in (cfg.output_dir / "videos").rglob("*.mp4")
+    )
+    assert len(videos) == len(build_conditions(cfg.phantom))
+    assert "clean/phantom_test_dot_0/episode_seed7.mp4" in videos
+    assert all(p.endswith("episode_seed7.mp4") for p in videos)
+
+
+def test_instruction_attacks_reach_the_task_text(tmp_path):
+    cfg = make_cfg(
+        tmp_path,
+        n_episodes=4,
+        attacks=["voice_dos", "voice_spoofing", "laser_blinding"],
+        intensities=["strong"],
+    )
+    report = evaluate(cfg, policy=kit.make_toy_policy("instructed"))
+    assert tsr(report, "clean") == 1.0
+    assert tsr(report, "voice_dos") == 0.0  # the instruction is gone: the policy does not move
+    assert tsr(report, "voice_spoofing") == 1.0  # the original text is kept in the paper's mode
+    assert tsr(report, "laser_blinding@strong") == 1.0  # reads true state, not the image
+
+
+def test_onset_after_the_episode_leaves_it_clean_and_short_duration_is_partial(tmp_path):
+    late = evaluate(
+        make_cfg(tmp_path / "late", attacks=["laser_blinding"], intensities=["strong"], onset=kit.MAX_STEPS),
+        policy=kit.make_toy_policy("colour"),
+    )
+    assert tsr(late, "laser_blinding@strong") == 1.0
+    # Blinded for the first 2 steps only: the policy waits, then still has time to reach the target.
+    brief = evaluate(
+        make_cfg(tmp_path / "brief", attacks=["laser_blinding"], intensities=["strong"], onset=0, duration=2),
+        policy=kit.make_toy_policy("colour"),
+    )
+    assert tsr(brief, "laser_blinding@strong") == 1.0
+    steps_clean = [e["steps"] for e in brief["results"][0]["per_episode"]]
+    steps_brief = [e["steps"] for e in brief["results"][1]["per_episode"]]
+    assert all(b == c + 2 for b, c in zip(steps_brief, steps_clean, strict=True))
+
+
+def test_condition_keys():
+    assert Condition("clean").key == "clean"
+    assert Condition("laser_blinding", "weak").key == "laser_blinding@weak"
+    assert Condition("voice_dos").key == "voice_dos"
+    assert Condition("laser_blinding", "0.5").intensity_value == 0.5
