@@ -1,0 +1,159 @@
+import os
+import pickle
+
+import numpy as np
+import pytest
+import torch
+from reference_optical import laser_blinding_reference
+
+from lerobot_phantom.transforms.laser_blinding import ALPHA_LEVELS, LaserBlinding, laser_blinding
+from lerobot_phantom.transforms.patterns import LASER_COLORS, laser_spot, parse_color
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+CPU = torch.device("cpu")
+
+
+def _random_uint8(shape, seed):
+    return torch.randint(0, 256, shape, dtype=torch.uint8, generator=torch.Generator().manual_seed(seed))
+
+
+def _hwc(chw: torch.Tensor) -> np.ndarray:
+    return chw.permute(1, 2, 0).numpy()
+
+
+@pytest.mark.parametrize("size", [(24, 32), (31, 17)])
+@pytest.mark.parametrize("level", ["weak", "medium", "strong"])
+def test_matches_paper_reference(size, level):
+    img = _random_uint8((3, *size), seed=size[0] + len(level))
+    attack = LaserBlinding(level, color="red")
+    params = attack.sample_params(1, *size)
+    pattern = attack.patterns_for(params["position"], *size, CPU)[0]
+    alpha = float(params["alpha"][0])
+    assert alpha == pytest.approx(dict(zip(("weak", "medium", "strong"), ALPHA_LEVELS[1:], strict=True))[level])
+    expected = laser_blinding_reference(_hwc(img), _hwc(pattern * 255.0), alpha)
+    fast = attack.apply_params(img, params)
+    assert np.abs(_hwc(fast).astype(int) - expected.astype(int)).max() <= 1
+    functional = laser_blinding(img, alpha, pattern)
+    assert np.abs(_hwc(functional).astype(int) - expected.astype(int)).max() <= 1
+
+
+def test_functional_resizes_pattern_and_accepts_per_sample_alpha():
+    img = _random_uint8((2, 3, 20, 30), seed=1)
+    small = torch.full((3, 5, 7), 255, dtype=torch.uint8)  # a white pattern of another size
+    out = laser_blinding(img, torch.tensor([0.0, 1.0]), small)
+    assert torch.equal(out[0], img[0])
+    assert bool((out[1] == 255).all())
+    with pytest.raises(ValueError, match=r"\[0, 1\]"):
+        laser_blinding(img, 1.5, small)
+
+
+def test_pattern_has_white_core_coloured_ring_and_power_law_halo():
+    height, width = 200, 200
+    spot = laser_spot(
+        height, width, center=(100.0, 100.0), core_radius=0.05, halo_exponent=2.0, color=(0, 1, 0), crosstalk=0.25
+    )
+    core = spot[:, 100, 100]
+    assert torch.allclose(core, torch.ones(3))  # every channel saturates: white
+    ring = spot[:, 100, 100 + 20]  # r = 0.1 > core radius 0.05
+    assert ring[1] == 1.0 and ring[0] < 1.0 and ring[2] < 1.0  # only the laser's channel clips
+    halo_near, halo_far = spot[1, 100, 100 + 50], spot[1, 100, 100 + 99]
+    assert 0 < halo_far < halo_near < 1
+    # power law: the unsaturated halo falls off like r^-2 (ratio of intensities ~ (r1/r2)^2, core term negligible)
+    assert float(halo_near / halo_far) == pytest.approx((99 / 50) ** 2, rel=0.05)
+
+
+def test_pattern_scales_with_image_size():
+    attack = LaserBlinding("strong")
+    small = attack.patterns_for(torch.tensor([[0.5, 0.5]]), 96, 96, CPU)[0]
+    large = attack.patterns_for(torch.tensor([[0.5, 0.5]]), 480, 480, CPU)[0]
+    shrunk = torch.nn.functional.interpolate(large[None], size=(96, 96), mode="area")[0]
+    assert (shrunk - small).abs().mean() < 0.02
+
+
+@pytest.mark.parametrize("color", sorted(LASER_COLORS))
+def test_laser_colour_dominates_the_halo(color):
+    rgb = torch.tensor(parse_color(color))
+    spot = LaserBlinding(color=color, streaks=0).render_pattern(64, 64, 32, 32, CPU)
+    halo = spot[:, 32, 60]
+    assert int(halo.argmax()) == int(rgb.argmax())
+
+
+def test_rgb_triple_colour_and_bad_colour():
+    assert parse_color((255, 128, 0)) == pytest.approx((1.0, 128 / 255, 0.0))
+    with pytest.raises(ValueError, match="red"):
+        LaserBlinding(color="purple-ish")
+
+
+def test_random_position_is_per_sample_and_seeded():
+    attack = LaserBlinding("strong", position="random", seed=3)
+    img = torch.zeros(6, 3, 40, 50, dtype=torch.uint8)
+    out = attack(img)
+    brightest = [int(o.float().sum(0).argmax()) for o in out]
+    assert len(set(brightest)) > 1
+    again = LaserBlinding("strong", position="random", seed=3)(img)
+    assert torch.equal(out, again)
+
+
+def test_fixed_position_places_spot_where_asked():
+    attack = LaserBlinding("strong", position=(0.25, 0.75), streaks=0)
+    out = attack(torch.zeros(3, 41, 81))
+    brightest = torch.nonzero(out.sum(0) >= out.sum(0).max() - 1e-6).float()
+    row, col = brightest.mean(0).tolist()  # centre of the saturated core
+    assert (row, col) == pytest.approx((30.0, 20.0), abs=1e-6)
+
+
+def test_canvas_crop_equals_direct_render():
+    attack = LaserBlinding("strong", position="random", seed=0)
+    params = attack.sample_params(4, 23, 37, generator=torch.Generator().manual_seed(5))
+    batch = attack.patterns_for(params["position"], 23, 37, CPU)
+    pixels = attack.spot_pixel(params["position"], 23, 37)
+    for i in range(4):
+        direct = attack.render_pattern(23, 37, int(pixels[i, 0]), int(pixels[i, 1]), CPU)
+        assert torch.allclose(batch[i], direct, atol=1e-6)
+
+
+def _write_png(path, array):
+    from PIL import Image
+
+    Image.fromarray(array).save(path)
+
+
+def test_user_pattern_is_loaded_once_and_used(tmp_path):
+    array = np.zeros((10, 10, 3), dtype=np.uint8)
+    array[:, :5] = (255, 0, 0)
+    path = tmp_path / "capture.png"
+    _write_png(path, array)
+    attack = LaserBlinding("strong", pattern=path)
+    path.unlink()  # a per-call reload (the paper code's defect) would now fail
+    out = attack(torch.zeros(3, 20, 20, dtype=torch.uint8))
+    assert out[0, :, :8].float().mean() > 200 and out[0, :, 12:].float().mean() < 5
+    clone = pickle.loads(pickle.dumps(attack))
+    assert torch.equal(clone(torch.zeros(3, 20, 20, dtype=torch.uint8)), out)
+
+
+def test_user_pattern_shifted_with_random_position(tmp_path):
+    array = np.zeros((9, 9, 3), dtype=np.uint8)
+    array[4, 4] = 255
+    path = tmp_path / "dot.png"
+    _write_png(path, array)
+    attack = LaserBlinding("strong", pattern=path, position="random", seed=1)
+    out = attack(torch.zeros(5, 3, 9, 9))
+    peaks = {int(o.sum(0).argmax()) for o in out}
+    assert len(peaks) > 1
+
+
+def test_missing_pattern_and_bad_parameters_raise():
+    with pytest.raises(FileNotFoundError, match="nothing.png"):
+        LaserBlinding(pattern="nothing.png")
+    with pytest.raises(ValueError, match="random"):
+        LaserBlinding(position="somewhere")
+    with pytest.raises(ValueError, match="levels"):
+        LaserBlinding(levels=(0.1, 0.2, 0.3, 0.4))
+    with pytest.raises(ValueError, match="core_radius"):
+        LaserBlinding(core_radius=0.0)
+
+
+def test_levels_override_changes_alpha():
+    attack = LaserBlinding("strong", levels=(0.0, 0.2, 0.4, 0.6))
+    assert float(attack.sample_params(1, 8, 8)["alpha"][0]) == pytest.approx(0.6)
