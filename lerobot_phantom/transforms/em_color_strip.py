@@ -1,0 +1,193 @@
+"""EM color strip: electromagnetic interference on the camera bus breaks colour decoding in horizontal bands (paper,
+Method and Appendix A, Algorithm "EM Color Strip Attack"; after GlitchHiker, Jiang et al. 2023).
+
+The paper's algorithm, for ``N`` stripes on an image of height ``h`` (pixel values 0-255)::
+
+    step = int(h / N)
+    for down in range(0, h - step, 2 * step):          # every other band of `step` rows
+        rows [down, down + step):  R' = clip(int(2.5 G)),  G' = clip(int((R + B) / 2) - 50),  B' = clip(int(2.5 G))
+
+with every new value computed from the pixel's original R, G, B. Levels: N = 8 / 12 / 16 at weak / medium / strong
+(Table 2).
+
+Deviations from the paper's code (and why):
+
+* **No uint8 overflow.** The released code adds R and B as ``np.uint8``, which wraps modulo 256, so a bright
+  pixel (R + B > 255) gets a *dark* green channel. Here the sum is computed in float: the paper's formula as
+  written.
+* **Continuous values.** Float images keep continuous values (``2.5 G`` instead of ``int(2.5 G)``); for uint8
+  images the result is rounded, so it is within one grey level of the paper's truncating ``int()``.
+* **At least one row per band.** ``step = max(1, int(h / N))``: the released code crashes (``range`` step 0) on
+  images with fewer rows than stripes.
+* **Continuous intensity** (the paper has only three levels). With ``s`` the intensity (weak = 1/3, medium = 2/3,
+  strong = 1):
+
+  - ``0 <= s <= 1/3``: the weak pattern (N = 8) with every band thinned to ``band_fraction = 3 s`` of its height
+    (the partial row is blended), so ``s = 0`` is the identity and the corrupted rows only grow with ``s``.
+  - ``1/3 <= s <= 2/3`` and ``2/3 <= s <= 1``: the patterns of the two neighbouring levels (8 -> 12 and
+    12 -> 16 stripes) are cross-faded per row with weight ``mix = 3 s - 1`` resp. ``3 s - 2``. Interpolating ``N``
+    itself would not do: the corrupted area of the paper's pattern jumps around for non-level ``N`` (for h = 256:
+    128 rows at N = 8, 112 at N = 9, 138 at N = 11, 126 at N = 12, 128 at N = 16), whereas the cross-fade moves the
+    mean absolute difference to the clean image linearly from one level's value to the next.
+
+  The three levels are the paper's patterns exactly. Between levels the distortion is monotone whenever the
+  paper's own levels are ordered for the image; they cover about half of the frame each (for h = 256:
+  128 / 126 / 128 rows), so for a given image the medium level can distort slightly less than the weak one.
+* **Vectorised per sample**: the band pattern is a per-row weight, so a batch whose samples have different
+  stripe counts is one elementwise op.
+"""
+
+from __future__ import annotations
+
+from typing import ClassVar
+
+import torch
+
+from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
+from lerobot_phantom.transforms.intensity import IntensitySpec
+
+LEVEL_STRIPES: tuple[float, float, float] = (8.0, 12.0, 16.0)
+GREEN_GAIN = 2.5
+GREEN_OFFSET = 50.0 / 255.0
+
+
+def _per_sample(value: float | torch.Tensor, batch: int, device: torch.device, what: str) -> torch.Tensor:
+    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> float64 ``(batch,)`` on ``device``."""
+    t = torch.as_tensor(value, dtype=torch.float64).to(device).reshape(-1)
+    if t.numel() == 1:
+        return t.expand(batch)
+    if t.numel() != batch:
+        raise ValueError(
+            f"{what} must be a scalar or have one value per sample ({batch}), got {t.numel()} values"
+        )
+    return t
+
+
+def stripe_row_weights(height: int, num_stripes: torch.Tensor, band_fraction: torch.Tensor) -> torch.Tensor:
+    """Per-row corruption weight in [0, 1], ``(B, height)``, for per-sample stripe counts and band fractions."""
+    step = torch.clamp(torch.floor(height / num_stripes), min=1.0).unsqueeze(1)  # (B, 1)
+    rows = torch.arange(height, device=num_stripes.device, dtype=torch.float64).unsqueeze(0)  # (1, H)
+    band = torch.floor(rows / step)
+    band_start = band * step
+    covered = (torch.remainder(band, 2) == 0) & (band_start < height - step)
+    thickness = band_fraction.unsqueeze(1) * step - (rows - band_start)
+    return torch.where(covered, thickness.clamp(0.0, 1.0), torch.zeros_like(thickness))
+
+
+def em_color_error(x: torch.Tensor) -> torch.Tensor:
+    """The colour-decoding error on float RGB ``(B, 3, H, W)`` in [0, 1] (every pixel, from the original values)."""
+    red, green, blue = x.unbind(dim=1)
+    new_red = (GREEN_GAIN * green).clamp_(0.0, 1.0)
+    new_green = ((red + blue) * 0.5 - GREEN_OFFSET).clamp_(0.0, 1.0)
+    return torch.stack((new_red, new_green, new_red), dim=1)
+
+
+def _check_stripes(num_stripes: torch.Tensor) -> None:
+    if not torch.isfinite(num_stripes).all() or (num_stripes < 1).any():
+        raise ValueError(f"num_stripes must be >= 1, got {num_stripes.tolist()}")
+
+
+def em_color_strip_float(
+    x: torch.Tensor,
+    num_stripes: float | torch.Tensor,
+    band_fraction: float | torch.Tensor = 1.0,
+    next_num_stripes: float | torch.Tensor | None = None,
+    mix: float | torch.Tensor = 0.0,
+) -> torch.Tensor:
+    """``em_color_strip`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op)."""
+    batch, _, height, _ = x.shape
+    stripes = _per_sample(num_stripes, batch, x.device, "num_stripes")
+    fraction = _per_sample(band_fraction, batch, x.device, "band_fraction")
+    _check_stripes(stripes)
+    if not ((fraction >= 0) & (fraction <= 1)).all():
+        raise ValueError(f"band_fraction must lie in [0, 1], got {fraction.tolist()}")
+    weights = stripe_row_weights(height, stripes, fraction)
+    if next_num_stripes is not None:
+        following = _per_sample(next_num_stripes, batch, x.device, "next_num_stripes")
+        _check_stripes(following)
+        weight_of_next = _per_sample(mix, batch, x.device, "mix")
+        if not ((weight_of_next >= 0) & (weight_of_next <= 1)).all():
+            raise ValueError(f"mix must lie in [0, 1], got {weight_of_next.tolist()}")
+        weight_of_next = weight_of_next.unsqueeze(1)
+        weights = (1 - weight_of_next) * weights + weight_of_next * stripe_row_weights(
+            height, following, fraction
+        )
+    weights = weights.to(x.dtype)[:, None, :, None]
+    return torch.lerp(x, em_color_error(x), weights)
+
+
+def em_color_strip(
+    image: torch.Tensor,
+    num_stripes: float | torch.Tensor,
+    band_fraction: float | torch.Tensor = 1.0,
+    next_num_stripes: float | torch.Tensor | None = None,
+    mix: float | torch.Tensor = 0.0,
+) -> torch.Tensor:
+    """EM color strip of ``image`` (uint8 or float [0, 1], ``(..., C, H, W)``, C in {1, 3, 4}).
+
+    ``num_stripes`` (N >= 1) is the paper's parameter; ``band_fraction`` in [0, 1] thins every corrupted band;
+    ``next_num_stripes`` with ``mix`` in [0, 1] cross-fades to a second pattern (used between the paper's levels).
+    Each may be a float or one value per image. Returns the input's shape, dtype and device.
+    """
+    check_image(image)
+    x, alpha = to_float_rgb(image)
+    y = em_color_strip_float(x, num_stripes, band_fraction, next_num_stripes, mix)
+    return from_float_rgb(y, alpha, image)
+
+
+def stripe_params_for(s: torch.Tensor) -> dict[str, torch.Tensor]:
+    """Intensity ``s`` (per sample) -> the kernel's parameters (see the module docstring)."""
+    levels = torch.tensor((LEVEL_STRIPES[0], *LEVEL_STRIPES), dtype=torch.float32, device=s.device)
+    pos = s.to(torch.float32).clamp(0.0, 1.0) * 3.0
+    segment = (
+        pos.floor().clamp(max=2).long()
+    )  # 0: thinning weak bands, 1: weak -> medium, 2: medium -> strong
+    frac = pos - segment.to(torch.float32)
+    thinning = segment == 0
+    return {
+        "num_stripes": levels[segment],
+        "next_num_stripes": levels[segment + 1],
+        "mix": torch.where(thinning, torch.zeros_like(frac), frac),
+        "band_fraction": torch.where(thinning, frac, torch.ones_like(frac)),
+    }
+
+
+class EMColorStrip(CameraAttack):
+    """EM color strip attack as a torchvision v2 transform.
+
+    Intensity -> stripes: identity / 8 (weak) / 12 (medium) / 16 (strong), paper Table 2; see the module docstring
+    for the continuous mapping. ``num_stripes=`` fixes the paper's stripe count whatever the intensity.
+    """
+
+    name: ClassVar[str] = "em_color_strip"
+    LEVEL_STRIPES: ClassVar[tuple[float, float, float]] = LEVEL_STRIPES
+
+    def __init__(
+        self,
+        intensity: IntensitySpec = "medium",
+        *,
+        num_stripes: int | None = None,
+        seed: int | None = None,
+        generator: torch.Generator | None = None,
+    ) -> None:
+        super().__init__(intensity, seed=seed, generator=generator)
+        if num_stripes is not None and int(num_stripes) < 1:
+            raise ValueError(f"num_stripes must be >= 1, got {num_stripes!r}")
+        self.num_stripes = None if num_stripes is None else int(num_stripes)
+
+    def _sample(self, s, height, width, generator, device):
+        if self.num_stripes is not None:
+            fixed = torch.full_like(s, float(self.num_stripes), dtype=torch.float32)
+            ones = torch.ones_like(fixed)
+            return {"num_stripes": fixed, "next_num_stripes": fixed, "mix": 0 * ones, "band_fraction": ones}
+        return {k: v.to(device) for k, v in stripe_params_for(s).items()}
+
+    def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        return em_color_strip_float(
+            x, params["num_stripes"], params["band_fraction"], params["next_num_stripes"], params["mix"]
+        )
+
+    def extra_repr(self) -> str:
+        return super().extra_repr() + (
+            "" if self.num_stripes is None else f", num_stripes={self.num_stripes}"
+        )

@@ -1,0 +1,175 @@
+import itertools
+import os
+import pickle
+
+import numpy as np
+import pytest
+import torch
+from reference_em_blur import em_color_strip_reference
+
+from lerobot_phantom.transforms.em_color_strip import (
+    EMColorStrip,
+    em_color_strip,
+    stripe_params_for,
+    stripe_row_weights,
+)
+from lerobot_phantom.transforms.intensity import LEVELS
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+
+def _random_uint8(shape, seed):
+    return torch.randint(0, 256, shape, dtype=torch.uint8, generator=torch.Generator().manual_seed(seed))
+
+
+def _reference(img: torch.Tensor, num_stripes: int, **kwargs) -> torch.Tensor:
+    out = em_color_strip_reference(img.permute(1, 2, 0).numpy(), num_stripes, **kwargs)
+    return torch.from_numpy(np.ascontiguousarray(out)).permute(2, 0, 1)
+
+
+def _mad(a: torch.Tensor, b: torch.Tensor) -> float:
+    return (a.double() - b.double()).abs().mean().item()
+
+
+@pytest.mark.parametrize("shape", [(3, 17, 23), (3, 64, 40), (3, 7, 5), (3, 255, 3)])
+@pytest.mark.parametrize("num_stripes", [8, 12, 16, 5])
+def test_matches_reference_within_one_grey_level(shape, num_stripes):
+    img = _random_uint8(shape, seed=shape[1] + num_stripes)
+    expected = _reference(img, num_stripes)
+    out = em_color_strip(img, num_stripes)
+    diff = (out.int() - expected.int()).abs()
+    # the reference truncates with int() like the paper, the kernel rounds: at most one grey level apart
+    assert int(diff.max()) <= 1
+    assert not torch.equal(out, img)
+
+
+@pytest.mark.parametrize("level", ["weak", "medium", "strong"])
+def test_levels_are_the_papers_stripe_counts(level):
+    num_stripes = {"weak": 8, "medium": 12, "strong": 16}[level]
+    img = _random_uint8((2, 3, 48, 30), seed=1)
+    attack = EMColorStrip(level)
+    torch.testing.assert_close(attack(img), em_color_strip(img, num_stripes), atol=0, rtol=0)
+    assert int((attack(img)[0].int() - _reference(img[0], num_stripes).int()).abs().max()) <= 1
+
+
+def test_uint8_overflow_of_the_paper_is_fixed():
+    img = torch.zeros(3, 16, 4, dtype=torch.uint8)
+    img[0], img[1], img[2] = 200, 10, 100  # R + B = 300 > 255
+    paper = _reference(img, 8, paper_uint8_sum=True)
+    fixed = _reference(img, 8)
+    # row 0 is corrupted: the paper computes (300 mod 256) / 2 - 50 = -28 -> 0, the formula gives 150 - 50 = 100
+    assert int(paper[1, 0, 0]) == 0
+    assert int(fixed[1, 0, 0]) == 100
+    ours = em_color_strip(img, 8)
+    assert int(ours[1, 0, 0]) == 100
+    assert int(ours[0, 0, 0]) == 25 and int(ours[2, 0, 0]) == 25  # 2.5 * G
+    torch.testing.assert_close(ours, fixed, atol=1, rtol=0)
+
+
+@pytest.mark.parametrize("height", [256, 96, 17, 33, 2])
+def test_row_weights_select_exactly_the_papers_bands(height):
+    img = torch.full(
+        (3, height, 2), 100, dtype=torch.uint8
+    )  # every corrupted pixel changes (G' = 50, R' = 250)
+    stripes = torch.tensor([8.0, 12.0, 16.0], dtype=torch.float64)
+    weights = stripe_row_weights(height, stripes, torch.ones(3, dtype=torch.float64))
+    for i, n in enumerate((8, 12, 16)):
+        changed_rows = (_reference(img, n) != img).any(dim=0).any(dim=1)
+        torch.testing.assert_close(weights[i] == 1, changed_rows)
+        assert ((weights[i] == 0) | (weights[i] == 1)).all()
+
+
+def test_small_images_do_not_crash_and_one_row_is_identity():
+    for shape in [(3, 1, 1), (3, 1, 9), (3, 3, 3), (1, 5, 2)]:
+        img = _random_uint8(shape, 2)
+        out = EMColorStrip("strong")(img)
+        assert out.shape == img.shape and out.dtype == img.dtype
+    one_row = _random_uint8((3, 1, 7), 3)
+    torch.testing.assert_close(EMColorStrip("strong")(one_row), one_row, atol=0, rtol=0)
+
+
+def test_intensity_zero_is_identity_and_thinning_below_weak_is_monotone_for_any_image():
+    img = torch.rand(3, 64, 32, generator=torch.Generator().manual_seed(4))
+    attack = EMColorStrip()
+    torch.testing.assert_close(attack.apply_params(img, attack.sample_params(1, 64, 32, intensity=0.0)), img)
+    distortions = []
+    for s in torch.linspace(0, LEVELS["weak"], 13):
+        params = attack.sample_params(1, 64, 32, intensity=s)
+        distortions.append(_mad(attack.apply_params(img, params), img))
+    assert distortions[0] == 0.0
+    assert all(b >= a for a, b in itertools.pairwise(distortions))
+    assert distortions[-1] > 0
+
+
+def test_between_levels_distortion_moves_linearly_from_level_to_level():
+    img = torch.rand(3, 80, 16, generator=torch.Generator().manual_seed(5))
+    attack = EMColorStrip()
+
+    def mad_at(s):
+        return _mad(attack.apply_params(img, attack.sample_params(1, 80, 16, intensity=s)), img)
+
+    for low, high in ((1 / 3, 2 / 3), (2 / 3, 1.0)):
+        for t in (0.25, 0.5, 0.75):
+            expected = (1 - t) * mad_at(low) + t * mad_at(high)
+            assert mad_at(low + t * (high - low)) == pytest.approx(expected, rel=1e-4, abs=1e-6)
+
+
+def test_params_mapping_hits_levels():
+    s = torch.tensor([0.0, 1 / 6, 1 / 3, 0.5, 2 / 3, 1.0])
+    params = stripe_params_for(s)
+    assert params["band_fraction"].tolist() == pytest.approx([0.0, 0.5, 1.0, 1.0, 1.0, 1.0], abs=1e-5)
+    effective = torch.where(params["mix"] > 0.5, params["next_num_stripes"], params["num_stripes"])
+    assert effective[2:].tolist() == [8.0, 8.0, 12.0, 16.0]
+    assert params["mix"][3].item() == pytest.approx(0.5, abs=1e-5)  # halfway between weak and medium
+
+
+def test_batch_with_per_sample_parameters_matches_single_calls():
+    imgs = _random_uint8((6, 3, 40, 20), 6)
+    attack = EMColorStrip("random")
+    params = attack.sample_params(6, 40, 20, generator=torch.Generator().manual_seed(1))
+    assert len(set(params["intensity"].tolist())) == 6
+    out = attack.apply_params(imgs, params)
+    for i in range(6):
+        single = {k: v[i : i + 1] for k, v in params.items()}
+        torch.testing.assert_close(
+            out[i : i + 1], attack.apply_params(imgs[i : i + 1], single), atol=0, rtol=0
+        )
+
+
+def test_broadcast_params_and_channels():
+    imgs = _random_uint8((3, 4, 20, 20), 7)
+    attack = EMColorStrip("medium")
+    params = attack.sample_params(1, 20, 20)
+    out = attack.apply_params(imgs, params)
+    torch.testing.assert_close(out[:, 3], imgs[:, 3], atol=0, rtol=0)  # alpha untouched
+    torch.testing.assert_close(out[:, :3], em_color_strip(imgs[:, :3], 12), atol=0, rtol=0)
+    floats = torch.rand(2, 3, 20, 20, dtype=torch.float64, generator=torch.Generator().manual_seed(0))
+    out64 = attack(floats)
+    assert out64.dtype == torch.float64 and out64.min() >= 0 and out64.max() <= 1
+
+
+def test_fixed_num_stripes_and_pickle_and_seed():
+    img = _random_uint8((2, 3, 30, 30), 8)
+    torch.testing.assert_close(
+        EMColorStrip("weak", num_stripes=4)(img), em_color_strip(img, 4), atol=0, rtol=0
+    )
+    a = EMColorStrip("random", seed=9)
+    b = pickle.loads(pickle.dumps(EMColorStrip("random", seed=9)))
+    torch.testing.assert_close(a(img), b(img), atol=0, rtol=0)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"num_stripes": 0}, "num_stripes"),
+        ({"num_stripes": float("nan")}, "num_stripes"),
+        ({"num_stripes": 8, "band_fraction": 1.5}, "band_fraction"),
+        ({"num_stripes": 8, "next_num_stripes": 12, "mix": -0.1}, "mix"),
+        ({"num_stripes": torch.tensor([8.0, 12.0, 16.0])}, "one value per sample"),
+    ],
+)
+def test_bad_parameters_raise_clear_errors(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        em_color_strip(_random_uint8((2, 3, 10, 10), 0), **kwargs)
+    with pytest.raises(ValueError, match="num_stripes"):
+        EMColorStrip(num_stripes=0)
