@@ -7,6 +7,7 @@ its own fields (see ``lerobot_phantom.eval``). Lists are written the way LeRobot
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 
 from lerobot_phantom.transforms.intensity import parse_intensity
@@ -46,11 +47,24 @@ class PhantomConfig:
     def validate(self) -> None:
         for name in ("rate", "instruction_rate"):
             value = getattr(self, name)
-            if not (0.0 <= float(value) <= 1.0):
-                raise ValueError(f"--phantom.{name} must lie in [0, 1], got {value!r}")
+            if (
+                isinstance(value, bool)
+                or not isinstance(value, int | float)
+                or not (0.0 <= float(value) <= 1.0)
+            ):
+                raise ValueError(f"--phantom.{name} must be a number in [0, 1], got {value!r}")
+        if isinstance(self.seed, bool) or not isinstance(self.seed, int):
+            raise ValueError(f"--phantom.seed must be an integer, got {self.seed!r}")
+        for group in ("attacks", "instruction_attacks", "cameras"):
+            values = getattr(self, group)
+            duplicates = sorted({v for v in values if values.count(v) > 1})
+            if duplicates:
+                raise ValueError(f"--phantom.{group} lists {duplicates} more than once: {values}")
         for name in (*self.attacks, *self.instruction_attacks):
             if name not in ATTACK_NAMES:
-                raise ValueError(f"unknown attack {name!r} in --phantom.*; valid attacks: {', '.join(ATTACK_NAMES)}")
+                raise ValueError(
+                    f"unknown attack {name!r} in --phantom.*; valid attacks: {', '.join(ATTACK_NAMES)}"
+                )
         for name in self.instruction_attacks:
             if name not in INSTRUCTION_ATTACKS:
                 raise ValueError(
@@ -63,7 +77,7 @@ class PhantomConfig:
                     f"--phantom.weights needs one weight per attack ({len(self.attacks)}: {self.attacks}), "
                     f"got {len(self.weights)}"
                 )
-            if any(w < 0 for w in self.weights) or sum(self.weights) <= 0:
+            if any(not math.isfinite(w) or w < 0 for w in self.weights) or sum(self.weights) <= 0:
                 raise ValueError(f"--phantom.weights must be >= 0 with a positive sum, got {self.weights}")
         parse_intensity(self.intensity)
         if not self.cameras:
@@ -84,3 +98,34 @@ class PhantomConfig:
     @property
     def camera_attacks(self) -> list[str]:
         return [a for a in self.attacks if a in CAMERA_ATTACKS]
+
+    @property
+    def attack_weights(self) -> list[float]:
+        """Relative weight of each entry of ``attacks`` (uniform when ``weights`` is unset)."""
+        return [1.0] * len(self.attacks) if self.weights is None else [float(w) for w in self.weights]
+
+    def resolve_cameras(self, camera_keys: list[str]) -> list[str]:
+        """The camera keys ``cameras`` can attack, for a dataset with ``camera_keys`` (order kept).
+
+        ``first`` -> ``[camera_keys[0]]``; ``all`` and ``random`` -> every key (``random`` then picks one per
+        sample); explicit keys are checked against the dataset's.
+        """
+        if not camera_keys:
+            raise ValueError("the dataset has no camera keys, so --phantom.cameras cannot be resolved")
+        mode = self.cameras[0]
+        if mode == "first":
+            return [camera_keys[0]]
+        if mode in ("all", "random"):
+            return list(camera_keys)
+        unknown = [c for c in self.cameras if c not in camera_keys]
+        if unknown:
+            raise ValueError(
+                f"--phantom.cameras: unknown camera key(s) {unknown}; this dataset's camera keys are "
+                f"{list(camera_keys)} (or use one of {CAMERA_MODES})"
+            )
+        return list(self.cameras)
+
+    @property
+    def random_camera(self) -> bool:
+        """True when each attacked sample gets one camera chosen at random among the resolved keys."""
+        return self.cameras == ["random"]
