@@ -1,0 +1,90 @@
+import os
+import pickle
+
+import numpy as np
+import pytest
+import torch
+from reference_optical import laser_color_strip_reference
+
+from lerobot_phantom.transforms.laser_color_strip import (
+    PAPER_COLOR_FRACTIONS,
+    STRENGTH_LEVELS,
+    LaserColorStrip,
+    band_rows,
+    laser_color_strip,
+    strip_profile,
+)
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+
+def _random_uint8(shape, seed):
+    return torch.randint(0, 256, shape, dtype=torch.uint8, generator=torch.Generator().manual_seed(seed))
+
+
+def _hwc(chw: torch.Tensor) -> np.ndarray:
+    return chw.permute(1, 2, 0).numpy()
+
+
+@pytest.mark.parametrize("size", [(24, 32), (31, 17), (5, 3)])
+@pytest.mark.parametrize("level", ["weak", "medium", "strong"])
+def test_matches_paper_reference(size, level):
+    img = _random_uint8((3, *size), seed=size[1] + len(level))
+    attack = LaserColorStrip(level)
+    params = attack.sample_params(1, *size)
+    strength = float(params["strength"][0])
+    assert strength == pytest.approx(dict(zip(("weak", "medium", "strong"), STRENGTH_LEVELS[1:], strict=True))[level])
+    expected = laser_color_strip_reference(_hwc(img), strength, PAPER_COLOR_FRACTIONS)
+    fast = attack.apply_params(img, params)
+    assert np.abs(_hwc(fast).astype(int) - expected.astype(int)).max() <= 1
+    functional = laser_color_strip(img, strength, PAPER_COLOR_FRACTIONS)
+    assert np.abs(_hwc(functional).astype(int) - expected.astype(int)).max() <= 1
+
+
+def test_only_the_band_rows_change_and_red_dominates():
+    img = torch.full((3, 30, 40), 0.2)
+    out = LaserColorStrip("weak")(img)
+    start, end = band_rows(30)
+    assert (start, end) == (10, 20)
+    assert torch.equal(out[:, :start], img[:, :start]) and torch.equal(out[:, end:], img[:, end:])
+    added = out[:, start:end] - img[:, start:end]
+    assert bool((added[0] >= added[1]).all()) and float(added[0].mean()) > 0.1
+
+
+def test_gaussian_centre_sits_below_the_band_as_in_the_paper_code():
+    profile = strip_profile(60, 80)
+    column = profile[:, 40]
+    assert bool((column[1:] > column[:-1]).all())  # brightening towards the band's lower edge
+    assert int(profile[-1].argmax()) == 40  # centred horizontally at w / 2
+
+
+def test_peak_gain_does_not_depend_on_image_size():
+    # S*h*w cancels the Gaussian's normaliser: the band's peak is 4/pi * exp(-a/2) with a ~ 1/9 whatever the size
+    small, large = strip_profile(30, 40), strip_profile(300, 400)
+    assert float(small.max()) == pytest.approx(float(large.max()), rel=0.05)
+    assert float(large.max()) < 4.0 / np.pi
+
+
+def test_per_sample_strength_and_colour_fractions():
+    img = torch.zeros(2, 3, 12, 12)
+    out = laser_color_strip(img, torch.tensor([0.0, 2500.0]), torch.tensor([[0.6, 0.1, 0.1], [0.0, 0.0, 1.0]]))
+    assert torch.equal(out[0], img[0])
+    assert float(out[1, 2].max()) == 1.0 and float(out[1, :2].max()) == 0.0
+
+
+def test_profile_is_cached_per_size_and_dropped_on_pickle():
+    attack = LaserColorStrip()
+    assert attack.profile(20, 30) is attack.profile(20, 30)
+    clone = pickle.loads(pickle.dumps(attack))
+    assert clone._cache == {}
+    img = _random_uint8((3, 20, 30), seed=0)
+    assert torch.equal(clone(img), attack(img))
+
+
+def test_bad_arguments_raise():
+    with pytest.raises(ValueError, match="color_fractions"):
+        LaserColorStrip(color_fractions=(0.6, 0.1))
+    with pytest.raises(ValueError, match="levels"):
+        LaserColorStrip(levels=(0, 1500, 500, 2500))
+    with pytest.raises(ValueError, match="strength"):
+        laser_color_strip(torch.zeros(3, 4, 4), -1.0)
