@@ -7,13 +7,150 @@ datasets, training, environments, evaluation.
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from importlib.metadata import version
+from typing import Any
 
 LEROBOT_VERSION = "0.4.4"
 
 
 def lerobot_version() -> str:
     return version("lerobot")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# training (lerobot_phantom.train; checked by tests/test_lerobot_compat.py)
+#
+# lerobot-phantom-train runs LeRobot's own ``train()`` (lerobot/scripts/lerobot_train.py) unchanged and only swaps,
+# for the duration of one call, the module-level names that loop looks up: the dataset factory (to wrap the
+# dataset in the mixer), make_policy (PEFT resume guard), make_pre_post_processors (device-side attack step),
+# update_policy (per-attack loss) and cycle (epoch counter).
+# ---------------------------------------------------------------------------------------------------------------
+TRAIN_LOOP_HOOKS = ("make_dataset", "make_policy", "make_pre_post_processors", "update_policy", "cycle")
+UPDATE_POLICY_PARAMETERS = (
+    "train_metrics",
+    "policy",
+    "batch",
+    "optimizer",
+    "grad_clip_norm",
+    "accelerator",
+    "lr_scheduler",
+    "lock",
+    "rabc_weights_provider",
+)
+
+
+def train_script_module():
+    """``lerobot.scripts.lerobot_train``: the module whose globals the training loop resolves at call time."""
+    import lerobot.scripts.lerobot_train as module
+
+    return module
+
+
+def train_loop_function():
+    """LeRobot's ``train(cfg, accelerator=None)`` without its ``@parser.wrap()``.
+
+    The wrapper re-parses ``sys.argv`` whenever ``type(cfg) is not TrainPipelineConfig``, which a subclass never
+    is, so the undecorated function (``functools.wraps`` keeps it as ``__wrapped__``) is called instead.
+    """
+    return train_script_module().train.__wrapped__
+
+
+@contextmanager
+def patched_train_loop(**replacements: Any) -> Iterator[dict[str, Any]]:
+    """Swap names in ``lerobot_train``'s module globals (only those in ``TRAIN_LOOP_HOOKS``); yield the originals."""
+    module = train_script_module()
+    unknown = sorted(set(replacements) - set(TRAIN_LOOP_HOOKS))
+    if unknown:
+        raise ValueError(f"cannot patch {unknown} in lerobot_train; hookable names: {TRAIN_LOOP_HOOKS}")
+    originals = {name: getattr(module, name) for name in replacements}
+    try:
+        for name, value in replacements.items():
+            setattr(module, name, value)
+        yield originals
+    finally:
+        for name, value in originals.items():
+            setattr(module, name, value)
+
+
+def train_pipeline_config_class():
+    from lerobot.configs.train import TrainPipelineConfig
+
+    return TrainPipelineConfig
+
+
+def config_parser_wrap():
+    """``lerobot.configs.parser.wrap``: draccus parsing plus ``--config_path`` / ``--policy.path`` handling."""
+    from lerobot.configs import parser
+
+    return parser.wrap
+
+
+def make_accelerator(cfg) -> Any:
+    """An ``Accelerator`` built the way ``lerobot_train.train`` builds its own when none is passed."""
+    from accelerate import Accelerator
+    from accelerate.utils import DistributedDataParallelKwargs
+
+    return Accelerator(
+        step_scheduler_with_optimizer=False,
+        kwargs_handlers=[DistributedDataParallelKwargs(find_unused_parameters=True)],
+        cpu=cfg.policy.device == "cpu",
+    )
+
+
+def load_checkpoint_step(checkpoint_dir) -> int:
+    """The training step stored in ``checkpoint_dir/training_state``."""
+    from pathlib import Path
+
+    from lerobot.utils.constants import TRAINING_STATE_DIR
+    from lerobot.utils.train_utils import load_training_step
+
+    return int(load_training_step(Path(checkpoint_dir) / TRAINING_STATE_DIR))
+
+
+def register_lerobot_plugins() -> None:
+    from lerobot.utils.import_utils import register_third_party_plugins
+
+    register_third_party_plugins()
+
+
+def processor_step_registry():
+    from lerobot.processor import ProcessorStepRegistry
+
+    return ProcessorStepRegistry
+
+
+def processor_step_base():
+    from lerobot.processor import ProcessorStep
+
+    return ProcessorStep
+
+
+def policy_processor_pipeline_class():
+    from lerobot.processor import PolicyProcessorPipeline
+
+    return PolicyProcessorPipeline
+
+
+def transition_keys():
+    """LeRobot's ``TransitionKey`` enum (``OBSERVATION``, ``COMPLEMENTARY_DATA``, ...)."""
+    from lerobot.processor.core import TransitionKey
+
+    return TransitionKey
+
+
+def pretrained_policy_class():
+    from lerobot.policies.pretrained import PreTrainedPolicy
+
+    return PreTrainedPolicy
+
+
+def accelerate_process_state():
+    """accelerate's process-wide state (rank, world size, device) of the ``Accelerator`` that ``train()`` made."""
+    from accelerate import PartialState
+
+    return PartialState()
 
 
 # ---------------------------------------------------------------------------------------------------------------
