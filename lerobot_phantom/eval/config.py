@@ -21,11 +21,10 @@ from lerobot.configs.eval import EvalPipelineConfig
 from lerobot.envs.configs import EnvConfig
 
 from lerobot_phantom.config import PhantomConfig
+from lerobot_phantom.eval.results import CLEAN
 from lerobot_phantom.transforms.instruction import MODES as INSTRUCTION_MODES
 from lerobot_phantom.transforms.intensity import parse_intensity
 from lerobot_phantom.transforms.registry import ATTACK_NAMES
-
-CLEAN = "clean"
 
 
 @dataclass

@@ -30,12 +30,9 @@ from tqdm import tqdm
 import lerobot_phantom
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
+from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT, pooled_summary, summarize
 from lerobot_phantom.eval.rollout import AttackStep, Condition, build_conditions, episode_outcomes
-from lerobot_phantom.eval.stats import wilson_interval
 from lerobot_phantom.transforms.base import derive_seed
-
-EVAL_FORMAT = "lerobot_phantom.eval/1"
-EVAL_FILENAME = "eval.json"
 
 logger = logging.getLogger(__name__)
 
@@ -98,13 +95,6 @@ def policy_metadata(cfg: PhantomEvalConfig, policy) -> dict[str, Any]:
     )
     config = getattr(policy, "config", None)
     return {"path": path, "type": getattr(config, "type", None) or type(policy).__name__}
-
-
-def summarize(records: list[dict[str, Any]]) -> dict[str, Any]:
-    successes = sum(int(r["success"]) for r in records)
-    episodes = len(records)
-    low, high = wilson_interval(successes, episodes)
-    return {"successes": successes, "episodes": episodes, "tsr": successes / episodes, "ci95": [low, high]}
 
 
 def run_condition(
@@ -247,16 +237,6 @@ def evaluate(cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocess
     with open(output_dir / EVAL_FILENAME, "w") as f:
         json.dump(report, f, indent=2)
     return report
-
-
-def pooled_summary(results: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per condition, pooled over every task: the headline numbers."""
-    keys = list(dict.fromkeys(r["condition"] for r in results))
-    out = []
-    for key in keys:
-        records = [e for r in results if r["condition"] == key for e in r["per_episode"]]
-        out.append({"condition": key, **summarize(records)})
-    return out
 
 
 def format_summary(report: dict[str, Any]) -> str:

@@ -23,7 +23,8 @@ import torch
 from lerobot.processor import ProcessorStep, TransitionKey
 from lerobot.utils.constants import OBS_IMAGE as OBSERVATION_IMAGE_PREFIX
 
-from lerobot_phantom.eval.config import CLEAN, EvalPhantomConfig
+from lerobot_phantom.eval.config import EvalPhantomConfig
+from lerobot_phantom.eval.results import CLEAN
 from lerobot_phantom.transforms.base import derive_seed
 from lerobot_phantom.transforms.intensity import parse_intensity
 from lerobot_phantom.transforms.registry import ATTACK_NAMES, is_camera_attack, make_attack

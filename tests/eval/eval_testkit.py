@@ -7,6 +7,7 @@ two real LeRobot policies (``PreTrainedPolicy`` subclasses) plugged into ``evalu
 """
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import gymnasium as gym
 import numpy as np
@@ -27,7 +28,7 @@ TASK = "move to the red dot"
 class DotReachEnv(gym.Env):
     """A point agent moves to a red dot drawn in the front camera; the wrist camera shows nothing useful."""
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": 10}
+    metadata: ClassVar[dict] = {"render_modes": ["rgb_array"], "render_fps": 10}
 
     def __init__(self, size: int = 32, render_mode: str = "rgb_array"):
         self.size = size

@@ -32,7 +32,7 @@ def tsr(report, condition):
 def colour_report(tmp_path_factory):
     cfg = make_cfg(
         tmp_path_factory.mktemp("colour"),
-        attacks=CAMERA_STRONG + ["voice_dos"],
+        attacks=[*CAMERA_STRONG, "voice_dos"],
         intensities=["strong"],
         videos=1,
     )
@@ -76,7 +76,7 @@ def test_paired_seeds_identical_across_conditions_and_recorded(colour_report):
 
 
 def test_attack_parameters_fixed_per_episode_and_reproducible(colour_report, tmp_path):
-    report, cfg = colour_report
+    report, _ = colour_report
     first = {r["condition"]: [e["attack_params"] for e in r["per_episode"]] for r in report["results"]}
     assert first["clean"][0] == {}
     assert set(first["laser_blinding@strong"][0]) == {"front"}  # the front camera only, as in the paper

@@ -1,0 +1,179 @@
+"""lerobot-phantom-report: tables rendered from fixture eval.json files (written here) match exactly."""
+
+import json
+
+import pytest
+
+from lerobot_phantom.eval.report import ReportConfig, make_report, report_cli
+from lerobot_phantom.eval.results import EVAL_FORMAT, pooled_summary, summarize
+
+SEEDS = [0, 1, 2, 3, 4, 5]
+BASE = {
+    ("clean", "spatial"): "111111",
+    ("clean", "goal"): "111100",
+    ("laser_blinding@weak", "spatial"): "111100",
+    ("laser_blinding@weak", "goal"): "101000",
+    ("laser_blinding@strong", "spatial"): "000000",
+    ("laser_blinding@strong", "goal"): "000000",
+    ("voice_dos", "spatial"): "110111",
+    ("voice_dos", "goal"): "000000",
+}
+TRAINED = {
+    ("clean", "spatial"): "111111",
+    ("clean", "goal"): "110100",
+    ("laser_blinding@weak", "spatial"): "111111",
+    ("laser_blinding@weak", "goal"): "111000",
+    ("laser_blinding@strong", "spatial"): "111111",
+    ("laser_blinding@strong", "goal"): "100000",
+    ("voice_dos", "spatial"): "110111",
+    ("voice_dos", "goal"): "000000",
+}
+
+
+def write_eval(path, outcomes, seeds=SEEDS, env_task="all"):
+    results = []
+    for (condition, suite), bits in outcomes.items():
+        attack, _, level = condition.partition("@")
+        per_episode = [{"seed": s, "success": b == "1"} for s, b in zip(seeds, bits, strict=True)]
+        results.append(
+            {
+                "condition": condition,
+                "attack": attack,
+                "intensity": level or None,
+                "suite": suite,
+                "task_id": 0,
+                **summarize(per_episode),
+                "per_episode": per_episode,
+            }
+        )
+    data = {
+        "format": EVAL_FORMAT,
+        "mode": "rollout",
+        "metadata": {
+            "policy": {"path": None, "type": "test"},
+            "env": {"type": "phantom_table", "task": env_task},
+            "episode_seeds": list(seeds),
+        },
+        "results": results,
+        "summary": pooled_summary(results),
+    }
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(json.dumps(data))
+    return path
+
+
+@pytest.fixture
+def evals(tmp_path):
+    return write_eval(tmp_path / "base" / "eval.json", BASE), write_eval(
+        tmp_path / "at" / "eval.json", TRAINED
+    )
+
+
+def test_robustness_and_before_after_tables_match_exactly(evals, tmp_path):
+    base, trained = evals
+    out = tmp_path / "report"
+    written = make_report(
+        [base, trained], out, labels=["base", "AT"], before=[base], after=[trained], figures=False
+    )
+    assert (out / "robustness.md").read_text() == (
+        "| Attack | base spatial | base goal | AT spatial | AT goal |\n"
+        "|---|---:|---:|---:|---:|\n"
+        "| Clean | 100.0 | 66.7 | 100.0 | 50.0 |\n"
+        "| LB weak | 66.7 | 33.3 | 100.0 | 50.0 |\n"
+        "| LB strong | 0.0 | 0.0 | 100.0 | 16.7 |\n"
+        "| VD | 83.3 | 0.0 | 83.3 | 0.0 |\n"
+    )
+    assert (out / "robustness.csv").read_text() == (
+        ",base,base,AT,AT\n"
+        "condition,spatial,goal,spatial,goal\n"
+        "clean,100.0,66.7,100.0,50.0\n"
+        "laser_blinding@weak,66.7,33.3,100.0,50.0\n"
+        "laser_blinding@strong,0.0,0.0,100.0,16.7\n"
+        "voice_dos,83.3,0.0,83.3,0.0\n"
+    )
+    assert (out / "robustness.tex").read_text() == (
+        "\\begin{tabular}{lcccc}\n"
+        "\\toprule\n"
+        " & \\multicolumn{2}{c}{\\textbf{base}} & \\multicolumn{2}{c}{\\textbf{AT}} \\\\\n"
+        "\\cmidrule(lr){2-3} \\cmidrule(lr){4-5}\n"
+        "\\textbf{Attack} & spatial & goal & spatial & goal \\\\\n"
+        "\\midrule\n"
+        "\\textbf{Clean} & 100.0 & 66.7 & 100.0 & 50.0 \\\\\n"
+        "\\midrule\n"
+        "$LB_{weak}$ & 66.7 & 33.3 & 100.0 & 50.0 \\\\\n"
+        "$LB_{strong}$ & 0.0 & 0.0 & 100.0 & 16.7 \\\\\n"
+        "VD & 83.3 & 0.0 & 83.3 & 0.0 \\\\\n"
+        "\\bottomrule\n"
+        "\\end{tabular}\n"
+    )
+    # After TSR (change in points); '*' = exact McNemar p < 0.05 (6 of 6 discordant pairs: p = 2/64).
+    assert (out / "before_after.md").read_text() == (
+        "| Attack | spatial | goal |\n"
+        "|---|---:|---:|\n"
+        "| Clean | 100.0 (+0.0) | 50.0 (-16.7) |\n"
+        "| LB weak | 100.0 (+33.3) | 50.0 (+16.7) |\n"
+        "| LB strong | 100.0 (+100.0)* | 16.7 (+16.7) |\n"
+        "| VD | 83.3 (+0.0) | 0.0 (+0.0) |\n"
+    )
+    assert (out / "summary.md").read_text() == (
+        "# Summary\n"
+        "\n"
+        "Largest drops under attack (paired with the clean control on the same seeds):\n"
+        "\n"
+        "- base / spatial: LB strong -100.0 pp (TSR 0.0%, p = 0.0312)\n"
+        "- base / goal: LB strong -66.7 pp (TSR 0.0%, p = 0.125)\n"
+        "- base / goal: VD -66.7 pp (TSR 0.0%, p = 0.125)\n"
+        "\n"
+        "Largest gains after training (exact McNemar on matched episodes):\n"
+        "\n"
+        "- AT / spatial: LB strong 0.0% -> 100.0% (+100.0 pp, p = 0.0312)\n"
+        "- AT / spatial: LB weak 66.7% -> 100.0% (+33.3 pp, p = 0.5)\n"
+        "- AT / goal: LB weak 33.3% -> 50.0% (+16.7 pp, p = 1)\n"
+        "\n"
+        "Largest losses after training (exact McNemar on matched episodes):\n"
+        "\n"
+        "- AT / goal: Clean 66.7% -> 50.0% (-16.7 pp, p = 1)\n"
+    )
+    results = (out / "results.csv").read_text().splitlines()
+    assert results[0].startswith("label,suite,condition,successes,episodes,tsr,ci95_low,ci95_high")
+    assert len(results) == 1 + 2 * 2 * 4
+    assert set(written) >= {"robustness.md", "before_after.tex", "before_after_tests.csv", "summary.md"}
+
+
+def test_figures_are_written(evals, tmp_path):
+    base, trained = evals
+    written = make_report([base], tmp_path / "fig", before=[base], after=[trained])
+    for name in ("tsr_vs_intensity.png", "before_after_heatmap.png"):
+        assert written[name].read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_single_input_uses_suite_columns_and_directory_label(evals, tmp_path):
+    base, _ = evals
+    report_cli(ReportConfig(inputs=[str(base.parent)], output_dir=str(tmp_path / "one"), figures=False))
+    assert (tmp_path / "one" / "robustness.md").read_text().splitlines()[0] == "| Attack | spatial | goal |"
+    assert (tmp_path / "one" / "robustness.csv").read_text().splitlines()[0] == "condition,spatial,goal"
+
+
+def test_mismatched_pairs_are_refused(evals, tmp_path):
+    base, _ = evals
+    other_seeds = write_eval(tmp_path / "seeds" / "eval.json", TRAINED, seeds=[10, 11, 12, 13, 14, 15])
+    with pytest.raises(ValueError, match="episode_seeds differs"):
+        make_report([], tmp_path / "r1", before=[base], after=[other_seeds])
+    other_env = write_eval(tmp_path / "env" / "eval.json", TRAINED, env_task="goal")
+    with pytest.raises(ValueError, match="env differs"):
+        make_report([], tmp_path / "r2", before=[base], after=[other_env])
+    with pytest.raises(ValueError, match="pair up one to one"):
+        make_report([], tmp_path / "r3", before=[base], after=[])
+
+
+def test_bad_inputs_give_clear_errors(evals, tmp_path):
+    base, _ = evals
+    with pytest.raises(FileNotFoundError, match="no eval.json"):
+        make_report([tmp_path / "missing"], tmp_path / "r")
+    (tmp_path / "junk.json").write_text("{}")
+    with pytest.raises(ValueError, match="not a lerobot-phantom-eval result"):
+        make_report([tmp_path / "junk.json"], tmp_path / "r")
+    with pytest.raises(ValueError, match="distinct labels"):
+        make_report([base, base], tmp_path / "r")
+    with pytest.raises(ValueError, match="one label per input"):
+        make_report([base], tmp_path / "r", labels=["a", "b"])
