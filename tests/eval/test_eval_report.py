@@ -168,7 +168,7 @@ def test_mismatched_pairs_are_refused(evals, tmp_path):
 
 def test_bad_inputs_give_clear_errors(evals, tmp_path):
     base, _ = evals
-    with pytest.raises(FileNotFoundError, match="no eval.json"):
+    with pytest.raises(FileNotFoundError, match=r"no eval\.json"):
         make_report([tmp_path / "missing"], tmp_path / "r")
     (tmp_path / "junk.json").write_text("{}")
     with pytest.raises(ValueError, match="not a lerobot-phantom-eval result"):
