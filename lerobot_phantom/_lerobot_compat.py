@@ -200,3 +200,67 @@ def eval_seed_everything(seed: int) -> None:
     from lerobot.utils.random_utils import set_seed
 
     set_seed(seed)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# transforms (lerobot_phantom.transforms.lerobot_registration; checked by tests/transforms/test_lerobot_registration.py)
+#
+# LeRobot 0.4.4 builds every ImageTransformConfig through lerobot.datasets.transforms.make_transform_from_config,
+# which knows only torchvision.transforms.v2 classes and SharpnessJitter. ImageTransforms resolves that name in its
+# module globals each time it is constructed, so replacing the module attribute with a wrapper (phantom class names
+# first, everything else to the original, which keeps raising LeRobot's own error for unknown names) is enough.
+# Modules that did ``from lerobot.datasets.transforms import make_transform_from_config`` before registration
+# (only lerobot/scripts/lerobot_imgtransform_viz.py) keep the original. LeRobot >= 0.5 has a _CUSTOM_TRANSFORMS
+# table (name -> class) that is filled instead when present.
+# ---------------------------------------------------------------------------------------------------------------
+def image_transforms_module():
+    """``lerobot.datasets.transforms``: ImageTransformConfig, ImageTransformsConfig, ImageTransforms."""
+    import lerobot.datasets.transforms as module
+
+    return module
+
+
+def original_make_transform_from_config():
+    """LeRobot's own ``make_transform_from_config``, whether or not the phantom wrapper is installed."""
+    current = image_transforms_module().make_transform_from_config
+    return getattr(current, "__phantom_original__", current)
+
+
+def register_image_transform_types(resolve, classes: dict[str, type]) -> str:
+    """Let LeRobot's image-transform config build extra types by name; idempotent.
+
+    ``resolve(type_name)`` returns a transform class or None (then LeRobot's own factory decides); ``classes`` is
+    the same mapping spelled out, for LeRobot's ``_CUSTOM_TRANSFORMS`` table when it exists. Returns "table" or
+    "wrapped" (how it was done).
+    """
+    import functools
+
+    module = image_transforms_module()
+    table = getattr(module, "_CUSTOM_TRANSFORMS", None)
+    if isinstance(table, dict):
+        for name, cls in classes.items():
+            table.setdefault(name, cls)
+        return "table"
+    current = module.make_transform_from_config
+    if getattr(current, "__phantom_original__", None) is not None:
+        current.__phantom_resolve__ = resolve  # already wrapped: only refresh the resolver
+        return "wrapped"
+    original = current
+
+    @functools.wraps(original)
+    def make_transform_from_config(cfg):
+        cls = make_transform_from_config.__phantom_resolve__(cfg.type)
+        if cls is None:
+            return original(cfg)
+        return cls(**cfg.kwargs)
+
+    make_transform_from_config.__phantom_original__ = original
+    make_transform_from_config.__phantom_resolve__ = resolve
+    module.make_transform_from_config = make_transform_from_config
+    return "wrapped"
+
+
+def unregister_image_transform_types() -> None:
+    """Put LeRobot's original factory back (tests use it to check registration from a clean state)."""
+    module = image_transforms_module()
+    module.make_transform_from_config = original_make_transform_from_config()

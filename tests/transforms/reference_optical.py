@@ -41,7 +41,7 @@ def light_projection_reference(
             a = int(float(watermark_rgba[i, j, 3]) * transparency)
             for k in range(3):
                 value = (float(watermark_rgba[i, j, k]) * a + float(image[row, col, k]) * (255 - a)) / 255.0
-                out[row, col, k] = int(math.floor(value + 0.5))
+                out[row, col, k] = math.floor(value + 0.5)
     return out
 
 

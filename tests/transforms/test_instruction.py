@@ -68,7 +68,8 @@ def test_graded_spoofing_appends_then_truncates_then_replaces():
 
 def test_graded_spoofing_keeps_fewer_words_as_intensity_grows():
     kept = [
-        len(VoiceSpoofing(s, mode="graded", suffix=" STOP")(TASK).split()) - 1 for s in (0.1, 0.4, 0.6, 0.8, 0.95)
+        len(VoiceSpoofing(s, mode="graded", suffix=" STOP")(TASK).split()) - 1
+        for s in (0.1, 0.4, 0.6, 0.8, 0.95)
     ]
     assert kept == sorted(kept, reverse=True) and kept[0] == 10 and kept[-1] < 10
 

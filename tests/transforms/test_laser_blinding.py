@@ -30,7 +30,9 @@ def test_matches_paper_reference(size, level):
     params = attack.sample_params(1, *size)
     pattern = attack.patterns_for(params["position"], *size, CPU)[0]
     alpha = float(params["alpha"][0])
-    assert alpha == pytest.approx(dict(zip(("weak", "medium", "strong"), ALPHA_LEVELS[1:], strict=True))[level])
+    assert alpha == pytest.approx(
+        dict(zip(("weak", "medium", "strong"), ALPHA_LEVELS[1:], strict=True))[level]
+    )
     expected = laser_blinding_reference(_hwc(img), _hwc(pattern * 255.0), alpha)
     fast = attack.apply_params(img, params)
     assert np.abs(_hwc(fast).astype(int) - expected.astype(int)).max() <= 1
@@ -51,7 +53,13 @@ def test_functional_resizes_pattern_and_accepts_per_sample_alpha():
 def test_pattern_has_white_core_coloured_ring_and_power_law_halo():
     height, width = 200, 200
     spot = laser_spot(
-        height, width, center=(100.0, 100.0), core_radius=0.05, halo_exponent=2.0, color=(0, 1, 0), crosstalk=0.25
+        height,
+        width,
+        center=(100.0, 100.0),
+        core_radius=0.05,
+        halo_exponent=2.0,
+        color=(0, 1, 0),
+        crosstalk=0.25,
     )
     core = spot[:, 100, 100]
     assert torch.allclose(core, torch.ones(3))  # every channel saturates: white
@@ -144,7 +152,7 @@ def test_user_pattern_shifted_with_random_position(tmp_path):
 
 
 def test_missing_pattern_and_bad_parameters_raise():
-    with pytest.raises(FileNotFoundError, match="nothing.png"):
+    with pytest.raises(FileNotFoundError, match=r"nothing\.png"):
         LaserBlinding(pattern="nothing.png")
     with pytest.raises(ValueError, match="random"):
         LaserBlinding(position="somewhere")

@@ -33,7 +33,9 @@ def test_matches_paper_reference(size, level):
     attack = LaserColorStrip(level)
     params = attack.sample_params(1, *size)
     strength = float(params["strength"][0])
-    assert strength == pytest.approx(dict(zip(("weak", "medium", "strong"), STRENGTH_LEVELS[1:], strict=True))[level])
+    assert strength == pytest.approx(
+        dict(zip(("weak", "medium", "strong"), STRENGTH_LEVELS[1:], strict=True))[level]
+    )
     expected = laser_color_strip_reference(_hwc(img), strength, PAPER_COLOR_FRACTIONS)
     fast = attack.apply_params(img, params)
     assert np.abs(_hwc(fast).astype(int) - expected.astype(int)).max() <= 1
@@ -67,7 +69,9 @@ def test_peak_gain_does_not_depend_on_image_size():
 
 def test_per_sample_strength_and_colour_fractions():
     img = torch.zeros(2, 3, 12, 12)
-    out = laser_color_strip(img, torch.tensor([0.0, 2500.0]), torch.tensor([[0.6, 0.1, 0.1], [0.0, 0.0, 1.0]]))
+    out = laser_color_strip(
+        img, torch.tensor([0.0, 2500.0]), torch.tensor([[0.6, 0.1, 0.1], [0.0, 0.0, 1.0]])
+    )
     assert torch.equal(out[0], img[0])
     assert float(out[1, 2].max()) == 1.0 and float(out[1, :2].max()) == 0.0
 

@@ -33,14 +33,18 @@ def _watermark_uint8(attack, height, width):
 
 @pytest.mark.parametrize("size", [(24, 32), (31, 17)])
 @pytest.mark.parametrize("level", ["weak", "medium", "strong"])
-@pytest.mark.parametrize(("pattern", "offset"), [("stop_sign", (0, 0)), ("can", (40, -25)), ("arrow", (-60, 10))])
+@pytest.mark.parametrize(
+    ("pattern", "offset"), [("stop_sign", (0, 0)), ("can", (40, -25)), ("arrow", (-60, 10))]
+)
 def test_matches_paper_reference(size, level, pattern, offset):
     height, width = size
     img = _random_uint8((3, height, width), seed=height * 3 + len(level))
     attack = LightProjection(level, pattern=pattern, size=0.8, x_offset=offset[0], y_offset=offset[1])
     params = attack.sample_params(1, height, width)
     t = float(params["transparency"][0])
-    assert t == pytest.approx(dict(zip(("weak", "medium", "strong"), TRANSPARENCY_LEVELS[1:], strict=True))[level])
+    assert t == pytest.approx(
+        dict(zip(("weak", "medium", "strong"), TRANSPARENCY_LEVELS[1:], strict=True))[level]
+    )
     wm = _watermark_uint8(attack, height, width)
     dx, dy = round(offset[0] * width / 256), round(offset[1] * height / 256)
     expected = light_projection_reference(_hwc(img), _hwc(wm), t, dx, dy)
@@ -83,7 +87,7 @@ def test_procedural_shapes_are_coloured_with_transparent_surround(shape):
     rgba = projection_shape(shape, 64)
     assert rgba.shape == (4, 64, 64)
     assert float(rgba[3].max()) == 1.0
-    assert float(rgba[3, 0, 0]) == 0.0 or shape == "disk" and float(rgba[3, 0, 0]) < 0.5
+    assert float(rgba[3, 0, 0]) == 0.0 or (shape == "disk" and float(rgba[3, 0, 0]) < 0.5)
     assert torch.equal(torch.round(rgba[3] * 255) / 255, rgba[3])  # 8-bit alpha as in the paper's PIL code
 
 
