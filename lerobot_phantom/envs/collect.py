@@ -1,0 +1,217 @@
+"""lerobot-phantom-collect: record scripted-expert demonstrations as a LeRobotDataset v3.
+
+    lerobot-phantom-collect --suite goal --episodes 100 --repo-id local/phantom_goal --root DIR \\
+        [--video] [--seed 0] [--overwrite] [--task-id K] [--image-size 96]
+
+Episodes cycle round-robin over the selected (suite, task) pairs, so ``--episodes`` is the total count and every
+task gets an equal share; ``--suite all`` cycles over every task of every suite (interleaving the suites) into one
+multi-task dataset. Only
+successful expert episodes are kept: a failed attempt is discarded and retried with the next seed (the number of
+discarded attempts is reported). Episode seeds are drawn from ``numpy.random.default_rng(seed)``, so a given
+``--seed`` always produces the same dataset. Features: ``observation.images.front`` / ``observation.images.wrist``
+(images, or AV1 videos with ``--video``), ``observation.state`` (TCP xyz + finger opening), ``action``
+(normalised [dx, dy, dz, grip]); the task string is the instruction.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from lerobot_phantom.envs.suites import SUITE_NAMES, SUITES
+
+ALL_SUITES = "all"
+STATE_NAMES = ["tcp_x", "tcp_y", "tcp_z", "gripper_opening"]
+ACTION_NAMES = ["dx", "dy", "dz", "grip"]
+
+
+@dataclass
+class CollectConfig:
+    suite: str = "goal"  # spatial | object | goal | long | all
+    episodes: int = 100  # total number of (successful) episodes, round-robin over the suite's tasks
+    repo_id: str | None = None  # default: local/phantom_<suite>
+    root: str | None = None  # dataset directory; default: LeRobot's HF_LEROBOT_HOME/<repo_id>
+    video: bool = False  # store camera streams as videos instead of PNG images
+    seed: int = 0
+    overwrite: bool = False  # delete an existing dataset at root first
+    task_id: int | None = None  # only this task of the suite (not with --suite all)
+    image_size: int = 96
+    vcodec: str = "libsvtav1"
+    image_writer_threads: int = 2  # PNG writing overlaps the simulation; 2 threads suit a 2-core machine
+    max_failed_attempts: int = 50  # give up if the expert fails this often (it should essentially never fail)
+    progress: bool = True
+
+
+@dataclass
+class CollectResult:
+    root: Path
+    repo_id: str
+    episodes: int
+    frames: int
+    failed_attempts: int
+    seconds: float
+
+    @property
+    def frames_per_second(self) -> float:
+        return self.frames / self.seconds if self.seconds > 0 else float("nan")
+
+
+def _task_plan(cfg: CollectConfig) -> list[tuple[str, int]]:
+    if cfg.suite == ALL_SUITES:
+        if cfg.task_id is not None:
+            raise ValueError(
+                "--task-id selects a task within one suite; it cannot be combined with --suite all"
+            )
+        # Interleave suites so that even a short collection covers all four.
+        most_tasks = max(len(SUITES[suite]) for suite in SUITE_NAMES)
+        return [(suite, k) for k in range(most_tasks) for suite in SUITE_NAMES if k < len(SUITES[suite])]
+    if cfg.suite not in SUITE_NAMES:
+        raise ValueError(f"unknown suite {cfg.suite!r}; valid: {', '.join(SUITE_NAMES)} or {ALL_SUITES!r}")
+    if cfg.task_id is not None:
+        if not 0 <= cfg.task_id < len(SUITES[cfg.suite]):
+            raise ValueError(
+                f"task_id {cfg.task_id} out of range for suite {cfg.suite!r}: valid 0..{len(SUITES[cfg.suite]) - 1}"
+            )
+        return [(cfg.suite, cfg.task_id)]
+    return [(cfg.suite, k) for k in range(len(SUITES[cfg.suite]))]
+
+
+def dataset_features(image_size: int, video: bool) -> dict:
+    image = {
+        "dtype": "video" if video else "image",
+        "shape": (image_size, image_size, 3),
+        "names": ["height", "width", "channels"],
+    }
+    return {
+        "observation.images.front": dict(image),
+        "observation.images.wrist": dict(image),
+        "observation.state": {"dtype": "float32", "shape": (len(STATE_NAMES),), "names": STATE_NAMES},
+        "action": {"dtype": "float32", "shape": (len(ACTION_NAMES),), "names": ACTION_NAMES},
+    }
+
+
+def _record_episode(env, expert, seed: int, task_id: int, dataset) -> tuple[bool, int]:
+    """Roll the expert out once, adding every frame to the dataset's episode buffer; returns (success, frames)."""
+    obs, info = env.reset(seed=seed, options={"task_id": task_id})
+    language = env.task_description
+    for step in range(env.max_episode_steps):
+        action = np.asarray(expert(obs), dtype=np.float32)
+        dataset.add_frame(
+            {
+                "observation.images.front": obs["pixels"]["front"],
+                "observation.images.wrist": obs["pixels"]["wrist"],
+                "observation.state": obs["agent_pos"],
+                "action": action,
+                "task": language,
+            }
+        )
+        obs, _, terminated, truncated, info = env.step(action)
+        if terminated or truncated:
+            return bool(info["is_success"]), step + 1
+    return False, env.max_episode_steps
+
+
+def collect(cfg: CollectConfig) -> CollectResult:
+    """Collect ``cfg.episodes`` successful expert episodes into a new LeRobotDataset v3 at ``cfg.root``."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+    from lerobot.utils.constants import HF_LEROBOT_HOME
+
+    from lerobot_phantom.envs.experts import scripted_expert
+    from lerobot_phantom.envs.table_env import CONTROL_HZ, make_phantom_env
+
+    if cfg.episodes < 1:
+        raise ValueError("--episodes must be at least 1")
+    plan = _task_plan(cfg)
+    repo_id = cfg.repo_id or f"local/phantom_{cfg.suite}"
+    root = Path(cfg.root) if cfg.root is not None else HF_LEROBOT_HOME / repo_id
+    if root.exists():
+        if not cfg.overwrite:
+            raise FileExistsError(
+                f"{root} already exists; pass --overwrite to replace it (or choose another --root)"
+            )
+        shutil.rmtree(root)
+
+    dataset = LeRobotDataset.create(
+        repo_id=repo_id,
+        fps=CONTROL_HZ,
+        features=dataset_features(cfg.image_size, cfg.video),
+        root=root,
+        robot_type="phantom_mocap_gripper",
+        use_videos=cfg.video,
+        image_writer_threads=cfg.image_writer_threads,
+        vcodec=cfg.vcodec,
+    )
+    envs = {}
+    rng = np.random.default_rng(cfg.seed)
+    frames = failed = 0
+    start = time.perf_counter()
+    try:
+        with tqdm(
+            total=cfg.episodes, desc=f"collect {cfg.suite}", unit="ep", disable=not cfg.progress
+        ) as bar:
+            for episode in range(cfg.episodes):
+                suite, task_id = plan[episode % len(plan)]
+                if suite not in envs:
+                    env = make_phantom_env(suite, image_size=cfg.image_size)
+                    envs[suite] = (env, scripted_expert(env))
+                env, expert = envs[suite]
+                while True:
+                    success, length = _record_episode(
+                        env, expert, int(rng.integers(2**31 - 1)), task_id, dataset
+                    )
+                    if success:
+                        break
+                    dataset.clear_episode_buffer()
+                    failed += 1
+                    if failed > cfg.max_failed_attempts:
+                        raise RuntimeError(
+                            f"the scripted expert failed {failed} times (last: suite {suite}, task {task_id})"
+                        )
+                dataset.save_episode(parallel_encoding=False)
+                frames += length
+                bar.update(1)
+                bar.set_postfix(frames=frames, failed=failed)
+    finally:
+        dataset.stop_image_writer()
+        dataset.finalize()
+        for env, _ in envs.values():
+            env.close()
+    return CollectResult(root, repo_id, cfg.episodes, frames, failed, time.perf_counter() - start)
+
+
+_BARE_FLAGS = ("video", "overwrite", "progress")
+
+
+def normalize_argv(argv: list[str]) -> list[str]:
+    """Accept dashed names (``--repo-id``) and bare boolean flags (``--video``); draccus wants ``--video=true``."""
+    out: list[str] = []
+    for position, arg in enumerate(argv):
+        if not arg.startswith("--"):
+            out.append(arg)
+            continue
+        name, sep, value = arg[2:].partition("=")
+        name = name.replace("-", "_")
+        following = argv[position + 1] if position + 1 < len(argv) else None
+        if name in _BARE_FLAGS and not sep and (following is None or following.startswith("--")):
+            out.append(f"--{name}=true")
+        else:
+            out.append(f"--{name}{sep}{value}")
+    return out
+
+
+def main(argv: list[str] | None = None) -> CollectResult:
+    import draccus
+
+    cfg = draccus.parse(CollectConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
+    result = collect(cfg)
+    print(
+        f"wrote {result.root} ({result.episodes} episodes, {result.frames} frames, "
+        f"{result.failed_attempts} failed attempts discarded, {result.frames_per_second:.1f} frames/s)"
+    )
+    return result
