@@ -24,11 +24,10 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_phantom.envs.interface import ACTION_NAMES, CAMERAS, CONTROL_HZ, STATE_NAMES
 from lerobot_phantom.envs.suites import SUITE_NAMES, SUITES
 
 ALL_SUITES = "all"
-STATE_NAMES = ["tcp_x", "tcp_y", "tcp_z", "gripper_opening"]
-ACTION_NAMES = ["dx", "dy", "dz", "grip"]
 
 
 @dataclass
@@ -89,10 +88,9 @@ def dataset_features(image_size: int, video: bool) -> dict:
         "names": ["height", "width", "channels"],
     }
     return {
-        "observation.images.front": dict(image),
-        "observation.images.wrist": dict(image),
-        "observation.state": {"dtype": "float32", "shape": (len(STATE_NAMES),), "names": STATE_NAMES},
-        "action": {"dtype": "float32", "shape": (len(ACTION_NAMES),), "names": ACTION_NAMES},
+        **{f"observation.images.{cam}": dict(image) for cam in CAMERAS},
+        "observation.state": {"dtype": "float32", "shape": (len(STATE_NAMES),), "names": list(STATE_NAMES)},
+        "action": {"dtype": "float32", "shape": (len(ACTION_NAMES),), "names": list(ACTION_NAMES)},
     }
 
 
@@ -104,8 +102,7 @@ def _record_episode(env, expert, seed: int, task_id: int, dataset) -> tuple[bool
         action = np.asarray(expert(obs), dtype=np.float32)
         dataset.add_frame(
             {
-                "observation.images.front": obs["pixels"]["front"],
-                "observation.images.wrist": obs["pixels"]["wrist"],
+                **{f"observation.images.{cam}": obs["pixels"][cam] for cam in CAMERAS},
                 "observation.state": obs["agent_pos"],
                 "action": action,
                 "task": language,
@@ -123,7 +120,7 @@ def collect(cfg: CollectConfig) -> CollectResult:
     from lerobot.utils.constants import HF_LEROBOT_HOME
 
     from lerobot_phantom.envs.experts import scripted_expert
-    from lerobot_phantom.envs.table_env import CONTROL_HZ, make_phantom_env
+    from lerobot_phantom.envs.table_env import make_phantom_env
 
     if cfg.episodes < 1:
         raise ValueError("--episodes must be at least 1")

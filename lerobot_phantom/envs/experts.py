@@ -11,8 +11,9 @@ from collections.abc import Callable
 
 import numpy as np
 
+from lerobot_phantom.envs.interface import MAX_STEP_M
 from lerobot_phantom.envs.scene import OBJECT_HALF_SIZE
-from lerobot_phantom.envs.table_env import MAX_STEP_M, PhantomTableEnv
+from lerobot_phantom.envs.table_env import PhantomTableEnv
 
 TRAVEL_Z = 0.12
 RELEASE_CLEARANCE = 0.008

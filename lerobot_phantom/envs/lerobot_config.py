@@ -23,10 +23,9 @@ from lerobot.envs.configs import EnvConfig
 from lerobot.utils.constants import ACTION, OBS_IMAGES, OBS_STATE
 
 from lerobot_phantom.envs import GYM_ID, SUITE_NAMES, SUITES
-from lerobot_phantom.envs.table_env import CAMERAS, CONTROL_HZ, OBS_TYPES, STATE_DIM
+from lerobot_phantom.envs.interface import ACTION_DIM, CAMERAS, CONTROL_HZ, OBS_TYPES, STATE_DIM
 
 ENV_TYPE = "phantom_table"
-ACTION_DIM = 4
 
 
 @EnvConfig.register_subclass(ENV_TYPE)

@@ -23,6 +23,7 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
+from lerobot_phantom.envs.interface import ACTION_DIM, CAMERAS, CONTROL_HZ, MAX_STEP_M, OBS_TYPES
 from lerobot_phantom.envs.rendering import select_gl_backend
 from lerobot_phantom.envs.scene import (
     BASKET_FLOOR_TOP,
@@ -40,10 +41,7 @@ from lerobot_phantom.envs.suites import get_suite, get_task, resolve_roles, samp
 select_gl_backend()  # must run before mujoco is imported
 import mujoco  # noqa: E402
 
-CAMERAS = ("front", "wrist")
-CONTROL_HZ = 10
 PHYSICS_SUBSTEPS = 20  # 20 x 5 ms = one 100 ms control step
-MAX_STEP_M = 0.04
 TCP_LOW = np.array([-0.25, -0.3, 0.015])
 TCP_HIGH = np.array([0.25, 0.3, 0.25])
 HOME_TCP = np.array([-0.2, 0.0, 0.2])
@@ -51,8 +49,6 @@ GRASP_XY_TOL = 0.02
 GRASP_Z_TOL = 0.02
 SETTLED_SPEED = 0.05  # m/s; a placed object must be at rest to count
 HEIGHT_TOL = 0.01
-STATE_DIM = 4
-OBS_TYPES = ("pixels_agent_pos", "pixels")
 
 
 def _close_renderers(renderers: dict) -> None:
@@ -147,7 +143,7 @@ class PhantomTableEnv(gym.Env):
                 dtype=np.float32,
             )
         self.observation_space = spaces.Dict(obs_spaces)
-        self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(4,), dtype=np.float32)
+        self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(ACTION_DIM,), dtype=np.float32)
 
         self._set_task(self.fixed_task_id if self.fixed_task_id is not None else 0)
         self._tcp = HOME_TCP.copy()
@@ -323,9 +319,10 @@ class PhantomTableEnv(gym.Env):
         dof = self._dof_adr[name]
         return float(np.linalg.norm(self.data.qvel[dof : dof + 3]))
 
-    def goals(self) -> list[tuple[str, str, str]]:
-        """The current task's goals with roles resolved to body names: (relation, object, target)."""
-        return [(rel, self._roles[obj], self._roles[target]) for rel, obj, target in self._task["goals"]]
+    def goals(self, task_id: int | None = None) -> list[tuple[str, str, str]]:
+        """Goals of the current task (or of ``task_id`` in this layout), roles resolved: (relation, object, target)."""
+        task = self._task if task_id is None else get_task(self.suite, task_id)
+        return [(rel, self._roles[obj], self._roles[target]) for rel, obj, target in task["goals"]]
 
     def support_height(self, relation: str, target: str) -> float:
         """Height of the surface an object rests on when ``relation`` to ``target`` holds."""
