@@ -147,11 +147,21 @@ def run_condition(
     return records
 
 
-def evaluate(cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None) -> dict[str, Any]:
+def suite_name(group: str, env_cfg) -> str:
+    """Name of a task group in the tables. LeRobot's ``make_env`` files single-id envs under the env type (e.g.
+    ``{"pusht": {0: env}}``); the task (``PushT-v0``, a phantom_table suite) says more there."""
+    return env_cfg.task if group == env_cfg.type and env_cfg.task else group
+
+
+def evaluate(
+    cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None, envs=None
+) -> dict[str, Any]:
     """Run every condition, write ``<output_dir>/eval.json`` and return its content.
 
     ``policy``: an already-built policy (tests, notebooks); default = loaded from ``cfg.policy`` (``--policy.path``).
     Its ``preprocessor``/``postprocessor`` default to pass-through pipelines when a policy is given.
+    ``envs``: ready ``{group: {task_id: vector_env}}`` (e.g. several suites at once); default = LeRobot's
+    ``make_env(cfg.env)``. Envs passed in stay open (the caller owns them).
     """
     if cfg.dataset is not None:
         from lerobot_phantom.eval.offline import evaluate_offline
@@ -176,13 +186,19 @@ def evaluate(cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocess
 
     output_dir = Path(cfg.output_dir)
     output_dir.mkdir(parents=True, exist_ok=True)
-    envs = make_env(
-        cfg.env,
-        n_envs=cfg.eval.batch_size,
-        use_async_envs=cfg.eval.use_async_envs,
-        trust_remote_code=cfg.trust_remote_code,
-    )
-    tasks = [(suite, task_id, env) for suite, group in envs.items() for task_id, env in group.items()]
+    owns_envs = envs is None
+    if owns_envs:
+        envs = make_env(
+            cfg.env,
+            n_envs=cfg.eval.batch_size,
+            use_async_envs=cfg.eval.use_async_envs,
+            trust_remote_code=cfg.trust_remote_code,
+        )
+    tasks = [
+        (suite_name(group, cfg.env), task_id, env)
+        for group, by_id in envs.items()
+        for task_id, env in by_id.items()
+    ]
     results: list[dict[str, Any]] = []
     device = torch.device(str(getattr(policy.config, "device", "cpu") or "cpu"))
     use_amp = bool(getattr(cfg.policy, "use_amp", False))
@@ -212,7 +228,8 @@ def evaluate(cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocess
                     )
     finally:
         progress.close()
-        compat.eval_close_envs(envs)
+        if owns_envs:
+            compat.eval_close_envs(envs)
 
     report = {
         "format": EVAL_FORMAT,
@@ -222,7 +239,7 @@ def evaluate(cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocess
             "duration_s": round(time.time() - started, 3),
             "policy": policy_metadata(cfg, policy),
             "env": {"type": cfg.env.type, "task": cfg.env.task},
-            "suites": sorted({suite for suite, _, _ in tasks}),
+            "suites": list(dict.fromkeys(suite for suite, _, _ in tasks)),
             "n_episodes": cfg.eval.n_episodes,
             "batch_size": cfg.eval.batch_size,
             "seed": cfg.seed,

@@ -106,6 +106,23 @@ def load_eval(path: str | Path, label: str | None = None) -> EvalRun:
     return EvalRun(path=path, label=label, data=data)
 
 
+def merge_by_label(runs: list[EvalRun]) -> list[EvalRun]:
+    """One column group per label: runs of one policy on different suites (one eval.json per suite) merge."""
+    merged: dict[str, EvalRun] = {}
+    for run in runs:
+        if run.label not in merged:
+            merged[run.label] = EvalRun(path=run.path, label=run.label, data={**run.data, "results": []})
+        target = merged[run.label]
+        overlap = set(target.suites) & set(run.suites)
+        if overlap:
+            raise ValueError(
+                f"{run.path} repeats suite(s) {sorted(overlap)} of label {run.label!r}; give each input a distinct "
+                "label (--labels) or drop the duplicate"
+            )
+        target.data["results"] = target.data["results"] + run.data["results"]
+    return list(merged.values())
+
+
 def pooled(run: EvalRun, condition: str, suite: str) -> tuple[int, int] | None:
     """(successes, episodes) of a condition pooled over a suite's tasks, or None when it was not run."""
     episodes = run.episodes(condition, suite)
@@ -474,10 +491,9 @@ def make_report(
         raise ValueError(f"--labels needs one label per input ({len(paths)}), got {len(labels)}")
     if len(before) != len(after):
         raise ValueError(f"--before and --after pair up one to one, got {len(before)} and {len(after)} files")
-    runs = [load_eval(p, None if labels is None else labels[i]) for i, p in enumerate(paths)]
-    if len({r.label for r in runs}) != len(runs):
-        raise ValueError(f"inputs need distinct labels, got {[r.label for r in runs]}; pass --labels")
-    label_of = {r.path.resolve(): r.label for r in runs}
+    loaded = [load_eval(p, None if labels is None else labels[i]) for i, p in enumerate(paths)]
+    label_of = {r.path.resolve(): r.label for r in loaded}
+    runs = merge_by_label(loaded)
     pairs = []
     for b, a in zip(before, after, strict=True):
         run_b, run_a = load_eval(b), load_eval(a)

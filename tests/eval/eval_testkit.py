@@ -188,3 +188,40 @@ class ToyPolicy(PreTrainedPolicy):
 
 def make_toy_policy(mode: str) -> ToyPolicy:
     return ToyPolicy(ToyPolicyConfig(mode=mode))
+
+
+def write_toy_dataset(root, episodes: int = 2, size: int = 32):
+    """A LeRobotDataset v3 (images, no videos) of oracle rollouts in DotReachEnv, written under ``root``."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    image = {"dtype": "image", "shape": (size, size, 3), "names": ["height", "width", "channels"]}
+    vector = {"dtype": "float32", "shape": (2,), "names": None}
+    features = {
+        "observation.images.front": image,
+        "observation.images.wrist": image,
+        "observation.state": vector,
+        "observation.environment_state": vector,
+        "action": vector,
+    }
+    dataset = LeRobotDataset.create("local/dot_reach", fps=10, features=features, root=root, use_videos=False)
+    env = DotReachEnv(size=size)
+    for episode in range(episodes):
+        obs, _ = env.reset(seed=episode)
+        for _ in range(6):
+            action = np.clip(obs["environment_state"] - obs["agent_pos"], -STEP_LIMIT, STEP_LIMIT).astype(
+                np.float32
+            )
+            dataset.add_frame(
+                {
+                    "observation.images.front": obs["pixels"]["front"],
+                    "observation.images.wrist": obs["pixels"]["wrist"],
+                    "observation.state": obs["agent_pos"],
+                    "observation.environment_state": obs["environment_state"],
+                    "action": action,
+                    "task": TASK,
+                }
+            )
+            obs, *_ = env.step(action)
+        dataset.save_episode()
+    dataset.finalize()
+    return dataset

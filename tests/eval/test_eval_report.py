@@ -154,6 +154,15 @@ def test_single_input_uses_suite_columns_and_directory_label(evals, tmp_path):
     assert (tmp_path / "one" / "robustness.csv").read_text().splitlines()[0] == "condition,spatial,goal"
 
 
+def test_one_file_per_suite_merges_into_one_column_group(tmp_path):
+    spatial = write_eval(tmp_path / "s" / "eval.json", {k: v for k, v in BASE.items() if k[1] == "spatial"})
+    goal = write_eval(tmp_path / "g" / "eval.json", {k: v for k, v in BASE.items() if k[1] == "goal"})
+    make_report([spatial, goal], tmp_path / "merged", labels=["base", "base"], figures=False)
+    lines = (tmp_path / "merged" / "robustness.md").read_text().splitlines()
+    assert lines[0] == "| Attack | spatial | goal |"
+    assert lines[2] == "| Clean | 100.0 | 66.7 |"
+
+
 def test_mismatched_pairs_are_refused(evals, tmp_path):
     base, _ = evals
     other_seeds = write_eval(tmp_path / "seeds" / "eval.json", TRAINED, seeds=[10, 11, 12, 13, 14, 15])
@@ -173,7 +182,7 @@ def test_bad_inputs_give_clear_errors(evals, tmp_path):
     (tmp_path / "junk.json").write_text("{}")
     with pytest.raises(ValueError, match="not a lerobot-phantom-eval result"):
         make_report([tmp_path / "junk.json"], tmp_path / "r")
-    with pytest.raises(ValueError, match="distinct labels"):
+    with pytest.raises(ValueError, match="repeats suite"):
         make_report([base, base], tmp_path / "r")
     with pytest.raises(ValueError, match="one label per input"):
         make_report([base], tmp_path / "r", labels=["a", "b"])

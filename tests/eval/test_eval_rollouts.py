@@ -100,7 +100,7 @@ def test_videos_written_for_first_episodes_of_each_condition(colour_report):
         for p in (cfg.output_dir / "videos").rglob("*.mp4")
     )
     assert len(videos) == len(build_conditions(cfg.phantom))
-    assert "clean/phantom_test_dot_0/episode_seed7.mp4" in videos
+    assert "clean/DotReach-v0_0/episode_seed7.mp4" in videos
     assert all(p.endswith("episode_seed7.mp4") for p in videos)
 
 

@@ -1,0 +1,168 @@
+"""Offline mode of ``lerobot-phantom-eval`` (``--dataset.*`` instead of ``--env.*``): no simulator, recorded frames.
+
+For real-robot data there is no success predicate, so the measure is how far the policy's action moves when its
+input is attacked: for each frame, the same policy (same RNG state, fresh action queue) acts on the clean frame and
+on the attacked frame, and the distance between the two actions is recorded. Distances are reported raw (L2, in
+action units) and normalised by the dataset's per-dimension action std (RMS of z-scores), next to the clean
+policy's own distance from the recorded action as a yardstick.
+
+    lerobot-phantom-eval --policy.path=CKPT --dataset.repo_id=local/real --dataset.root=DIR \\
+        --phantom.attacks='[laser_blinding,voice_dos]' --phantom.offline_frames=256 --eval.batch_size=16
+"""
+
+import json
+import statistics
+import time
+from dataclasses import asdict
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import torch
+from tqdm import tqdm
+
+from lerobot_phantom import _lerobot_compat as compat
+from lerobot_phantom.eval.config import PhantomEvalConfig
+from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT
+from lerobot_phantom.eval.rollout import AttackStep, build_conditions
+from lerobot_phantom.transforms.base import derive_seed
+
+
+def frame_indices(n_frames: int, wanted: int) -> list[int]:
+    """At most ``wanted`` frame indices spread evenly over the dataset (first and last included)."""
+    if n_frames < 1:
+        raise ValueError("the dataset has no frames")
+    return sorted({int(i) for i in np.linspace(0, n_frames - 1, min(wanted, n_frames)).round()})
+
+
+def load_offline_policy(cfg: PhantomEvalConfig, dataset):
+    from lerobot.policies.factory import make_policy, make_pre_post_processors
+
+    if cfg.policy is None:
+        raise ValueError(
+            "no policy to evaluate: pass --policy.path=<checkpoint dir> (or policy= to evaluate())"
+        )
+    policy = make_policy(cfg=cfg.policy, ds_meta=dataset.meta, rename_map=cfg.rename_map)
+    preprocessor, postprocessor = make_pre_post_processors(
+        policy_cfg=cfg.policy,
+        pretrained_path=cfg.policy.pretrained_path,
+        preprocessor_overrides={
+            "device_processor": {"device": str(policy.config.device)},
+            "rename_observations_processor": {"rename_map": cfg.rename_map},
+        },
+    )
+    return policy, preprocessor, postprocessor
+
+
+def act(policy, preprocessor, postprocessor, batch: dict[str, Any], seed: int) -> torch.Tensor:
+    """The policy's first action for each frame of ``batch``, from an empty action queue and a fixed RNG state."""
+    compat.eval_seed_everything(seed)
+    policy.reset()
+    with torch.inference_mode():
+        action = policy.select_action(preprocessor(dict(batch)))
+    return postprocessor(action).to("cpu", torch.float32).reshape(len(batch["index"]), -1)
+
+
+def deviation_stats(distances: list[float], normalised: list[float]) -> dict[str, float]:
+    return {
+        "mean_l2": statistics.fmean(distances),
+        "median_l2": statistics.median(distances),
+        "max_l2": max(distances),
+        "mean_normalized": statistics.fmean(normalised),
+    }
+
+
+def evaluate_offline(
+    cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None
+) -> dict[str, Any]:
+    """Action deviation clean vs attacked per condition over dataset frames; writes and returns eval.json."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+    from torch.utils.data import Subset, default_collate
+
+    from lerobot_phantom.eval.eval import identity_processors, versions, with_step
+
+    started = time.time()
+    dataset = LeRobotDataset(
+        cfg.dataset.repo_id,
+        root=cfg.dataset.root,
+        episodes=cfg.dataset.episodes,
+        revision=cfg.dataset.revision,
+        video_backend=cfg.dataset.video_backend,
+    )
+    conditions = build_conditions(cfg.phantom)[1:]  # the clean frame is every condition's reference
+    steps = [AttackStep(condition, cfg.phantom) for condition in conditions]
+    if policy is None:
+        policy, preprocessor, postprocessor = load_offline_policy(cfg, dataset)
+    elif preprocessor is None or postprocessor is None:
+        preprocessor, postprocessor = identity_processors()
+    policy.eval()
+    identity, _ = identity_processors()
+    attackers = [with_step(identity, step) for step in steps]
+
+    std = dataset.meta.stats["action"]["std"]
+    action_std = torch.as_tensor(np.asarray(std), dtype=torch.float32).reshape(-1).clamp(min=1e-6)
+    indices = frame_indices(len(dataset), cfg.phantom.offline_frames)
+    frames = Subset(dataset, indices)
+    batch_size = cfg.eval.batch_size
+    distances: list[list[float]] = [[] for _ in conditions]
+    normalised: list[list[float]] = [[] for _ in conditions]
+    clean_vs_recorded: list[float] = []
+    progress = tqdm(total=len(indices) * len(conditions), desc="conditions x frames")
+    try:
+        for start in range(0, len(indices), batch_size):
+            batch = default_collate([frames[i] for i in range(start, min(start + batch_size, len(indices)))])
+            seed = derive_seed(cfg.seed or 0, start) % 2**32
+            clean = act(policy, preprocessor, postprocessor, batch, seed)
+            clean_vs_recorded += (clean - batch["action"].reshape(clean.shape)).norm(dim=1).tolist()
+            for k, (step, attacker) in enumerate(zip(steps, attackers, strict=True)):
+                # Each frame is its own "episode": its attack parameters are seeded by its dataset index.
+                step.arm(batch["index"].tolist())
+                attacked = act(policy, preprocessor, postprocessor, attacker(dict(batch)), seed)
+                diff = attacked - clean
+                distances[k] += diff.norm(dim=1).tolist()
+                normalised[k] += (diff / action_std).pow(2).mean(dim=1).sqrt().tolist()
+                progress.update(len(clean))
+    finally:
+        progress.close()
+
+    results = [
+        {
+            "condition": condition.key,
+            "attack": condition.attack,
+            "intensity": condition.intensity,
+            "intensity_value": condition.intensity_value,
+            "frames": len(indices),
+            **deviation_stats(distances[k], normalised[k]),
+            "per_frame_l2": [round(d, 6) for d in distances[k]],
+        }
+        for k, condition in enumerate(conditions)
+    ]
+    report = {
+        "format": EVAL_FORMAT,
+        "mode": "offline",
+        "metadata": {
+            "created": datetime.now(UTC).isoformat(timespec="seconds"),
+            "duration_s": round(time.time() - started, 3),
+            "policy": {
+                "path": None if cfg.policy is None else str(cfg.policy.pretrained_path),
+                "type": getattr(policy.config, "type", None) or type(policy).__name__,
+            },
+            "dataset": {
+                "repo_id": cfg.dataset.repo_id,
+                "root": None if cfg.dataset.root is None else str(cfg.dataset.root),
+            },
+            "frame_indices": indices,
+            "seed": cfg.seed,
+            "clean_vs_recorded_l2": statistics.fmean(clean_vs_recorded),
+            "conditions": [c.key for c in conditions],
+            "phantom": asdict(cfg.phantom),
+            "versions": versions(),
+        },
+        "results": results,
+    }
+    output_dir = Path(cfg.output_dir)
+    output_dir.mkdir(parents=True, exist_ok=True)
+    with open(output_dir / EVAL_FILENAME, "w") as f:
+        json.dump(report, f, indent=2)
+    return report
