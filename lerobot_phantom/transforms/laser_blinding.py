@@ -54,6 +54,7 @@ def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.devi
 def blend(x: torch.Tensor, alpha: torch.Tensor | float, pattern: torch.Tensor) -> torch.Tensor:
     """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding)."""
     weight = _as_batch_values(alpha, x.shape[0], x.device)
+    # a convex combination of values in [0, 1] stays in [0, 1]: the clip only guards patterns out of range
     return torch.lerp(x, pattern.to(x.dtype), weight).clamp_(0.0, 1.0)
 
 
@@ -242,10 +243,15 @@ class LaserBlinding(CameraAttack):
     ) -> torch.Tensor:
         """Patterns ``(B or 1, 3, H, W)`` for per-sample positions ``(B, 2)``."""
         pixels = self.spot_pixel(position.to(device), height, width)
-        if bool((pixels == pixels[:1]).all()):
+        same_everywhere = bool((pixels == pixels[:1]).all())
+        if same_everywhere and self._fixed_position is not None:
             row, col = (int(v) for v in pixels[0].tolist())
             return self.render_pattern(height, width, row, col, device)[None]
+        # random positions: crop the cached canvas (a view when one position serves the whole batch)
         canvas = self._canvas(height, width, device)
+        if same_everywhere:
+            top, left = height - 1 - int(pixels[0, 0]), width - 1 - int(pixels[0, 1])
+            return canvas[None, :, top : top + height, left : left + width]
         rows = (height - 1 - pixels[:, :1]) + torch.arange(height, device=device)
         cols = (width - 1 - pixels[:, 1:]) + torch.arange(width, device=device)
         return canvas[:, rows[:, :, None], cols[:, None, :]].permute(1, 0, 2, 3)
