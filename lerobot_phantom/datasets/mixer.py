@@ -246,21 +246,29 @@ class PhantomDataset(Dataset):
         item = self.dataset[index]
         choice = self.decision(index)
         if self.apply:
-            self._attack(item, choice)
+            self.attack_item(item, choice)
             if self.image_transforms is not None:
                 for key in self.camera_keys:
                     item[key] = self.image_transforms(item[key])
-        item["phantom.attack"] = torch.tensor(choice["attack_id"], dtype=torch.int64)
-        item["phantom.intensity"] = torch.tensor(choice["intensity"], dtype=torch.float32)
-        item["phantom.camera"] = torch.tensor(choice["camera_mask"], dtype=torch.int64)
-        item["phantom.instruction_attack"] = torch.tensor(choice["instruction_attack_id"], dtype=torch.int64)
-        item["phantom.instruction_intensity"] = torch.tensor(
-            choice["instruction_intensity"], dtype=torch.float32
-        )
-        item["phantom.seed"] = torch.tensor(choice["seed"], dtype=torch.int64)
+        item.update(self.labels(choice))
         return item
 
-    def _attack(self, item: dict[str, Any], choice: dict[str, Any]) -> None:
+    @staticmethod
+    def labels(choice: dict[str, Any]) -> dict[str, torch.Tensor]:
+        """The ``phantom.*`` label tensors of a decision."""
+        return {
+            "phantom.attack": torch.tensor(choice["attack_id"], dtype=torch.int64),
+            "phantom.intensity": torch.tensor(choice["intensity"], dtype=torch.float32),
+            "phantom.camera": torch.tensor(choice["camera_mask"], dtype=torch.int64),
+            "phantom.instruction_attack": torch.tensor(choice["instruction_attack_id"], dtype=torch.int64),
+            "phantom.instruction_intensity": torch.tensor(
+                choice["instruction_intensity"], dtype=torch.float32
+            ),
+            "phantom.seed": torch.tensor(choice["seed"], dtype=torch.int64),
+        }
+
+    def attack_item(self, item: dict[str, Any], choice: dict[str, Any]) -> None:
+        """Apply ``choice`` (a ``decision``) to ``item`` in place: its cameras and/or its task."""
         name = choice["attack"]
         try:
             if name is not None and choice["cameras"]:
