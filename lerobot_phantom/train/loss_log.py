@@ -11,7 +11,7 @@ Two ways, chosen per policy, both cheap and both stated in the log:
   no-grad forward per attack group of the current batch, in training mode, inside ``torch.random.fork_rng`` so
   logging does not change the training run's random stream. Noisier (one batch), but costs nothing between logs.
 
-Logged at LeRobot's log steps: a ``phantom:`` line in the log, ``phantom/loss/<attack>`` (plus
+Logged at LeRobot's log steps and at the last step: a ``phantom:`` line in the log, ``phantom/loss/<attack>`` (plus
 ``phantom/attacked_fraction``) in the dict LeRobot sends to wandb, and one JSON line per log step in
 ``<output_dir>/phantom_train_log.jsonl``. Group names: ``clean`` (neither channel attacked), the camera/main attack's
 name, and ``instruction:<name>`` for the instruction channel. ``seen`` counts every sample the loop trained on
@@ -72,11 +72,18 @@ class PerAttackLossLog:
     """Collects per-group losses during training; see the module docstring."""
 
     def __init__(
-        self, policy: Any, *, accelerator: Any, log_freq: int, output_dir: str | Path | None
+        self,
+        policy: Any,
+        *,
+        accelerator: Any,
+        log_freq: int,
+        output_dir: str | Path | None,
+        final_step: int | None = None,
     ) -> None:
         self.policy = policy
         self.accelerator = accelerator
         self.log_freq = int(log_freq)
+        self.final_step = final_step
         self.path = Path(output_dir) / LOG_FILE_NAME if output_dir is not None else None
         forward_parameters = inspect.signature(policy.forward).parameters
         self.mode = "per_sample" if "reduction" in forward_parameters else "log_step_forward"
@@ -132,7 +139,8 @@ class PerAttackLossLog:
             self._window_sum += (member.to(torch.float64) * losses[:, None]).sum(0)
             self._window_count += member.sum(0).to(torch.float64)
             self._last_per_sample = None
-        if self.log_freq <= 0 or step % self.log_freq != 0:
+        is_log_step = self.log_freq > 0 and step % self.log_freq == 0
+        if not (is_log_step or step == self.final_step):
             return {}
         if self.mode == "log_step_forward":
             self._window_sum.zero_()

@@ -154,6 +154,7 @@ class _PhantomTrainingRun:
                 accelerator=accelerator,
                 log_freq=self.cfg.log_freq,
                 output_dir=self.cfg.output_dir,
+                final_step=self.cfg.steps,
             )
         labels, batch = self.loss_log.split_labels(batch)
         train_metrics, output_dict = self.originals["update_policy"](
