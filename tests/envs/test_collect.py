@@ -1,0 +1,107 @@
+import numpy as np
+import pytest
+from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+from lerobot_phantom.envs import SUITES
+from lerobot_phantom.envs.collect import CollectConfig, collect, main, normalize_argv
+
+REPO_ID = "local/phantom_test"
+
+
+def _collect(root, **overrides):
+    cfg = CollectConfig(suite="goal", episodes=2, repo_id=REPO_ID, root=str(root), progress=False)
+    for key, value in overrides.items():
+        setattr(cfg, key, value)
+    return collect(cfg)
+
+
+@pytest.fixture(scope="module")
+def goal_dataset(tmp_path_factory):
+    root = tmp_path_factory.mktemp("collect") / "goal"
+    return _collect(root, seed=3)
+
+
+def test_collected_dataset_reloads_offline_with_expected_contents(goal_dataset):
+    ds = LeRobotDataset(REPO_ID, root=goal_dataset.root)
+    assert ds.num_episodes == 2 == goal_dataset.episodes
+    assert ds.num_frames == goal_dataset.frames
+    assert ds.fps == 10
+    assert set(ds.meta.tasks.index) == {SUITES["goal"][0]["language"], SUITES["goal"][1]["language"]}
+    for key in ("observation.images.front", "observation.images.wrist"):
+        assert ds.features[key]["dtype"] == "image" and tuple(ds.features[key]["shape"]) == (96, 96, 3)
+    assert tuple(ds.features["observation.state"]["shape"]) == (4,)
+    assert tuple(ds.features["action"]["shape"]) == (4,)
+    frame = ds[0]
+    assert frame["observation.images.front"].shape == (3, 96, 96)
+    assert frame["task"] == SUITES["goal"][0]["language"]
+    assert frame["action"].abs().max() <= 1.0
+
+
+def test_collection_is_deterministic_for_a_seed(goal_dataset, tmp_path):
+    again = _collect(tmp_path / "again", seed=3)
+    other = _collect(tmp_path / "other", seed=4)
+    first = LeRobotDataset(REPO_ID, root=goal_dataset.root).hf_dataset.with_format(None)
+    second = LeRobotDataset(REPO_ID, root=again.root).hf_dataset.with_format(None)
+    third = LeRobotDataset(REPO_ID, root=other.root).hf_dataset.with_format(None)
+    for column in ("action", "observation.state", "task_index"):
+        assert first[column] == second[column]
+    for key in ("observation.images.front", "observation.images.wrist"):
+        np.testing.assert_array_equal(
+            np.stack([np.asarray(im) for im in first[key]]), np.stack([np.asarray(im) for im in second[key]])
+        )
+    assert (
+        np.asarray(first["observation.state"])[0].tolist()
+        == np.asarray(third["observation.state"])[0].tolist()
+    )
+    assert first["action"] != third["action"]  # another seed, other layouts
+
+
+def test_refuses_to_overwrite_unless_told(goal_dataset, tmp_path):
+    root = tmp_path / "existing"
+    root.mkdir()
+    (root / "keep.txt").write_text("precious")
+    with pytest.raises(FileExistsError, match="--overwrite"):
+        _collect(root, episodes=1)
+    assert (root / "keep.txt").read_text() == "precious"
+    result = _collect(root, episodes=1, overwrite=True)
+    assert not (root / "keep.txt").exists()
+    assert LeRobotDataset(REPO_ID, root=result.root).num_episodes == 1
+
+
+def test_bad_arguments_name_the_valid_values(tmp_path):
+    with pytest.raises(ValueError, match="valid: spatial, object, goal, long or 'all'"):
+        _collect(tmp_path / "x", suite="kitchen")
+    with pytest.raises(ValueError, match="cannot be combined"):
+        _collect(tmp_path / "x", suite="all", task_id=0)
+    with pytest.raises(ValueError, match=r"valid 0\.\.5"):
+        _collect(tmp_path / "x", task_id=9)
+    assert not (tmp_path / "x").exists()
+
+
+def test_cli_accepts_dashed_names_and_bare_flags():
+    argv = ["--suite", "all", "--repo-id", "local/x", "--video", "--overwrite", "--seed", "2"]
+    assert normalize_argv(argv) == [
+        "--suite",
+        "all",
+        "--repo_id",
+        "local/x",
+        "--video=true",
+        "--overwrite=true",
+        "--seed",
+        "2",
+    ]
+
+
+@pytest.mark.slow
+def test_cli_collects_all_suites_as_videos(tmp_path):
+    root = tmp_path / "all"
+    result = main(["--suite", "all", "--episodes", "4", "--repo-id", REPO_ID, "--root", str(root), "--video"])
+    ds = LeRobotDataset(REPO_ID, root=root)
+    assert ds.num_episodes == 4 == result.episodes
+    assert set(ds.meta.video_keys) == {"observation.images.front", "observation.images.wrist"}
+    # --suite all interleaves the suites, so four episodes cover the first task of each suite.
+    assert set(ds.meta.tasks.index) == {
+        SUITES[s][0]["language"] for s in ("spatial", "object", "goal", "long")
+    }
+    frame = ds[ds.num_frames - 1]
+    assert frame["observation.images.front"].shape == (3, 96, 96)
