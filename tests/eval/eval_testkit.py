@@ -225,3 +225,27 @@ def write_toy_dataset(root, episodes: int = 2, size: int = 32):
         dataset.save_episode()
     dataset.finalize()
     return dataset
+
+
+class PhantomTableExpertPolicy(ToyPolicy):
+    """The phantom_table scripted expert behind LeRobot's policy interface (it reads the true sim state, not the
+    observation); it also keeps the first front/wrist images it was shown in each rollout."""
+
+    def bind(self, vector_env):
+        from lerobot_phantom.envs import scripted_expert
+
+        self.experts = [scripted_expert(env) for env in vector_env.envs]
+        self.first_images: list[dict[str, torch.Tensor]] = []
+        self._fresh = False
+        return self
+
+    def reset(self):
+        self._fresh = True
+
+    def select_action(self, batch, **kwargs):
+        if self._fresh:
+            self.first_images.append(
+                {k: batch[f"observation.images.{k}"].clone() for k in ("front", "wrist")}
+            )
+            self._fresh = False
+        return torch.as_tensor(np.stack([expert() for expert in self.experts]))

@@ -107,7 +107,9 @@ def test_cli_missing_checkpoint_is_a_clear_error(tmp_path, monkeypatch):
         "argv",
         ["lerobot-phantom-eval", f"--policy.path={missing}", "--env.type=pusht", f"--output_dir={tmp_path}"],
     )
-    with pytest.raises(FileNotFoundError, match=r"does not exist locally and the Hugging Face hub is offline"):
+    with pytest.raises(
+        FileNotFoundError, match=r"does not exist locally and the Hugging Face hub is offline"
+    ):
         eval_module.main()
 
 
