@@ -149,3 +149,13 @@ def test_dataset_config_from_json_goes_through_make_dataset(registered, tmp_path
     attacked, clean = dataset[1]["observation.image"], raw[1]["observation.image"]
     assert attacked.shape == clean.shape
     assert float((attacked - clean).abs().mean()) > 0.1  # strong laser: alpha 0.9
+
+
+def test_newer_lerobot_custom_transforms_table_is_used_when_present(registered, monkeypatch):
+    table = {"SharpnessJitter": transforms_module.SharpnessJitter}
+    monkeypatch.setattr(transforms_module, "_CUSTOM_TRANSFORMS", table, raising=False)
+    factory_before = transforms_module.make_transform_from_config
+    assert register_image_transforms() == "table"
+    assert set(table) == {"SharpnessJitter", *camera_attack_class_names()}
+    assert table["UltrasoundBlur"].name == "ultrasound_blur"
+    assert transforms_module.make_transform_from_config is factory_before  # the table, not the wrapper
