@@ -1,0 +1,237 @@
+"""The model-agnostic part of calibration: parametric models, least-squares fits, seeded splits, selection.
+
+A *problem* is one kind of measured data with a base model (the paper's simulation) and a library of named
+physical extensions. Its data is cut into *items* (table rows, image tiles or whole images) so that splits never
+share an item between fitting and scoring. Selection is forward: starting from the base, the extension that most
+lowers the inner cross-validated RMSE is kept if it lowers it by a clear relative margin; repeat until none does.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import torch
+from scipy.optimize import least_squares
+
+
+@dataclass(frozen=True)
+class Effect:
+    """A named physical extension: its cause in plain words and the effects it builds on."""
+
+    name: str
+    cause: str
+    requires: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class Param:
+    """A fitted parameter: start value, bounds and a typical magnitude (the optimiser works in ``value/scale``)."""
+
+    name: str
+    init: float
+    low: float
+    high: float
+    scale: float = 1.0
+
+
+@dataclass
+class Fit:
+    effects: frozenset[str]
+    params: dict[str, float]
+    extra: dict = field(default_factory=dict)  # per-item nuisance values etc.
+
+
+def fit_least_squares(
+    params: Sequence[Param],
+    residuals: Callable[[dict[str, torch.Tensor]], torch.Tensor],
+    *,
+    max_nfev: int = 200,
+    starts: Sequence[dict[str, float]] = (),
+    autodiff: bool = True,
+) -> dict[str, float]:
+    """Bounded least squares (scipy's trust-region reflective) over named parameters; best of several starts.
+
+    ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor; with ``autodiff`` its Jacobian
+    comes from torch forward-mode differentiation, otherwise from finite differences.
+    """
+    if not params:
+        return {}
+    names = [p.name for p in params]
+    scale = torch.tensor([p.scale for p in params], dtype=torch.float64)
+    low = np.array([p.low for p in params], dtype=np.float64) / scale.numpy()
+    high = np.array([p.high for p in params], dtype=np.float64) / scale.numpy()
+
+    def call(z: torch.Tensor) -> torch.Tensor:
+        values = z * scale
+        return residuals({n: values[i] for i, n in enumerate(names)})
+
+    def fun(z: np.ndarray) -> np.ndarray:
+        with torch.no_grad():
+            return call(torch.from_numpy(z)).numpy()
+
+    def jac(z: np.ndarray) -> np.ndarray:
+        return torch.func.jacfwd(call)(torch.from_numpy(z)).detach().numpy()
+
+    best: tuple[float, dict[str, float]] | None = None
+    for init in [{p.name: p.init for p in params}, *starts]:
+        z0 = np.array([init.get(p.name, p.init) for p in params], dtype=np.float64) / scale.numpy()
+        z0 = np.clip(z0, low + 1e-9 * (high - low), high - 1e-9 * (high - low))
+        result = least_squares(
+            fun,
+            z0,
+            jac=jac if autodiff else "2-point",
+            bounds=(low, high),
+            max_nfev=max_nfev,
+            x_scale=1.0,
+            tr_solver="lsmr",
+        )
+        if best is None or result.cost < best[0]:
+            best = (
+                float(result.cost),
+                {n: float(v) for n, v in zip(names, result.x * scale.numpy(), strict=True)},
+            )
+    assert best is not None
+    return best[1]
+
+
+class Problem:
+    """Interface of one calibration problem. Subclasses set the class attributes and implement the methods."""
+
+    attack: str = ""
+    input_kind: str = ""
+    units: str = ""
+    base_model: str = ""
+    extended_model: str = ""
+    candidates: tuple[Effect, ...] = ()
+
+    @property
+    def n_items(self) -> int:
+        raise NotImplementedError
+
+    def fit(self, effects: frozenset[str], items: np.ndarray) -> Fit:
+        raise NotImplementedError
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        """Sum of squared errors (in the data's units) and number of values over ``items``."""
+        raise NotImplementedError
+
+    def rmse(self, fit: Fit, items: np.ndarray) -> float:
+        total, count = self.squared_errors(fit, items)
+        return math.sqrt(total / max(count, 1))
+
+    def analyse(self, fit: Fit, items: np.ndarray) -> dict[str, dict[str, list[float]]]:
+        """Residual RMSE binned by the variables that could explain it: ``{variable: {"x": [...], "rmse": [...]}}``."""
+        return {}
+
+    def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
+        return ""
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        """Constructor options of the attack transform reproducing ``fit`` (what ``calibrated.json`` carries)."""
+        return {}
+
+    def derived(self, fit: Fit) -> dict:
+        """Physical quantities derived from the fitted parameters (e.g. a saturation radius)."""
+        return {}
+
+    def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir) -> list[str]:
+        return []
+
+
+def seeded_split(n_items: int, heldout: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
+    """(fit, held-out) item indices: a seeded random permutation; at least one item on each side."""
+    if n_items < 2:
+        raise ValueError(f"need at least 2 items (rows, tiles or image pairs) to hold any out, got {n_items}")
+    if not 0.0 < heldout < 1.0:
+        raise ValueError(f"--heldout must lie in (0, 1), got {heldout}")
+    order = np.random.default_rng(seed).permutation(n_items)
+    n_heldout = min(max(1, round(heldout * n_items)), n_items - 1)
+    return np.sort(order[n_heldout:]), np.sort(order[:n_heldout])
+
+
+def kfold(
+    items: np.ndarray, folds: int, seed: int, max_train_items: int | None = None
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Seeded k-fold splits; training folds are subsampled to ``max_train_items`` (large tables fit fast)."""
+    rng = np.random.default_rng(seed)
+    order = rng.permutation(items)
+    folds = max(2, min(folds, len(items)))
+    parts = np.array_split(order, folds)
+    splits = []
+    for i in range(folds):
+        train = np.concatenate(parts[:i] + parts[i + 1 :])
+        if max_train_items is not None and len(train) > max_train_items:
+            train = rng.choice(train, max_train_items, replace=False)
+        splits.append((np.sort(train), np.sort(parts[i])))
+    return splits
+
+
+@dataclass
+class Step:
+    effects: list[str]
+    validation_rmse: float
+    tried: dict[str, float]
+
+
+def cross_validated_rmse(problem: Problem, effects: frozenset[str], splits) -> float:
+    total, count = 0.0, 0
+    for train, val in splits:
+        fit = problem.fit(effects, train)
+        sq, n = problem.squared_errors(fit, val)
+        total, count = total + sq, count + n
+    return math.sqrt(total / max(count, 1))
+
+
+def forward_select(
+    problem: Problem,
+    fit_items: np.ndarray,
+    *,
+    seed: int,
+    margin: float,
+    folds: int = 4,
+    max_train_items: int = 2500,
+) -> tuple[frozenset[str], list[Step]]:
+    """Forward selection of extensions by inner k-fold validation RMSE, each step needing a ``margin`` gain."""
+    splits = kfold(fit_items, folds, seed + 1, max_train_items)
+    chosen: frozenset[str] = frozenset()
+    current = cross_validated_rmse(problem, chosen, splits)
+    steps = [Step([], current, {})]
+    while True:
+        tried: dict[str, float] = {}
+        for effect in problem.candidates:
+            if effect.name in chosen or not set(effect.requires) <= chosen:
+                continue
+            tried[effect.name] = cross_validated_rmse(problem, chosen | {effect.name}, splits)
+        if not tried:
+            break
+        best = min(tried, key=tried.__getitem__)
+        steps[-1].tried = tried
+        if tried[best] > (1.0 - margin) * current:
+            break
+        chosen = chosen | {best}
+        current = tried[best]
+        steps.append(Step(sorted(chosen), current, {}))
+    return chosen, steps
+
+
+def binned_rmse(x: np.ndarray, residual: np.ndarray, bins: int = 8) -> dict[str, list[float]]:
+    """RMSE of ``residual`` in quantile bins of ``x`` (or per distinct value when ``x`` has few values)."""
+    x = np.asarray(x, dtype=np.float64).ravel()
+    residual = np.asarray(residual, dtype=np.float64).ravel()
+    values = np.unique(x)
+    if len(values) <= bins:
+        groups = [(float(v), x == v) for v in values]
+    else:
+        edges = np.unique(np.quantile(x, np.linspace(0, 1, bins + 1)))
+        index = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
+        groups = [(float(0.5 * (edges[i] + edges[i + 1])), index == i) for i in range(len(edges) - 1)]
+    centres, rmses, counts = [], [], []
+    for centre, mask in groups:
+        if mask.any():
+            centres.append(centre)
+            rmses.append(float(np.sqrt(np.mean(residual[mask] ** 2))))
+            counts.append(int(mask.sum()))
+    return {"x": centres, "rmse": rmses, "count": counts}

@@ -1,0 +1,223 @@
+"""Light projection: colour-triple tables (surface colour, projected colour -> captured colour).
+
+Base (the paper): the captured colour is an alpha blend of the surface and the projected colour. Physically a
+projector's light *adds* to the ambient light, in proportion to what the surface reflects, seen through the
+camera's colour filters (cross-talk between primaries), and the sensor saturates.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+
+from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+
+TRIPLE_COLUMNS = tuple(f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb")
+
+EFFECTS = (
+    Effect(
+        "additive_light",
+        "projected light adds to the light already on the surface; it never replaces (blends away) the surface's "
+        "own colour",
+    ),
+    Effect(
+        "albedo_modulation",
+        "a surface reflects projected light in proportion to its reflectance in each channel, so dark or "
+        "strongly coloured surfaces gain less of the projected colour",
+        requires=("additive_light",),
+    ),
+    Effect(
+        "channel_crosstalk",
+        "the projector's red, green and blue primaries are seen through the camera's overlapping colour filters: "
+        "each camera channel picks up a mix of the projected channels (a 3x3 matrix)",
+    ),
+    Effect(
+        "clipping",
+        "the sensor saturates: captured values stop growing at a white level however much light is added",
+    ),
+    Effect(
+        "sensor_gamma",
+        "light adds in linear irradiance, but pixel values are gamma-encoded; composing in the encoded values "
+        "gets bright additions wrong",
+    ),
+)
+
+CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
+
+
+def projection_specs(effects: frozenset[str]) -> list[Param]:
+    specs: list[Param] = []
+    additive = "additive_light" in effects
+    if not additive:
+        specs.append(Param("opacity", 0.3, 0.0, 1.0, scale=0.3))
+    if "channel_crosstalk" in effects:
+        specs += [Param(n, 0.3 if n[-2] == n[-1] else 0.0, -5.0, 5.0, scale=0.3) for n in CROSSTALK_NAMES]
+    elif additive:
+        specs.append(Param("strength", 0.3, 0.0, 20.0, scale=0.3))
+    if "albedo_modulation" in effects:
+        specs.append(Param("reflectance_floor", 0.1, 0.0, 10.0, scale=0.1))
+    if "clipping" in effects:
+        specs.append(Param("white", 0.95, 0.2, 1.0, scale=0.1))
+    if "sensor_gamma" in effects:
+        specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+    return specs
+
+
+def projection_predict(
+    surface: torch.Tensor, projected: torch.Tensor, strength: torch.Tensor, effects, params: dict[str, float]
+) -> torch.Tensor:
+    """Captured colour (N, 3) in [0, 1] from surface colour, projected colour (N, 3) and strength (N, 1)."""
+    gamma = params.get("gamma") if "sensor_gamma" in effects else None
+    surface_lin = surface.clamp(min=0) ** gamma if gamma else surface
+    light = projected.clamp(min=0) ** gamma if gamma else projected
+    if "channel_crosstalk" in effects:
+        matrix = torch.stack(
+            [torch.as_tensor(params[n], dtype=surface.dtype) for n in CROSSTALK_NAMES]
+        ).reshape(3, 3)
+        light = light @ matrix.T
+    if "additive_light" in effects:
+        light = strength * light * (1.0 if "channel_crosstalk" in effects else params["strength"])
+        if "albedo_modulation" in effects:
+            light = light * (surface_lin + params["reflectance_floor"])
+        total = surface_lin + light
+    else:
+        opacity = params["opacity"] * strength
+        total = (1.0 - opacity) * surface_lin + opacity * light
+    if "clipping" in effects:
+        total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
+    if gamma:
+        total = total.clamp(min=1e-12) ** (1.0 / gamma)
+    return total.clamp(0.0, 1.0)
+
+
+def projection_kwargs(fit: Fit) -> dict:
+    effects, p = fit.effects, fit.params
+    if "additive_light" not in effects:
+        kwargs: dict = {"model": "paper", "opacity": p["opacity"]}
+    else:
+        kwargs = {
+            "model": "additive",
+            "strength": 1.0 if "channel_crosstalk" in effects else p["strength"],
+            "albedo": "albedo_modulation" in effects,
+            "reflectance_floor": p.get("reflectance_floor", 0.0),
+        }
+    if "channel_crosstalk" in effects:
+        kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+    if "clipping" in effects:
+        kwargs["white"] = p["white"]
+    if "sensor_gamma" in effects:
+        kwargs["gamma"] = p["gamma"]
+    return kwargs
+
+
+def is_triple_table(columns) -> bool:
+    return set(TRIPLE_COLUMNS) <= set(columns)
+
+
+class TripleProblem(Problem):
+    attack = "light_projection"
+    input_kind = "colour_triples"
+    units = "grey levels (0-255)"
+    base_model = "alpha blend of surface and projected colour (the paper's light projection)"
+    extended_model = "additive projector light"
+    candidates = EFFECTS
+
+    def __init__(self, path: Path) -> None:
+        table = pd.read_csv(path)
+        missing = [c for c in TRIPLE_COLUMNS if c not in table.columns]
+        if missing:
+            raise ValueError(
+                f"{path}: colour-triple table lacks columns {missing}; needs {list(TRIPLE_COLUMNS)}"
+            )
+        self.path = path
+
+        def block(kind: str) -> torch.Tensor:
+            return torch.tensor(table[[f"{kind}_{c}" for c in "rgb"]].to_numpy(np.float64) / 255.0)
+
+        self.surface, self.projected, self.captured = block("origin"), block("addition"), block("outcome")
+        self.strength = torch.ones(len(table), 1, dtype=torch.float64)
+
+    @property
+    def n_items(self) -> int:
+        return len(self.captured)
+
+    def predict(self, fit_effects, params, items) -> torch.Tensor:
+        index = torch.as_tensor(items)
+        return projection_predict(
+            self.surface[index], self.projected[index], self.strength[index], fit_effects, params
+        )
+
+    def fit(self, effects: frozenset[str], items: np.ndarray) -> Fit:
+        target = self.captured[torch.as_tensor(items)]
+        params = fit_least_squares(
+            projection_specs(effects), lambda p: (self.predict(effects, p, items) - target).ravel()
+        )
+        return Fit(effects, params)
+
+    def residual(self, fit: Fit, items: np.ndarray) -> np.ndarray:
+        return (
+            255.0
+            * (self.predict(fit.effects, fit.params, items) - self.captured[torch.as_tensor(items)]).numpy()
+        )
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        r = self.residual(fit, items)
+        return float(np.sum(r**2)), r.size
+
+    def analyse(self, fit: Fit, items: np.ndarray) -> dict:
+        r = self.residual(fit, items)
+        index = torch.as_tensor(items)
+        surface = self.surface[index].numpy() * 255
+        projected = self.projected[index].numpy() * 255
+        channel = np.broadcast_to(np.arange(3), r.shape)
+        return {
+            "channel": binned_rmse(channel, r),
+            "projected_level": binned_rmse(projected, r),
+            "surface_level": binned_rmse(surface, r),
+            "projected_brightness": binned_rmse(np.repeat(projected.sum(1, keepdims=True), 3, 1), r),
+        }
+
+    def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
+        r = self.residual(before, items)
+        index = torch.as_tensor(items)
+        surface = self.surface[index].numpy()
+        projected = self.projected[index].numpy()
+        if effect in ("additive_light", "albedo_modulation"):
+            driver = surface * projected if effect == "albedo_modulation" else surface
+        elif effect == "channel_crosstalk":
+            driver = (
+                projected[:, [1, 2, 0]] + projected[:, [2, 0, 1]]
+            )  # the *other* channels' projected light
+        else:
+            driver = np.repeat((surface + projected).sum(1, keepdims=True), 3, 1)
+        corr = float(np.corrcoef(driver.ravel(), r.ravel())[0, 1]) if np.std(driver) > 0 else 0.0
+        return f"before {effect}: residual correlates {corr:+.2f} with its driving variable"
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        return projection_kwargs(fit)
+
+    def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir: Path) -> list[str]:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        truth = self.captured[torch.as_tensor(items)].numpy().ravel() * 255
+        fig, axes = plt.subplots(1, 2, figsize=(10, 4.5), sharey=True)
+        for ax, fit, label in ((axes[0], base, "base (alpha blend)"), (axes[1], extended, "extended")):
+            pred = self.predict(fit.effects, fit.params, items).numpy().ravel() * 255
+            ax.plot(truth, pred, ".", ms=1, alpha=0.3)
+            ax.plot([0, 255], [0, 255], "k-", lw=0.8)
+            ax.set(
+                xlabel="captured (held-out)",
+                title=f"{label}: RMSE {np.sqrt(np.mean((pred - truth) ** 2)):.1f}",
+            )
+        axes[0].set_ylabel("predicted")
+        fig.tight_layout()
+        path = out_dir / "triples_measured_vs_predicted.png"
+        fig.savefig(path, dpi=100)
+        plt.close(fig)
+        return [path.name]

@@ -1,0 +1,325 @@
+"""Sensor-physics kernels shared by the attack transforms and by ``lerobot-phantom-calibrate``.
+
+The paper's simulations are image-space formulas (alpha blends, a fixed band of rows, a uniform line blur). Real
+cameras differ in ways these kernels model: light adds in linear irradiance and clips at the sensor's full well
+before the gamma curve, laser glare falls off as a power law, auto-exposure darkens the whole frame, a rolling
+shutter lights the rows whose exposure window overlaps a laser pulse, a resonating gyroscope moves the image
+sinusoidally (so the blur path dwells at its ends), and dropped rows flip the Bayer colour-filter phase.
+
+Everything here is pure torch, differentiable where it makes sense, dtype-agnostic (float32 for the transforms,
+float64 for fitting) and batched: per-sample parameters are tensors with a leading batch dim (or scalars).
+Images are ``(B, 3, H, W)`` in [0, 1].
+"""
+
+from __future__ import annotations
+
+import math
+
+import torch
+
+# ---------------------------------------------------------------------------------------------------------------
+# tone curves
+
+
+def srgb_to_linear(x: torch.Tensor) -> torch.Tensor:
+    """sRGB-encoded values in [0, 1] -> linear light (IEC 61966-2-1)."""
+    x = x.clamp(0.0, 1.0)
+    return torch.where(x <= 0.04045, x / 12.92, ((x + 0.055) / 1.055) ** 2.4)
+
+
+def linear_to_srgb(x: torch.Tensor) -> torch.Tensor:
+    """Linear light in [0, 1] -> sRGB-encoded values (values outside [0, 1] are clipped first)."""
+    x = x.clamp(0.0, 1.0)
+    return torch.where(x <= 0.0031308, 12.92 * x, 1.055 * x.clamp(min=0.0031308) ** (1.0 / 2.4) - 0.055)
+
+
+def decode(x: torch.Tensor, gamma: float | torch.Tensor | None) -> torch.Tensor:
+    """Encoded pixel values -> linear light: sRGB when ``gamma`` is None, else a pure power law ``x ** gamma``."""
+    if gamma is None:
+        return srgb_to_linear(x)
+    return x.clamp(min=0.0) ** _as(gamma, x)
+
+
+def encode(x: torch.Tensor, gamma: float | torch.Tensor | None) -> torch.Tensor:
+    """Inverse of ``decode`` (clips to [0, 1] first: a sensor cannot record more than its full well)."""
+    if gamma is None:
+        return linear_to_srgb(x)
+    return x.clamp(1e-12, 1.0) ** (1.0 / _as(gamma, x))
+
+
+def _as(value: float | torch.Tensor, like: torch.Tensor) -> torch.Tensor:
+    """A scalar or per-sample ``(B,)`` value broadcastable against ``like`` of shape ``(B, ...)``."""
+    t = torch.as_tensor(value, dtype=like.dtype, device=like.device)
+    if t.ndim == 1 and like.ndim > 1:
+        t = t.reshape(-1, *([1] * (like.ndim - 1)))
+    return t
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# light injection (laser blinding, light projection)
+
+
+def inject_linear_light(
+    x: torch.Tensor,
+    light: torch.Tensor,
+    *,
+    auto_exposure: float | torch.Tensor = 0.0,
+    white: float | torch.Tensor = 1.0,
+    gamma: float | torch.Tensor | None = None,
+) -> torch.Tensor:
+    """Add ``light`` (linear irradiance, same shape as ``x`` or broadcastable) to the scene in linear light.
+
+    ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean injected light)``, darkening the whole
+    frame; ``white``: linear level at which the sensor saturates (clipping); ``gamma``: None = sRGB tone curve.
+    """
+    scene = decode(x, gamma)
+    mean_light = light.mean(dim=tuple(range(1, light.ndim)))
+    gain = 1.0 / (1.0 + _as(auto_exposure, mean_light) * mean_light)
+    total = gain.reshape(-1, *([1] * (x.ndim - 1))) * (scene + light)
+    return encode(torch.minimum(total, _as(white, total)) / _as(white, total), gamma)
+
+
+def radial_distance(
+    height: int, width: int, center: torch.Tensor, *, dtype=torch.float32, device=None
+) -> torch.Tensor:
+    """Distance in pixels of every pixel from ``center`` = ``(B, 2)`` (x, y) -> ``(B, 1, H, W)``."""
+    ys = torch.arange(height, dtype=dtype, device=device).reshape(1, 1, height, 1)
+    xs = torch.arange(width, dtype=dtype, device=device).reshape(1, 1, 1, width)
+    center = center.to(dtype).reshape(-1, 2, 1, 1)
+    return torch.sqrt((xs - center[:, 0:1]) ** 2 + (ys - center[:, 1:2]) ** 2)
+
+
+def laser_spot_profile(
+    radius: torch.Tensor,
+    core_sigma: float | torch.Tensor,
+    *,
+    halo_amplitude: float | torch.Tensor = 0.0,
+    halo_exponent: float | torch.Tensor = 2.0,
+    halo_scale: float | torch.Tensor = 1.0,
+) -> torch.Tensor:
+    """Relative irradiance of a laser spot: Gaussian core plus a power-law glare ``h * (1 + r / r0) ** -k``.
+
+    Scattering in the lens and on the sensor spreads a bright source far beyond its geometric image; measured
+    glare falls off as a power of the distance rather than the Gaussian's exponential tail.
+    """
+    sigma = _as(core_sigma, radius)
+    core = torch.exp(-0.5 * (radius / sigma) ** 2)
+    halo = _as(halo_amplitude, radius) * (1.0 + radius / _as(halo_scale, radius)) ** (
+        -_as(halo_exponent, radius)
+    )
+    return core + halo
+
+
+def saturation_radius(
+    peak: float,
+    core_sigma: float,
+    *,
+    halo_amplitude: float = 0.0,
+    halo_exponent: float = 2.0,
+    halo_scale: float = 1.0,
+    white: float = 1.0,
+    max_radius: float = 1e4,
+) -> float:
+    """Radius (pixels) inside which ``peak * laser_spot_profile`` reaches the sensor's ``white`` level (0 if never)."""
+    if peak <= white:
+        return 0.0
+    lo, hi = 0.0, max_radius
+    for _ in range(80):  # bisection: the profile decreases monotonically with r
+        mid = 0.5 * (lo + hi)
+        r = torch.tensor([mid], dtype=torch.float64)
+        value = peak * float(
+            laser_spot_profile(
+                r,
+                core_sigma,
+                halo_amplitude=halo_amplitude,
+                halo_exponent=halo_exponent,
+                halo_scale=halo_scale,
+            )[0]
+        )
+        lo, hi = (mid, hi) if value >= white else (lo, mid)
+    return 0.5 * (lo + hi)
+
+
+def project_light(
+    x: torch.Tensor,
+    pattern: torch.Tensor,
+    strength: float | torch.Tensor,
+    *,
+    albedo: bool = True,
+    ambient: float | torch.Tensor = 1.0,
+    crosstalk: torch.Tensor | None = None,
+    white: float | torch.Tensor = 1.0,
+    gamma: float | torch.Tensor | None = None,
+) -> torch.Tensor:
+    """Projector light on a surface seen by a camera, in linear light.
+
+    The projected colour ``pattern`` (encoded, like an image) reaches the camera as ``crosstalk @ rgb`` (3x3: the
+    projector's primaries seen through the camera's filters), scaled by ``strength`` and, with ``albedo``, by the
+    surface reflectance estimated as scene linear colour / ``ambient`` (light only adds what the surface
+    reflects). The result clips at ``white`` and is re-encoded.
+    """
+    scene = decode(x, gamma)
+    light = decode(pattern, gamma)
+    if crosstalk is not None:
+        light = torch.einsum("ij,bjhw->bihw", crosstalk.to(light.dtype), light)
+    light = _as(strength, light) * light
+    if albedo:
+        light = light * scene / _as(ambient, scene)
+    total = scene + light
+    return encode(torch.minimum(total, _as(white, total)) / _as(white, total), gamma)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# rolling shutter (laser color strip)
+
+
+def cumulative_on_time(t: torch.Tensor, period_s: torch.Tensor, on_s: torch.Tensor) -> torch.Tensor:
+    """Total time a pulse train (on for ``on_s`` at the start of every ``period_s``) has been on in [0, t]."""
+    cycles = torch.floor(t / period_s)
+    return cycles * on_s + torch.minimum(t - cycles * period_s, on_s)
+
+
+def rolling_shutter_row_light(
+    height: int,
+    frequency_hz: float | torch.Tensor,
+    duty: float | torch.Tensor,
+    exposure_s: float | torch.Tensor,
+    row_time_s: float | torch.Tensor,
+    *,
+    integration_offset_s: float | torch.Tensor = 0.0,
+    phase_s: float | torch.Tensor = 0.0,
+    dtype=torch.float32,
+    device=None,
+) -> torch.Tensor:
+    """Per-row fraction of full brightness a pulsed laser leaves in a rolling-shutter frame -> ``(B, H)``.
+
+    Row ``r`` integrates light during ``[r * row_time + phase, ... + exposure + integration_offset]``; the laser is
+    on for ``duty / frequency`` of every period. Rows whose window overlaps a pulse are lit, partially at the
+    edges (a ramp), and several stripes appear when the laser period is shorter than the frame readout.
+    """
+    rows = torch.arange(height, dtype=dtype, device=device).reshape(1, height)
+
+    def col(v):
+        return torch.as_tensor(v, dtype=dtype, device=device).reshape(-1, 1)
+
+    period = 1.0 / col(frequency_hz)
+    on = col(duty).clamp(0.0, 1.0) * period
+    window = (col(exposure_s) + col(integration_offset_s)).clamp(min=1e-9)
+    start = rows * col(row_time_s) + col(phase_s)
+    lit = cumulative_on_time(start + window, period, on) - cumulative_on_time(start, period, on)
+    return (lit / torch.minimum(on, window).clamp(min=1e-12)).clamp(0.0, 1.0)
+
+
+def rolling_shutter_rows_lit(
+    frequency_hz: torch.Tensor,
+    duty: torch.Tensor,
+    exposure_s: torch.Tensor,
+    row_time_s: float | torch.Tensor,
+    *,
+    image_rows: int,
+    integration_offset_s: float | torch.Tensor = 0.0,
+    edge_threshold: float | torch.Tensor = 0.0,
+    periodic: bool = False,
+) -> torch.Tensor:
+    """Expected number of rows a pulsed laser lights (averaged over the pulse phase), vectorised over conditions.
+
+    One stripe spans ``(on_time + exposure + offset) / row_time`` rows (the pulse/exposure overlap), minus the
+    two edge ramps' parts below ``edge_threshold`` (fraction of the peak); with ``periodic`` a stripe repeats
+    every ``1 / (frequency * row_time)`` rows, so the lit fraction of the frame saturates at 1.
+    """
+    on = duty.clamp(0.0, 1.0) / frequency_hz
+    window = (exposure_s + integration_offset_s).clamp(min=0.0)
+    width = (on + window - 2.0 * edge_threshold * torch.minimum(on, window)) / row_time_s
+    width = width.clamp(min=0.0)
+    if periodic:
+        period_rows = 1.0 / (frequency_hz * row_time_s)
+        many = image_rows * torch.clamp(width / period_rows, max=1.0)
+        return torch.where(period_rows < image_rows, many, width.clamp(max=image_rows))
+    return width.clamp(max=image_rows)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# motion blur (ultrasound on the gyroscope)
+
+BLUR_PATHS = ("uniform", "sinusoidal")
+
+
+def blur_path_offsets(path: str, taps: int, *, dtype=torch.float32, device=None) -> torch.Tensor:
+    """Positions in [-1/2, 1/2] along the blur segment, one per tap, each sample equally weighted.
+
+    ``uniform``: constant velocity (the paper's line average). ``sinusoidal``: a resonating gyroscope moves the
+    image as ``sin(w t)``, so equal time steps put more samples near the turning points (arcsine density).
+    """
+    if path not in BLUR_PATHS:
+        raise ValueError(f"unknown blur path {path!r}; valid: {', '.join(BLUR_PATHS)}")
+    if taps < 1:
+        raise ValueError(f"taps must be >= 1, got {taps}")
+    u = (torch.arange(taps, dtype=dtype, device=device) + 0.5) / taps
+    if path == "uniform":
+        return u - 0.5
+    return 0.5 * torch.sin(math.pi * (u - 0.5))
+
+
+def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torch.Tensor) -> torch.Tensor:
+    """Average of ``x`` shifted by ``offsets * (dx, dy)`` pixels (bilinear, border-replicated), per sample."""
+    batch, _, height, width = x.shape
+    dx = torch.as_tensor(dx, dtype=x.dtype, device=x.device).reshape(-1).expand(batch)
+    dy = torch.as_tensor(dy, dtype=x.dtype, device=x.device).reshape(-1).expand(batch)
+    ys = torch.linspace(-1.0, 1.0, height, dtype=x.dtype, device=x.device) if height > 1 else x.new_zeros(1)
+    xs = torch.linspace(-1.0, 1.0, width, dtype=x.dtype, device=x.device) if width > 1 else x.new_zeros(1)
+    grid_y, grid_x = torch.meshgrid(ys, xs, indexing="ij")
+    scale_x = 2.0 / max(width - 1, 1)
+    scale_y = 2.0 / max(height - 1, 1)
+    out = torch.zeros_like(x)
+    for offset in offsets.to(x.dtype):
+        gx = grid_x.unsqueeze(0) + (offset * dx * scale_x).reshape(-1, 1, 1)
+        gy = grid_y.unsqueeze(0) + (offset * dy * scale_y).reshape(-1, 1, 1)
+        grid = torch.stack([gx, gy], dim=-1)
+        out = out + torch.nn.functional.grid_sample(
+            x, grid, mode="bilinear", padding_mode="border", align_corners=True
+        )
+    return out / len(offsets)
+
+
+def blur_taps(dx: float, dy: float) -> int:
+    """Enough taps that neighbouring samples are at most half a pixel apart."""
+    return max(3, int(math.ceil(2.0 * math.hypot(dx, dy))) + 1)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# EM interference on the video link (EM color strip)
+
+
+def em_color_map(
+    x: torch.Tensor, gain: float | torch.Tensor = 2.5, offset: float | torch.Tensor = 50.0 / 255.0
+) -> torch.Tensor:
+    """The colour a mis-decoded row shows: R' = B' = gain * G, G' = (R + B) / 2 - offset (the paper's form).
+
+    It is what demosaicing does when the colour-filter phase is off by one: green samples are read as red/blue
+    and red/blue samples as green.
+    """
+    red, green, blue = x[:, 0:1], x[:, 1:2], x[:, 2:3]
+    swapped = _as(gain, green) * green
+    mixed = 0.5 * (red + blue) - _as(offset, green)
+    return torch.cat([swapped, mixed, swapped], dim=1).clamp(0.0, 1.0)
+
+
+def periodic_band_mask(
+    height: int, period_rows: float | torch.Tensor, phase_rows: float | torch.Tensor = 0.0, *, device=None
+) -> torch.Tensor:
+    """``(B, 1, H, 1)`` mask of the paper's alternating bands: rows in the first half of every period."""
+    rows = torch.arange(height, dtype=torch.float32, device=device).reshape(1, 1, height, 1)
+    period = torch.as_tensor(period_rows, dtype=torch.float32, device=device).reshape(-1, 1, 1, 1)
+    phase = torch.as_tensor(phase_rows, dtype=torch.float32, device=device).reshape(-1, 1, 1, 1)
+    return (torch.remainder(rows - phase, period) < 0.5 * period).to(torch.float32)
+
+
+def bayer_flip_mask(height: int, start_row: torch.Tensor | float, *, device=None) -> torch.Tensor:
+    """``(B, 1, H, 1)`` mask of the rows from ``start_row`` to the frame's end.
+
+    An odd number of dropped rows shifts the colour-filter phase for every later row of the frame, so the wrong
+    colours run to the bottom instead of alternating in bands.
+    """
+    rows = torch.arange(height, dtype=torch.float32, device=device).reshape(1, 1, height, 1)
+    start = torch.as_tensor(start_row, dtype=torch.float32, device=device).reshape(-1, 1, 1, 1)
+    return (rows >= start).to(torch.float32)
