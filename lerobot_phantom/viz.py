@@ -80,7 +80,9 @@ def load_image(path: str | Path) -> torch.Tensor:
     return torch.from_numpy(cv2.cvtColor(bgr, cv2.COLOR_BGR2RGB)).permute(2, 0, 1).contiguous()
 
 
-def load_dataset_frame(repo_id: str, root: str | None, episode: int, frame: int, camera: str | None) -> torch.Tensor:
+def load_dataset_frame(
+    repo_id: str, root: str | None, episode: int, frame: int, camera: str | None
+) -> torch.Tensor:
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     dataset = LeRobotDataset(repo_id, root=root, episodes=[episode])
@@ -97,7 +99,10 @@ def load_dataset_frame(repo_id: str, root: str | None, episode: int, frame: int,
 
 
 def render_gallery(
-    image: torch.Tensor, attacks: tuple[str, ...] = CAMERA_ATTACKS, seed: int = 0, calibration: str | None = None
+    image: torch.Tensor,
+    attacks: tuple[str, ...] = CAMERA_ATTACKS,
+    seed: int = 0,
+    calibration: str | None = None,
 ) -> np.ndarray:
     """Attack ``image`` (uint8 CHW) at every level; returns the grid as HxWx3 uint8 (rows = attacks)."""
     rows = []

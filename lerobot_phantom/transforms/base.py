@@ -43,7 +43,9 @@ def check_image(img: torch.Tensor) -> None:
     if not isinstance(img, torch.Tensor):
         raise TypeError(f"expected a torch.Tensor image, got {type(img).__name__}")
     if img.ndim < 3:
-        raise ValueError(f"expected an image of shape (C, H, W) or (B, C, H, W), got shape {tuple(img.shape)}")
+        raise ValueError(
+            f"expected an image of shape (C, H, W) or (B, C, H, W), got shape {tuple(img.shape)}"
+        )
     if img.shape[-3] not in SUPPORTED_CHANNELS:
         raise ValueError(
             f"expected {SUPPORTED_CHANNELS} channels in dim -3 (CHW layout), got shape {tuple(img.shape)}"
@@ -75,10 +77,7 @@ def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tens
     elif alpha is not None:
         x = torch.cat([x, alpha], dim=1)
     x = x.clamp(0.0, 1.0)
-    if like.dtype == torch.uint8:
-        x = (x * 255.0).round().to(torch.uint8)
-    else:
-        x = x.to(like.dtype)
+    x = (x * 255.0).round().to(torch.uint8) if like.dtype == torch.uint8 else x.to(like.dtype)
     return x.reshape(like.shape)
 
 
@@ -167,8 +166,13 @@ class CameraAttack(v2.Transform):
         try:
             y = self._apply(x, params)
         except Exception as err:  # re-raised with context: which attack, which parameters
-            shown = {k: (v.tolist() if isinstance(v, torch.Tensor) and v.numel() <= 8 else v) for k, v in params.items()}
-            raise RuntimeError(f"{type(self).__name__} failed on image {tuple(img.shape)} with {shown}") from err
+            shown = {
+                k: (v.tolist() if isinstance(v, torch.Tensor) and v.numel() <= 8 else v)
+                for k, v in params.items()
+            }
+            raise RuntimeError(
+                f"{type(self).__name__} failed on image {tuple(img.shape)} with {shown}"
+            ) from err
         return from_float_rgb(y, alpha, img)
 
     # -- subclass hooks -----------------------------------------------------------------------------------

@@ -24,7 +24,9 @@ RANDOM_RANGE: tuple[float, float] = (LEVELS["weak"], LEVELS["strong"])
 
 IntensitySpec = str | float | int | tuple[float, float] | Sequence[float]
 
-_VALID_TEXT = "a level ('weak', 'medium', 'strong'), 'random', a float in [0, 1], or a (low, high) range in [0, 1]"
+_VALID_TEXT = (
+    "a level ('weak', 'medium', 'strong'), 'random', a float in [0, 1], or a (low, high) range in [0, 1]"
+)
 
 
 def _check_unit(value: float, what: str) -> float:
@@ -60,7 +62,9 @@ def parse_intensity(intensity: IntensitySpec) -> tuple[float, float]:
         low = _check_unit(intensity[0], "intensity low")
         high = _check_unit(intensity[1], "intensity high")
         if low > high:
-            raise ValueError(f"intensity range needs low <= high, got ({low}, {high}); intensity is {_VALID_TEXT}")
+            raise ValueError(
+                f"intensity range needs low <= high, got ({low}, {high}); intensity is {_VALID_TEXT}"
+            )
         return low, high
     raise ValueError(f"intensity must be {_VALID_TEXT}, got {intensity!r}")
 

@@ -56,7 +56,9 @@ def is_camera_attack(name: str) -> bool:
     return check_attack_name(name) in CAMERA_ATTACKS
 
 
-def make_attack(name: str, intensity: Any = "medium", *, calibration: str | None = None, **kwargs: Any) -> Any:
+def make_attack(
+    name: str, intensity: Any = "medium", *, calibration: str | None = None, **kwargs: Any
+) -> Any:
     """Build attack ``name`` at ``intensity``; ``calibration`` is a directory holding ``calibrated.json``."""
     cls = get_attack_class(name)
     if calibration is not None:

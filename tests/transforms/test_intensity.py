@@ -28,15 +28,17 @@ def test_parse_intensity_accepts_every_documented_form(spec, expected):
     assert parse_intensity(spec) == pytest.approx(expected)
 
 
-@pytest.mark.parametrize("spec", ["extreme", 1.5, -0.1, float("nan"), (0.8, 0.2), (0.1, 2.0), "0.1:0.2:0.3", True, None])
+@pytest.mark.parametrize(
+    "spec", ["extreme", 1.5, -0.1, float("nan"), (0.8, 0.2), (0.1, 2.0), "0.1:0.2:0.3", True, None]
+)
 def test_parse_intensity_rejects_bad_values_naming_valid_ones(spec):
     with pytest.raises(ValueError, match="weak"):
         parse_intensity(spec)
 
 
 def test_levels_sit_at_thirds():
-    assert LEVELS == pytest.approx({"weak": 1 / 3, "medium": 2 / 3, "strong": 1.0})
-    assert RANDOM_RANGE == (LEVELS["weak"], LEVELS["strong"])
+    assert pytest.approx({"weak": 1 / 3, "medium": 2 / 3, "strong": 1.0}) == LEVELS
+    assert (LEVELS["weak"], LEVELS["strong"]) == RANDOM_RANGE
 
 
 def test_interpolate_levels_hits_the_paper_points_and_is_monotone():
