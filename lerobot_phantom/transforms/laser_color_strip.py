@@ -53,13 +53,14 @@ def strip_profile(height: int, width: int, device: torch.device | str | None = N
     start, end = band_rows(height)
     rho = 0.0
     sigma_p, sigma_q = height / 2.0, width / 4.0
-    p = torch.arange(start, end, dtype=torch.float64, device=device)[:, None]
-    q = torch.arange(width, dtype=torch.float64, device=device)[None, :]
+    # float64 on the CPU (some accelerators lack float64), computed once per size and cached by the attack
+    p = torch.arange(start, end, dtype=torch.float64)[:, None]
+    q = torch.arange(width, dtype=torch.float64)[None, :]
     a = (p - start - sigma_p) ** 2 / sigma_p**2
     b = (q - width / 2.0) ** 2 / sigma_q**2
     norm = 1.0 / (2.0 * math.pi * sigma_p * sigma_q * math.sqrt(1.0 - rho**2))
     profile = norm * torch.exp(-(a + b) / (2.0 * (1.0 - rho**2))) * (height * width)
-    return profile.to(torch.float32)
+    return profile.to(device=device, dtype=torch.float32)
 
 
 def add_strip(
