@@ -264,3 +264,38 @@ def unregister_image_transform_types() -> None:
     """Put LeRobot's original factory back (tests use it to check registration from a clean state)."""
     module = image_transforms_module()
     module.make_transform_from_config = original_make_transform_from_config()
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# datasets (lerobot_phantom.datasets; checked by tests/datasets/test_compat_datasets.py)
+#
+# The mixer relies on LeRobotDataset.__getitem__ applying ``self.image_transforms`` to every ``meta.camera_keys``
+# entry (so it can take them over and run them after the attack). The augment tool writes staged single-episode
+# datasets and merges them with LeRobot's aggregate_datasets, reading episode frame ranges from the v3 episodes
+# table.
+# ---------------------------------------------------------------------------------------------------------------
+def lerobot_home():
+    """``$HF_LEROBOT_HOME``: where LeRobot keeps datasets that are named without a root."""
+    from lerobot.utils.constants import HF_LEROBOT_HOME
+
+    return HF_LEROBOT_HOME
+
+
+def default_feature_keys() -> tuple[str, ...]:
+    """Columns LeRobot adds to every frame itself (``timestamp``, ``frame_index``, ``index``, ...)."""
+    from lerobot.datasets.utils import DEFAULT_FEATURES
+
+    return tuple(DEFAULT_FEATURES)
+
+
+def aggregate_datasets(repo_ids, roots, aggr_repo_id: str, aggr_root) -> None:
+    """Merge datasets in order into one (LeRobot's ``lerobot.datasets.aggregate.aggregate_datasets``)."""
+    from lerobot.datasets.aggregate import aggregate_datasets as aggregate
+
+    aggregate(repo_ids=list(repo_ids), roots=list(roots), aggr_repo_id=aggr_repo_id, aggr_root=aggr_root)
+
+
+def episode_frame_range(meta, position: int) -> tuple[int, int, int]:
+    """``(episode_index, first frame, end frame)`` of the ``position``-th episode of a v3 dataset's metadata."""
+    episode = meta.episodes[position]
+    return int(episode["episode_index"]), int(episode["dataset_from_index"]), int(episode["dataset_to_index"])

@@ -41,6 +41,7 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
+from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.config import PhantomConfig
 from lerobot_phantom.datasets.mixer import PhantomDataset
 from lerobot_phantom.transforms.intensity import LEVELS
@@ -103,14 +104,8 @@ class AugmentResult:
 
 
 # -- paths ---------------------------------------------------------------------------------------------------------
-def lerobot_home() -> Path:
-    from lerobot.utils.constants import HF_LEROBOT_HOME
-
-    return Path(HF_LEROBOT_HOME)
-
-
 def _dataset_root(repo_id: str, root: str | None) -> Path:
-    return (Path(root) if root else lerobot_home() / repo_id).expanduser().resolve()
+    return (Path(root) if root else Path(compat.lerobot_home()) / repo_id).expanduser().resolve()
 
 
 def temporary_dir(output_root: Path) -> Path:
@@ -304,12 +299,11 @@ def format_summary(summary: dict[str, Any]) -> str:
 
 # -- the tool ------------------------------------------------------------------------------------------------------
 def _output_features(source_meta: Any, phantom: PhantomConfig) -> dict:
-    from lerobot.datasets.utils import DEFAULT_FEATURES
-
+    default_keys = compat.default_feature_keys()
     features = {
         key: {k: v for k, v in feature.items() if k != "info"}  # video info is rewritten by the encoder
         for key, feature in source_meta.features.items()
-        if key not in DEFAULT_FEATURES
+        if key not in default_keys
     }
     clash = [key for key in (ATTACK_COLUMN, INTENSITY_COLUMN, INSTRUCTION_COLUMN) if key in features]
     if clash:
@@ -360,7 +354,6 @@ def _prepare_tmp(cfg: AugmentConfig, tmp: Path, record: dict[str, Any]) -> None:
 
 def augment(cfg: AugmentConfig) -> AugmentResult:
     """Write the augmented dataset described by ``cfg``; see the module docstring."""
-    from lerobot.datasets.aggregate import aggregate_datasets
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     cfg.check_required()
@@ -412,14 +405,13 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
     )
     jobs = []
     for position in range(meta.total_episodes):
-        episode = meta.episodes[position]
-        episode_index = int(episode["episode_index"])
+        episode_index, start, stop = compat.episode_frame_range(meta, position)
         jobs.append(
             _EpisodeJob(
                 position=position,
                 episode_index=episode_index,
-                start=int(episode["dataset_from_index"]),
-                stop=int(episode["dataset_to_index"]),
+                start=start,
+                stop=stop,
                 staging_root=str(tmp / "episodes" / f"{episode_index:06d}"),
                 repo_id=f"{cfg.output_repo_id}-episode-{episode_index:06d}",
             )
@@ -449,7 +441,7 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
     aggregate_root = tmp / "aggregate"
     if aggregate_root.exists():
         shutil.rmtree(aggregate_root)
-    aggregate_datasets(
+    compat.aggregate_datasets(
         repo_ids=[job.repo_id for job in jobs],
         roots=[Path(job.staging_root) for job in jobs],
         aggr_repo_id=cfg.output_repo_id,

@@ -6,7 +6,8 @@ import os
 from pathlib import Path
 
 import pytest
-from phantom_dataset_builder import build_dataset
+
+from lerobot_phantom.datasets.synthetic import build_synthetic_dataset
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
@@ -14,7 +15,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 @pytest.fixture(scope="session")
 def image_dataset_root(tmp_path_factory) -> Path:
     root = tmp_path_factory.mktemp("src") / "tiny_images"
-    build_dataset(root)
+    build_synthetic_dataset(root, "phantom/tiny")
     return root
 
 

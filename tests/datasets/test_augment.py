@@ -13,7 +13,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
-from phantom_dataset_builder import CAMERAS, build_dataset
 
 from lerobot_phantom.config import PhantomConfig
 from lerobot_phantom.datasets import PhantomDataset, camera_attack_params
@@ -25,6 +24,7 @@ from lerobot_phantom.datasets.augment import (
     temporary_dir,
 )
 from lerobot_phantom.datasets.schedule import attacked_count, sample_seed
+from lerobot_phantom.datasets.synthetic import CAMERAS, build_synthetic_dataset
 
 FRONT, WRIST = CAMERAS
 # LeRobot stores shape-(1,) features through datasets.Value, which calls float() on a 1-element array.
@@ -263,7 +263,9 @@ def test_kill_9_then_resume_gives_the_uninterrupted_output(augmented, image_data
 @pytest.mark.slow
 def test_video_dataset_is_decoded_attacked_and_reencoded(tmp_path):
     source_root = tmp_path / "videos"
-    build_dataset(source_root, "phantom/tiny_video", episode_lengths=(8, 8), use_videos=True, size=64)
+    build_synthetic_dataset(
+        source_root, "phantom/tiny_video", episode_lengths=(8, 8), use_videos=True, size=64
+    )
     phantom = PhantomConfig(rate=0.5, attacks=["em_truncation"], intensity="strong", seed=6)
     cfg = AugmentConfig(
         repo_id="phantom/tiny_video", root=str(source_root), output_repo_id="phantom/tiny_video_aug",

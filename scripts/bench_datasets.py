@@ -1,0 +1,165 @@
+"""Benchmark the attack mixer and the augment tool against their clean baselines, measured in one run.
+
+* dataloader samples/s through ``PhantomDataset`` at ``--rate`` vs rate 0 (same workers, batch size, dataset);
+  target ratio >= 0.95;
+* ``lerobot-phantom-augment`` wall time at ``--rate`` vs rate 0 (a plain copy through the same pipeline);
+  target ratio <= 1.25.
+
+Runs alternate between the two settings (``--repeats`` times each) and the best time of each is kept, so that load
+from other processes on the machine hits both sides alike. A synthetic image dataset is built unless ``--repo-id``
+and ``--root`` name an existing one. Prints the ratios and writes JSON (``--output``).
+
+    python scripts/bench_datasets.py --episodes 6 --frames 30 --size 96 --num-workers 2 --output bench_datasets.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+import torch
+from torch.utils.data import DataLoader
+
+from lerobot_phantom.config import PhantomConfig
+from lerobot_phantom.datasets import PhantomDataset
+from lerobot_phantom.datasets.augment import AugmentConfig, augment
+from lerobot_phantom.datasets.synthetic import build_synthetic_dataset
+
+
+def loader_rate(dataset, phantom: PhantomConfig, num_workers: int, batch_size: int, epochs: int) -> float:
+    wrapped = PhantomDataset(dataset, phantom)
+    loader = DataLoader(
+        wrapped,
+        batch_size=batch_size,
+        shuffle=False,
+        num_workers=num_workers,
+        persistent_workers=num_workers > 0,
+    )
+    next(iter(loader))  # worker start-up and first-epoch planning are not what is measured
+    start = time.perf_counter()
+    samples = 0
+    for epoch in range(epochs):
+        wrapped.set_epoch(epoch)
+        for batch in loader:
+            samples += int(batch["phantom.attack"].shape[0])
+    return samples / (time.perf_counter() - start)
+
+
+def augment_time(repo_id: str, root: Path, workdir: Path, phantom: PhantomConfig, num_workers: int) -> float:
+    output = workdir / f"out_{phantom.rate}"
+    if output.exists():
+        shutil.rmtree(output)
+    start = time.perf_counter()
+    augment(
+        AugmentConfig(
+            repo_id=repo_id,
+            root=str(root),
+            output_repo_id=f"{repo_id}_bench",
+            output_root=str(output),
+            phantom=phantom,
+            num_workers=num_workers,
+        )
+    )
+    return time.perf_counter() - start
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--repo-id", default=None, help="existing dataset (default: build a synthetic one)")
+    parser.add_argument("--root", default=None)
+    parser.add_argument("--episodes", type=int, default=6)
+    parser.add_argument("--frames", type=int, default=30, help="frames per synthetic episode")
+    parser.add_argument("--size", type=int, default=96, help="synthetic image size")
+    parser.add_argument("--rate", type=float, default=0.3)
+    parser.add_argument("--num-workers", type=int, default=2, help="dataloader workers")
+    parser.add_argument("--augment-workers", type=int, default=0)
+    parser.add_argument("--batch-size", type=int, default=16)
+    parser.add_argument("--epochs", type=int, default=2)
+    parser.add_argument("--repeats", type=int, default=2)
+    parser.add_argument("--skip-augment", action="store_true")
+    parser.add_argument("--output", default="bench_datasets.json")
+    args = parser.parse_args()
+
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    workdir = Path(tempfile.mkdtemp(prefix="bench_datasets_"))
+    try:
+        if args.repo_id:
+            repo_id, root = args.repo_id, Path(args.root) if args.root else None
+        else:
+            repo_id, root = "phantom/bench", workdir / "source"
+            build_synthetic_dataset(
+                root, repo_id, episode_lengths=(args.frames,) * args.episodes, size=args.size
+            )
+        dataset = LeRobotDataset(repo_id, root=root)
+        clean, attacked = PhantomConfig(rate=0.0), PhantomConfig(rate=args.rate)
+
+        rates: dict[str, list[float]] = {"clean": [], "attacked": []}
+        for _ in range(args.repeats):
+            for name, phantom in (("clean", clean), ("attacked", attacked)):
+                rates[name].append(
+                    loader_rate(dataset, phantom, args.num_workers, args.batch_size, args.epochs)
+                )
+        loader = {
+            "samples_per_s_rate0": max(rates["clean"]),
+            f"samples_per_s_rate{args.rate}": max(rates["attacked"]),
+            "ratio": max(rates["attacked"]) / max(rates["clean"]),
+            "target": ">= 0.95",
+            "runs": rates,
+        }
+        print(
+            f"dataloader: {loader['samples_per_s_rate0']:.1f} samples/s clean, "
+            f"{max(rates['attacked']):.1f} at rate {args.rate} -> ratio {loader['ratio']:.3f} (target >= 0.95)"
+        )
+
+        augment_result = None
+        if not args.skip_augment:
+            times: dict[str, list[float]] = {"clean": [], "attacked": []}
+            for _ in range(args.repeats):
+                for name, phantom in (("clean", clean), ("attacked", attacked)):
+                    times[name].append(augment_time(repo_id, root, workdir, phantom, args.augment_workers))
+            augment_result = {
+                "seconds_rate0": min(times["clean"]),
+                f"seconds_rate{args.rate}": min(times["attacked"]),
+                "ratio": min(times["attacked"]) / min(times["clean"]),
+                "target": "<= 1.25",
+                "runs": times,
+            }
+            print(
+                f"augment: {augment_result['seconds_rate0']:.2f} s plain copy (rate 0), "
+                f"{min(times['attacked']):.2f} s at rate {args.rate} -> ratio {augment_result['ratio']:.3f} "
+                "(target <= 1.25)"
+            )
+
+        report = {
+            "dataset": {"repo_id": repo_id, "frames": len(dataset), "episodes": dataset.meta.total_episodes},
+            "image_shape": list(dataset[0][dataset.meta.camera_keys[0]].shape),
+            "attacks": attacked.attacks,
+            "settings": vars(args),
+            "machine": {
+                "cpus": os.cpu_count(),
+                "torch_threads": torch.get_num_threads(),
+                "python": platform.python_version(),
+                "load_average": os.getloadavg(),
+            },
+            "dataloader": loader,
+            "augment": augment_result,
+        }
+        Path(args.output).write_text(json.dumps(report, indent=2))
+        print(f"wrote {args.output}")
+    finally:
+        shutil.rmtree(workdir, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()
