@@ -61,7 +61,8 @@ def check_image(img: torch.Tensor) -> None:
 def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Any supported image -> (float32 (N, 3, H, W) in [0, 1], alpha channel or None)."""
     x = img.reshape(-1, *img.shape[-3:])
-    x = x.to(torch.float32) / 255.0 if x.dtype == torch.uint8 else x.to(torch.float32)
+    # uint8 -> float makes a fresh tensor, so scaling it in place saves one full-size allocation
+    x = x.to(torch.float32).mul_(1.0 / 255.0) if x.dtype == torch.uint8 else x.to(torch.float32)
     alpha = None
     if x.shape[1] == 4:
         x, alpha = x[:, :3], x[:, 3:]
@@ -76,8 +77,10 @@ def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tens
         x = x.mean(dim=1, keepdim=True)
     elif alpha is not None:
         x = torch.cat([x, alpha], dim=1)
+    # clamp allocates the output once; the uint8 path then scales and rounds it in place (the kernel's result
+    # may alias the caller's float input, so it is never modified in place itself)
     x = x.clamp(0.0, 1.0)
-    x = (x * 255.0).round().to(torch.uint8) if like.dtype == torch.uint8 else x.to(like.dtype)
+    x = x.mul_(255.0).round_().to(torch.uint8) if like.dtype == torch.uint8 else x.to(like.dtype)
     return x.reshape(like.shape)
 
 
