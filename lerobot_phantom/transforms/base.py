@@ -62,7 +62,7 @@ def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Any supported image -> (float32 (N, 3, H, W) in [0, 1], alpha channel or None)."""
     x = img.reshape(-1, *img.shape[-3:])
     # uint8 -> float makes a fresh tensor, so scaling it in place saves one full-size allocation
-    x = x.to(torch.float32).mul_(1.0 / 255.0) if x.dtype == torch.uint8 else x.to(torch.float32)
+    x = x.to(torch.float32).div_(255.0) if x.dtype == torch.uint8 else x.to(torch.float32)
     alpha = None
     if x.shape[1] == 4:
         x, alpha = x[:, :3], x[:, 3:]
