@@ -6,7 +6,6 @@ import eval_testkit as kit
 import pytest
 from lerobot.configs.default import DatasetConfig, EvalConfig
 
-from lerobot_phantom.eval import eval as eval_module
 from lerobot_phantom.eval.config import EvalPhantomConfig, PhantomEvalConfig, check_policy_path
 from lerobot_phantom.eval.eval import evaluate
 from lerobot_phantom.eval.offline import frame_indices
@@ -99,18 +98,15 @@ def test_unknown_camera_lists_available(tmp_path):
         evaluate(cfg, policy=kit.make_toy_policy("colour"))
 
 
-@pytest.mark.slow  # draccus builds the help of every LeRobot policy/env choice (~10 s), as lerobot-eval does
-def test_cli_missing_checkpoint_is_a_clear_error(tmp_path, monkeypatch):
-    missing = tmp_path / "no_such_checkpoint"
+def test_missing_checkpoint_is_a_clear_error(tmp_path, monkeypatch):
+    # The config reads --policy.path from the command line, as LeRobot's EvalPipelineConfig does.
     monkeypatch.setattr(
-        sys,
-        "argv",
-        ["lerobot-phantom-eval", f"--policy.path={missing}", "--env.type=pusht", f"--output_dir={tmp_path}"],
+        sys, "argv", ["lerobot-phantom-eval", f"--policy.path={tmp_path / 'no_such_checkpoint'}"]
     )
     with pytest.raises(
         FileNotFoundError, match=r"does not exist locally and the Hugging Face hub is offline"
     ):
-        eval_module.main()
+        PhantomEvalConfig(env=kit.DotReachEnvConfig())
 
 
 def test_directory_without_config_is_not_a_checkpoint(tmp_path):
