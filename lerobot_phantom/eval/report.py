@@ -62,6 +62,10 @@ class EvalRun:
     data: dict[str, Any]
 
     @property
+    def offline(self) -> bool:
+        return self.data["mode"] == "offline"
+
+    @property
     def suites(self) -> list[str]:
         return list(dict.fromkeys(r["suite"] for r in self.data["results"]))
 
@@ -92,8 +96,8 @@ def load_eval(path: str | Path, label: str | None = None) -> EvalRun:
         data = json.load(f)
     if not isinstance(data, dict) or data.get("format") != EVAL_FORMAT:
         raise ValueError(f"{path} is not a lerobot-phantom-eval result (expected format {EVAL_FORMAT!r})")
-    if data.get("mode") != "rollout":
-        raise ValueError(f"{path} holds {data.get('mode')!r} results; the TSR tables need rollout results")
+    if data.get("mode") not in ("rollout", "offline"):
+        raise ValueError(f"{path} has an unknown mode {data.get('mode')!r} (expected 'rollout' or 'offline')")
     if label is None:
         policy_path = data["metadata"].get("policy", {}).get("path")
         label = Path(policy_path).name if policy_path else path.parent.name
@@ -354,7 +358,36 @@ def before_after(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dict
     return Table(groups=groups, columns=columns, rows=rows), records
 
 
-def summary_text(results: list[dict[str, Any]], changes: list[dict[str, Any]], top: int = 3) -> str:
+def offline_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
+    """Offline mode: mean normalised action deviation (RMS z-score of attacked - clean action) per condition."""
+    records = [
+        {
+            "label": run.label,
+            "condition": r["condition"],
+            "frames": r["frames"],
+            "mean_normalized": r["mean_normalized"],
+            "mean_l2": r["mean_l2"],
+            "median_l2": r["median_l2"],
+            "max_l2": r["max_l2"],
+        }
+        for run in runs
+        for r in run.data["results"]
+    ]
+    value = {(r["label"], r["condition"]): r["mean_normalized"] for r in records}
+    conditions = sorted({r["condition"] for r in records}, key=condition_sort_key)
+    rows = [
+        (c, [f"{value[(run.label, c)]:.3f}" if (run.label, c) in value else "-" for run in runs])
+        for c in conditions
+    ]
+    return Table(groups=[("", len(runs))], columns=[run.label for run in runs], rows=rows), records
+
+
+def summary_text(
+    results: list[dict[str, Any]],
+    changes: list[dict[str, Any]],
+    deviations: list[dict[str, Any]] = (),
+    top: int = 3,
+) -> str:
     lines = ["# Summary", ""]
     drops = [r for r in results if r["delta_vs_clean"] is not None]
     if drops:
@@ -383,6 +416,15 @@ def summary_text(results: list[dict[str, Any]], changes: list[dict[str, Any]], t
                     f"({100 * r['delta']:+.1f} pp, p = {r['p_value']:.3g})"
                 )
             lines.append("")
+    if deviations:
+        lines.append("Largest action deviations on recorded frames (offline, std-normalised):")
+        lines.append("")
+        for r in sorted(deviations, key=lambda r: -r["mean_normalized"])[:top]:
+            lines.append(
+                f"- {r['label']}: {condition_label(r['condition'])} {r['mean_normalized']:.3f} "
+                f"(mean L2 {r['mean_l2']:.3g} over {r['frames']} frames)"
+            )
+        lines.append("")
     if len(lines) == 2:
         lines.append("No attacked conditions to summarise.")
     return "\n".join(lines).rstrip() + "\n"
@@ -462,7 +504,8 @@ def plot_before_after(records: list[dict[str, Any]], path: Path) -> None:
     image = ax.imshow(grid, cmap="RdBu", vmin=-limit, vmax=limit, aspect="auto")
     for (i, j), value in np.ndenumerate(grid):
         if not np.isnan(value):
-            ax.text(j, i, f"{value:+.0f}", ha="center", va="center", fontsize=7)
+            colour = "white" if abs(value) > 0.6 * limit else "black"  # readable on the saturated ends
+            ax.text(j, i, f"{value:+.0f}", ha="center", va="center", fontsize=7, color=colour)
     ax.set_yticks(range(len(conditions)), [condition_label(c) for c in conditions])
     ax.set_xticks(range(len(columns)), [f"{a}\n{s}" for a, s in columns], fontsize=8)
     fig.colorbar(image, ax=ax, label="TSR change after - before (pp)")
@@ -493,10 +536,17 @@ def make_report(
         raise ValueError(f"--before and --after pair up one to one, got {len(before)} and {len(after)} files")
     loaded = [load_eval(p, None if labels is None else labels[i]) for i, p in enumerate(paths)]
     label_of = {r.path.resolve(): r.label for r in loaded}
-    runs = merge_by_label(loaded)
+    offline = [r for r in loaded if r.offline]
+    if len({r.label for r in offline}) != len(offline):
+        raise ValueError(
+            f"offline inputs need distinct labels, got {[r.label for r in offline]}; pass --labels"
+        )
+    runs = merge_by_label([r for r in loaded if not r.offline])
     pairs = []
     for b, a in zip(before, after, strict=True):
         run_b, run_a = load_eval(b), load_eval(a)
+        if run_b.offline or run_a.offline:
+            raise ValueError("--before/--after compare task success; offline (--dataset) results have none")
         run_b.label = label_of.get(run_b.path.resolve(), run_b.label)
         run_a.label = label_of.get(run_a.path.resolve(), run_a.label)
         pairs.append((run_b, run_a))
@@ -532,7 +582,15 @@ def make_report(
         if figures:
             plot_before_after(changes, out / "before_after_heatmap.png")
             written["before_after_heatmap.png"] = out / "before_after_heatmap.png"
-    write("summary.md", summary_text(results, changes))
+    deviations: list[dict[str, Any]] = []
+    if offline:
+        table, deviations = offline_table(offline)
+        write("offline.md", table.markdown())
+        write("offline.csv", table.csv())
+        write("offline.tex", table.latex())
+        write_records(out / "offline_results.csv", deviations)
+        written["offline_results.csv"] = out / "offline_results.csv"
+    write("summary.md", summary_text(results, changes, deviations))
     return written
 
 

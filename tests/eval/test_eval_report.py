@@ -186,3 +186,31 @@ def test_bad_inputs_give_clear_errors(evals, tmp_path):
         make_report([base, base], tmp_path / "r")
     with pytest.raises(ValueError, match="one label per input"):
         make_report([base], tmp_path / "r", labels=["a", "b"])
+
+
+def write_offline(path, deviations):
+    results = [
+        {"condition": c, "frames": 4, "mean_normalized": v, "mean_l2": 2 * v, "median_l2": v, "max_l2": 3 * v}
+        for c, v in deviations.items()
+    ]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(
+        json.dumps({"format": EVAL_FORMAT, "mode": "offline", "metadata": {}, "results": results})
+    )
+    return path
+
+
+def test_offline_results_get_their_own_table(evals, tmp_path):
+    base, _ = evals
+    real_a = write_offline(tmp_path / "a" / "eval.json", {"voice_dos": 0.0, "laser_blinding@strong": 1.25})
+    real_b = write_offline(tmp_path / "b" / "eval.json", {"laser_blinding@strong": 0.5})
+    make_report([base, real_a, real_b], tmp_path / "r", labels=["sim", "real", "real AT"], figures=False)
+    assert (tmp_path / "r" / "offline.md").read_text() == (
+        "| Attack | real | real AT |\n|---|---:|---:|\n| LB strong | 1.250 | 0.500 |\n| VD | 0.000 | - |\n"
+    )
+    assert (tmp_path / "r" / "robustness.md").read_text().startswith("| Attack | spatial | goal |\n")
+    assert (
+        "- real: LB strong 1.250 (mean L2 2.5 over 4 frames)" in (tmp_path / "r" / "summary.md").read_text()
+    )
+    with pytest.raises(ValueError, match="offline"):
+        make_report([], tmp_path / "r2", before=[real_a], after=[real_b])
