@@ -228,9 +228,20 @@ def _write_episode(plan: _Plan, job: _EpisodeJob) -> int:
     return job.stop - job.start
 
 
+def _write_episode_with_context(plan: _Plan, job: _EpisodeJob) -> int:
+    try:
+        return _write_episode(plan, job)
+    except Exception as err:
+        err.add_note(
+            f"lerobot-phantom-augment: while writing source episode {job.episode_index} "
+            f"(frames {job.start}..{job.stop - 1}) of {plan.source_repo_id} to {job.staging_root}.partial"
+        )
+        raise
+
+
 def _write_episode_in_worker(plan: _Plan, job: _EpisodeJob) -> int:
     logging.getLogger().setLevel(logging.WARNING)
-    return _write_episode(plan, job)
+    return _write_episode_with_context(plan, job)
 
 
 # -- summary -------------------------------------------------------------------------------------------------------
@@ -431,7 +442,7 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
     ) as bar:
         if cfg.num_workers == 0:
             for job in todo:
-                bar.update(_write_episode(plan, job))
+                bar.update(_write_episode_with_context(plan, job))
         else:
             with ProcessPoolExecutor(max_workers=cfg.num_workers, mp_context=get_context("spawn")) as pool:
                 futures = [pool.submit(_write_episode_in_worker, plan, job) for job in todo]

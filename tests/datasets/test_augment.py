@@ -289,3 +289,19 @@ def test_video_dataset_is_decoded_attacked_and_reencoded(tmp_path):
     assert attacked == 8
     # Re-encoding is lossy, so clean frames only stay close; attacked frames move far more.
     assert max(clean_error) < 0.05 < min(attacked_error)
+
+
+def test_an_attack_error_stops_the_run_with_its_context(image_dataset_root, tmp_path, monkeypatch):
+    from lerobot_phantom.transforms.registry import get_attack_class
+
+    def broken(self, image, params):
+        raise ValueError("kernel exploded")
+
+    monkeypatch.setattr(get_attack_class("em_truncation"), "apply_params", broken)
+    output = tmp_path / "out"
+    phantom = PhantomConfig(rate=1.0, attacks=["em_truncation"])
+    with pytest.raises(ValueError, match="kernel exploded") as info:
+        augment(config(image_dataset_root, output, phantom=phantom))
+    notes = "\n".join(info.value.__notes__)
+    assert "sample index 0" in notes and "source episode 0" in notes and "em_truncation" in notes
+    assert not output.exists() and temporary_dir(output).exists()  # nothing half-written in place; resumable
