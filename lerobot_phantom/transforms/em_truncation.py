@@ -16,8 +16,8 @@ Deviations from the paper's code (and why):
   0.1/0.2/0.3), and for ``1/3 < r <= 0.5`` the band slides up so that it never overlaps the appended tail. The
   output always has height ``h``. Ratios above 0.5 are rejected: with at most ``h`` rows there is no way to lose
   more than half of them and still append as many.
-* **Vectorised per sample.** The whole operation is one row-index gather, so a batch whose samples have
-  different ratios is a single op, exact for any dtype (no float round trip).
+* **Vectorised per sample.** The operation is a row-index gather (one row copy per distinct ratio in the batch),
+  exact for any dtype (no float round trip).
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
@@ -67,13 +67,19 @@ def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Ten
     """
     check_image(image)
     flat = image.reshape(-1, *image.shape[-3:])
-    batch, channels, height, width = flat.shape
+    batch, _, height, _ = flat.shape
     r = _per_sample(ratio, batch, flat.device, "ratio")
     if not torch.isfinite(r).all() or (r < 0).any() or (r > MAX_RATIO).any():
         raise ValueError(f"EM truncation ratio must lie in [0, {MAX_RATIO}], got {r.tolist()}")
     index = truncation_row_index(height, r)  # (B, H)
-    gathered = flat.gather(2, index[:, None, :, None].expand(batch, channels, height, width))
-    return gathered.reshape(image.shape)
+    patterns, group = torch.unique(index, dim=0, return_inverse=True)
+    if patterns.shape[0] == 1:  # one ratio for the whole batch: a plain row copy
+        return flat.index_select(2, patterns[0]).reshape(image.shape)
+    out = torch.empty_like(flat)
+    for g in range(patterns.shape[0]):
+        members = (group == g).nonzero().squeeze(1)
+        out[members] = flat[members].index_select(2, patterns[g])
+    return out.reshape(image.shape)
 
 
 class EMTruncation(CameraAttack):

@@ -55,6 +55,7 @@ from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_leve
 
 MAX_SAMPLES = 100
 SNAP = 1e-6
+_CHUNK_ELEMENTS = 1 << 20
 LEVEL_DISPLACEMENT_PX: tuple[float, float, float, float] = (0.0, 5.0, 10.0, 20.0)
 
 
@@ -86,31 +87,46 @@ def _axis_spans(size: int, offset: float) -> list[tuple[int, int, int]]:
     return spans
 
 
-def _axis_valid(size: int, spans: list[tuple[int, int, int]], device: torch.device) -> torch.Tensor:
-    valid = torch.zeros(size, device=device)
-    for start, stop, _ in spans:
-        valid[start:stop] = 1.0
-    return valid
+def _axis_valid(
+    size: int, spans_per_sample: list[list[tuple[int, int, int]]], device: torch.device
+) -> torch.Tensor:
+    """``(samples, size)`` 0/1: which destinations each sample's spans cover (built in one go, not per span)."""
+    starts, stops = [], []
+    for spans in spans_per_sample:
+        # at most a main run and the single truncated-to-zero position: pad to two runs per sample
+        runs = [*spans, (0, 0, 0), (0, 0, 0)][:2]
+        starts.append([r[0] for r in runs])
+        stops.append([r[1] for r in runs])
+    positions = torch.arange(size, device=device)
+    lo = torch.tensor(starts, device=device)[:, :, None]
+    hi = torch.tensor(stops, device=device)[:, :, None]
+    return ((positions >= lo) & (positions < hi)).any(dim=1).to(torch.float32)
 
 
 def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
     """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views."""
-    _, _, height, width = x.shape
+    batch, _, height, width = x.shape
     num = min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES)
     if num <= 0:
         return x
-    total = torch.zeros_like(x)
-    row_valid, col_valid = [], []
-    for i in range(num + 1):
-        n = i / num
-        row_spans, col_spans = _axis_spans(height, n * d_row), _axis_spans(width, n * d_col)
-        for r0, r1, rs in row_spans:
-            for c0, c1, cs in col_spans:
-                total[..., r0:r1, c0:c1] += x[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
-        row_valid.append(_axis_valid(height, row_spans, x.device))
-        col_valid.append(_axis_valid(width, col_spans, x.device))
-    count = torch.stack(row_valid).T @ torch.stack(col_valid)  # (H, W): in-bounds samples per pixel
-    return total / count  # sample i = 0 is the pixel itself, so count >= 1
+    spans = [
+        (_axis_spans(height, i / num * d_row), _axis_spans(width, i / num * d_col)) for i in range(num + 1)
+    ]
+    row_valid = _axis_valid(height, [rows for rows, _ in spans], x.device)
+    col_valid = _axis_valid(width, [cols for _, cols in spans], x.device)
+    count = (row_valid.T @ col_valid).to(x.dtype)  # (H, W) in-bounds samples; sample 0 is the pixel itself
+    out = torch.empty_like(x)
+    # a few images at a time keep the ~N read-modify-write passes in cache
+    per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())
+    for first in range(0, batch, per_chunk):
+        part = x[first : first + per_chunk]
+        total = part.clone()  # sample i = 0: offset (0, 0)
+        for row_spans, col_spans in spans[1:]:
+            for r0, r1, rs in row_spans:
+                for c0, c1, cs in col_spans:
+                    total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
+        torch.div(total, count, out=out[first : first + per_chunk])
+    return out
 
 
 def _general_blur(
