@@ -37,7 +37,7 @@ from lerobot_phantom.envs import scripted_expert
 from lerobot_phantom.envs.lerobot_config import PhantomTableEnvConfig
 from lerobot_phantom.eval.config import EvalPhantomConfig, PhantomEvalConfig
 from lerobot_phantom.eval.eval import identity_processors, run_condition
-from lerobot_phantom.eval.rollout import build_conditions
+from lerobot_phantom.eval.rollout import AttackStep, build_conditions
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
 
@@ -119,16 +119,19 @@ def main() -> None:
     env_pre, env_post = compat.eval_env_processors(env_cfg, policy.config)
     processors = (env_pre, env_post, *identity_processors())
     conditions = build_conditions(cfg.phantom)
+    steps = {c.key: AttackStep(c, cfg.phantom) for c in conditions}
     best = {c.key: float("inf") for c in conditions}
     steps = {}
     progress = tqdm(disable=True)
     try:
         with torch.no_grad():
-            run_condition(vector_env, conditions[0], cfg, policy, processors, None, progress)  # warm-up
+            run_condition(vector_env, steps["clean"], cfg, policy, processors, None, progress)  # warm-up
             for _ in range(args.repeats):
                 for condition in conditions:
                     start = time.perf_counter()
-                    records = run_condition(vector_env, condition, cfg, policy, processors, None, progress)
+                    records = run_condition(
+                        vector_env, steps[condition.key], cfg, policy, processors, None, progress
+                    )
                     best[condition.key] = min(best[condition.key], time.perf_counter() - start)
                     steps[condition.key] = [r["steps"] for r in records]
     finally:

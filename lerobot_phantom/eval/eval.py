@@ -31,7 +31,7 @@ import lerobot_phantom
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
 from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT, pooled_summary, summarize
-from lerobot_phantom.eval.rollout import AttackStep, Condition, build_conditions, episode_outcomes
+from lerobot_phantom.eval.rollout import AttackStep, build_conditions, episode_outcomes
 from lerobot_phantom.transforms.base import derive_seed
 
 logger = logging.getLogger(__name__)
@@ -99,7 +99,7 @@ def policy_metadata(cfg: PhantomEvalConfig, policy) -> dict[str, Any]:
 
 def run_condition(
     env,
-    condition: Condition,
+    step: AttackStep,
     cfg: PhantomEvalConfig,
     policy,
     processors: tuple,
@@ -108,7 +108,6 @@ def run_condition(
 ) -> list[dict[str, Any]]:
     """All episodes of one condition on one vectorised task env; one record per episode (seed, success, ...)."""
     env_preprocessor, env_postprocessor, preprocessor, postprocessor = processors
-    step = AttackStep(condition, cfg.phantom)
     attacked_env_preprocessor = with_step(env_preprocessor, step)
     rollout = compat.eval_rollout()
     n_episodes, num_envs = cfg.eval.n_episodes, env.num_envs
@@ -173,9 +172,8 @@ def evaluate(
 
     started = time.time()
     conditions = build_conditions(cfg.phantom)
-    # Build every attack once up front so that a bad name or calibration fails before any rollout.
-    for condition in conditions:
-        AttackStep(condition, cfg.phantom)
+    # Every attack is built up front, so that a bad name or calibration fails before any rollout.
+    steps = [AttackStep(condition, cfg.phantom) for condition in conditions]
     if policy is None:
         policy, preprocessor, postprocessor = load_policy(cfg)
     elif preprocessor is None or postprocessor is None:
@@ -206,14 +204,14 @@ def evaluate(
     try:
         with torch.no_grad(), torch.autocast(device_type=device.type) if use_amp else nullcontext():
             for suite, task_id, env in tasks:
-                for condition in conditions:
+                for condition, step in zip(conditions, steps, strict=True):
                     progress.set_postfix_str(f"{suite}/{task_id} {condition.key}")
                     videos_dir = None
                     if cfg.phantom.videos > 0:
                         videos_dir = (
                             output_dir / "videos" / condition.key.replace("@", "_") / f"{suite}_{task_id}"
                         )
-                    records = run_condition(env, condition, cfg, policy, processors, videos_dir, progress)
+                    records = run_condition(env, step, cfg, policy, processors, videos_dir, progress)
                     results.append(
                         {
                             "condition": condition.key,
@@ -245,6 +243,7 @@ def evaluate(
             "seed": cfg.seed,
             "episode_seeds": [cfg.seed + i for i in range(cfg.eval.n_episodes)],
             "conditions": [c.key for c in conditions],
+            "attacks": {step.condition.key: repr(step.attack) for step in steps if step.attack is not None},
             "phantom": asdict(cfg.phantom),
             "versions": versions(),
         },

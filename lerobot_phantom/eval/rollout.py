@@ -197,6 +197,10 @@ class AttackStep(ProcessorStep):
         else:
             self.camera_masks = {k: torch.ones(batch, dtype=torch.bool) for k in chosen}
         for key in self.camera_masks:
+            if observation[key].shape[0] != batch:
+                raise RuntimeError(
+                    f"armed with {batch} episode seeds but {key} holds {observation[key].shape[0]} images"
+                )
             height, width = observation[key].shape[-2:]
             self.params[key] = concat_params(
                 [
@@ -226,8 +230,6 @@ class AttackStep(ProcessorStep):
             raise RuntimeError("AttackStep.arm(seeds) must be called before a rollout")
         observation = dict(transition[TransitionKey.OBSERVATION])
         transition = dict(transition)
-        if len(self.seeds) != next(iter(observation.values())).shape[0]:
-            raise RuntimeError(f"armed with {len(self.seeds)} seeds but the batch has another size")
         if self.attack is not None and self.phantom.is_active(self.step):
             if self.condition.is_camera:
                 if not self.params:
