@@ -173,3 +173,9 @@ def test_bad_parameters_raise_clear_errors(kwargs, match):
         em_color_strip(_random_uint8((2, 3, 10, 10), 0), **kwargs)
     with pytest.raises(ValueError, match="num_stripes"):
         EMColorStrip(num_stripes=0)
+
+
+def test_full_hd_frame_keeps_shape_and_dtype():
+    frame = _random_uint8((3, 1080, 1920), seed=12)
+    out = EMColorStrip("strong")(frame)
+    assert out.shape == frame.shape and out.dtype == frame.dtype and not torch.equal(out, frame)

@@ -155,3 +155,9 @@ def test_bad_images_raise():
         em_truncation(torch.zeros(5, 10, 10), 0.1)
     with pytest.raises(ValueError, match="NaN"):
         em_truncation(torch.full((3, 4, 4), float("nan")), 0.1)
+
+
+def test_full_hd_frame_keeps_shape_and_dtype():
+    frame = _random_uint8((3, 1080, 1920), seed=12)
+    out = EMTruncation("strong")(frame)
+    assert out.shape == frame.shape and out.dtype == frame.dtype and not torch.equal(out, frame)

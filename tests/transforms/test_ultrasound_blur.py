@@ -53,6 +53,7 @@ def test_paper_levels_match_reference_within_one_grey_level(displacement, shape)
         (3.0, -4.0, 0.0, 0.1),
         (0.0, 0.0, 15.0, 0.05),
         (-2.5, -9.0, -8.0, 0.0),
+        (150.0, 150.0, 0.0, 0.0),  # beyond the 100-sample cap of the paper's code
     ],
 )
 def test_general_settings_match_reference_within_one_grey_level(dx, dy, theta_deg, scale):
@@ -218,3 +219,17 @@ def test_bad_parameters_raise(kwargs, match):
         ultrasound_blur(_random_uint8((2, 3, 8, 8), 0), **kwargs)
     with pytest.raises(ValueError, match="radial_scale"):
         UltrasoundBlur(radial_scale=2.0)
+
+
+def test_full_hd_frame_keeps_shape_and_caps_the_path_at_100_samples():
+    frame = _random_uint8((3, 1080, 1920), seed=11)
+    attack = UltrasoundBlur("strong")
+    params = attack.sample_params(1, 1080, 1920)
+    assert params["dx"].item() == pytest.approx(150.0) and params["dy"].item() == pytest.approx(84.375)
+    out = attack.apply_params(frame, params)
+    assert out.shape == frame.shape and out.dtype == frame.dtype
+    # with 101 samples the top-left pixel averages the in-bounds part of its path: rows/cols i * (84.375, 150) / 100
+    samples = [
+        frame[:, int(i * 0.84375 + SNAP), int(i * 1.5 + SNAP)].double() for i in range(101) if i * 1.5 < 1920
+    ]
+    torch.testing.assert_close(out[:, 0, 0].double(), torch.stack(samples).mean(0).round(), atol=1, rtol=0)
