@@ -58,18 +58,19 @@ def test_clean_run_saves_phantom_config_and_reloads_offline(clean_smolvla_run, t
 @pytest.mark.slow
 def test_attacked_fraction_seen_by_the_loop_matches_rate(tmp_path, tiny_dataset_root, tiny_vlm):
     out = tmp_path / "rate"
-    # batch 4 x 6 steps = one pass over the 24 frames; 12 steps = two epochs (two different attack plans).
-    main(smolvla_args(tiny_dataset_root, tiny_vlm, out, "--steps=12", "--log_freq=1", "--phantom.rate=0.3"))
+    # batch 4 x 6 steps = exactly one pass over the 24 frames.
+    main(smolvla_args(tiny_dataset_root, tiny_vlm, out, "--steps=6", "--log_freq=3", "--phantom.rate=0.3"))
     by_step = {r["step"]: r for r in loss_log(out)}
-    expected_per_epoch = round(0.3 * FRAMES)
-    assert by_step[6]["seen"] == {**by_step[6]["seen"], "total": FRAMES, "attacked": expected_per_epoch}
-    assert by_step[12]["seen"]["total"] == 2 * FRAMES
-    assert by_step[12]["seen"]["attacked"] == 2 * expected_per_epoch
+    assert sorted(by_step) == [3, 6]
+    assert by_step[6]["seen"]["total"] == FRAMES
+    assert by_step[6]["seen"]["attacked"] == round(0.3 * FRAMES)
+    assert sum(by_step[6]["seen"]["groups"].values()) == FRAMES  # camera attacks only: one group per sample
     # Per-attack loss: the training forward's own per-sample losses, grouped by the mixer's labels.
     camera_attacks = set(train_config(out)["phantom"]["attacks"])
     groups = set().union(*(r["loss"] for r in by_step.values()))
     assert CLEAN in groups and groups & camera_attacks and groups <= camera_attacks | {CLEAN}
     assert all(math.isfinite(v) for r in by_step.values() for v in r["loss"].values())
+    assert sum(sum(r["loss_samples"].values()) for r in by_step.values()) == FRAMES
     assert {r["mode"] for r in by_step.values()} == {"per_sample"}
 
 
@@ -87,7 +88,7 @@ def test_device_mode_run_keeps_attack_step_out_of_checkpoint(
             "--log_freq=1",
             "--phantom.where=device",
             "--phantom.rate=0.5",
-            "--phantom.attacks=[laser_blinding,em_truncation,voice_dos]",
+            '--phantom.attacks=["laser_blinding","em_truncation","voice_dos"]',  # JSON lists with --config_path
         )
     )
     assert train_config(out)["phantom"]["where"] == "device"
