@@ -89,9 +89,10 @@ def test_processor_seams():
     assert transition_to_batch(transition)["phantom.attack"] == 2
     pipeline = compat.policy_processor_pipeline_class()(steps=[])
     assert callable(pipeline.to_transition) and callable(pipeline.to_output)
-    assert issubclass(
-        compat.processor_step_registry().get("phantom_attack_processor"), compat.processor_step_base()
-    )
+    from lerobot_phantom.train.device_step import ATTACK_STEP_NAME, PhantomAttackProcessorStep
+
+    assert registry.get(ATTACK_STEP_NAME) is PhantomAttackProcessorStep
+    assert issubclass(PhantomAttackProcessorStep, compat.processor_step_base())
 
 
 def test_checkpoint_step_and_process_state(tmp_path):
