@@ -153,14 +153,21 @@ def _general_blur(
     flat = x.reshape(batch, channels, height * width)
     total = torch.zeros_like(flat)
     count = torch.zeros(height * width, device=device, dtype=x.dtype)
+    # without rotation the circular term is the same for every sample: compute it once
+    still_row, still_col = radius * torch.cos(alpha) + c0 + SNAP, radius * torch.sin(alpha) + c1 + SNAP
     for i in range(int(num.max().item()) + 1):
         n = i / safe_num
-        row_t = torch.trunc(radius * torch.cos(alpha + n * theta) + n * x_cos + c0 + SNAP)
-        col_t = torch.trunc(radius * torch.sin(alpha + n * theta) + n * y_sin + c1 + SNAP)
+        if theta == 0.0:
+            row_t = torch.trunc(still_row + n * x_cos)
+            col_t = torch.trunc(still_col + n * y_sin)
+        else:
+            row_t = torch.trunc(radius * torch.cos(alpha + n * theta) + n * x_cos + c0 + SNAP)
+            col_t = torch.trunc(radius * torch.sin(alpha + n * theta) + n * y_sin + c1 + SNAP)
         valid = blurred & (i <= num) & (row_t >= 0) & (row_t < height) & (col_t >= 0) & (col_t < width)
-        index = torch.where(valid, row_t * width + col_t, torch.zeros_like(row_t)).long().reshape(-1)
+        index = torch.where(valid, row_t * width + col_t, torch.zeros_like(row_t)).long().reshape(1, 1, -1)
         weight = valid.reshape(-1).to(x.dtype)
-        total += flat.index_select(2, index) * weight
+        # gather, not index_select: index_select along the last dim is ~50x slower on CPU
+        total += flat.gather(2, index.expand(batch, channels, -1)) * weight
         count += weight
     keep = count == 0
     out = torch.where(keep, flat, total / torch.where(keep, torch.ones_like(count), count))
