@@ -146,10 +146,11 @@ def frames_to_video_frames(observation: dict[str, Any], keys: Sequence[str], cou
 class AttackStep(ProcessorStep):
     """The attacker, as the last step of the env preprocessor. ``arm()`` before each batch of episodes."""
 
-    def __init__(self, condition: Condition, phantom: EvalPhantomConfig, attack: Any = None) -> None:
+    def __init__(self, condition: Condition, phantom: EvalPhantomConfig) -> None:
         self.condition = condition
         self.phantom = phantom
-        if attack is None and condition.attack != CLEAN:
+        attack = None
+        if condition.attack != CLEAN:
             extra = {} if condition.is_camera else {"mode": phantom.instruction_mode}
             attack = make_attack(
                 condition.attack,

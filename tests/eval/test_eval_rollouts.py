@@ -140,3 +140,27 @@ def test_condition_keys():
     assert Condition("laser_blinding", "weak").key == "laser_blinding@weak"
     assert Condition("voice_dos").key == "voice_dos"
     assert Condition("laser_blinding", "0.5").intensity_value == 0.5
+
+
+def attacked_cameras(report, condition):
+    (row,) = [r for r in report["results"] if r["condition"] == condition]
+    return [sorted(e["attack_params"]) for e in row["per_episode"]]
+
+
+def test_camera_selection(tmp_path):
+    def run(cameras, name):
+        cfg = make_cfg(tmp_path / name, attacks=["laser_blinding"], intensities=["strong"], cameras=cameras)
+        return evaluate(cfg, policy=kit.make_toy_policy("colour"))
+
+    wrist = run(["wrist"], "wrist")
+    assert attacked_cameras(wrist, "laser_blinding@strong") == [["wrist"]] * 8
+    assert tsr(wrist, "laser_blinding@strong") == 1.0  # the colour policy only looks at the front camera
+    every = run(["all"], "all")
+    assert attacked_cameras(every, "laser_blinding@strong") == [["front", "wrist"]] * 8
+    assert tsr(every, "laser_blinding@strong") == 0.0
+    one = run(["random"], "random")
+    picks = attacked_cameras(one, "laser_blinding@strong")
+    assert all(len(p) == 1 for p in picks) and {p[0] for p in picks} == {"front", "wrist"}
+    # Exactly the episodes whose front camera was picked are lost.
+    (row,) = [r for r in one["results"] if r["condition"] == "laser_blinding@strong"]
+    assert [not e["success"] for e in row["per_episode"]] == [p == ["front"] for p in picks]
