@@ -392,6 +392,8 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
 
     source = LeRobotDataset(cfg.repo_id, root=source_root)
     meta = source.meta
+    if meta.total_episodes == 0:
+        raise ValueError(f"{cfg.repo_id} ({source_root}) has no episodes to augment")
     if not meta.camera_keys and cfg.phantom.camera_attacks and cfg.phantom.rate > 0:
         raise ValueError(f"{cfg.repo_id} has no camera keys to attack with {cfg.phantom.camera_attacks}")
     if meta.camera_keys:

@@ -99,6 +99,10 @@ class _Schedule:
         self._epoch: int | None = None
         self._plans: dict[str, ChannelPlan] = {}
 
+    def __getstate__(self) -> dict[str, Any]:
+        # Plans are cheap to recompute and O(N): dataloader workers rebuild them instead of receiving copies.
+        return {**self.__dict__, "_epoch": None, "_plans": {}}
+
     def plans(self, epoch: int) -> dict[str, ChannelPlan]:
         if epoch != self._epoch:
             config = self.config

@@ -59,9 +59,9 @@ def sample_seed(seed: int, epoch: int, index: int) -> int:
 class ChannelPlan:
     """One epoch of one channel: per item, the attack slot (-1 = clean), intensity and camera slot."""
 
-    choice: torch.Tensor  # int64 (N,): index into the channel's attack list, -1 for clean items
+    choice: torch.Tensor  # int16 (N,): index into the channel's attack list, -1 for clean items
     intensity: torch.Tensor  # float32 (N,): 0 for clean items
-    camera_slot: torch.Tensor  # int64 (N,): index into the attackable cameras (used by cameras=[random])
+    camera_slot: torch.Tensor  # int16 (N,): index into the attackable cameras (used by cameras=[random])
 
     @property
     def num_items(self) -> int:
@@ -85,9 +85,9 @@ def plan_channel(
     if num_camera_slots < 1:
         raise ValueError(f"num_camera_slots must be >= 1, got {num_camera_slots}")
     generator = torch.Generator().manual_seed(derive_seed("phantom-plan", int(seed), int(epoch), channel))
-    choice = torch.full((num_items,), -1, dtype=torch.int64)
+    choice = torch.full((num_items,), -1, dtype=torch.int16)
     intensity = torch.zeros(num_items, dtype=torch.float32)
-    camera_slot = torch.zeros(num_items, dtype=torch.int64)
+    camera_slot = torch.zeros(num_items, dtype=torch.int16)
     attacked = attacked_count(rate, num_items)
     if attacked == 0:
         return ChannelPlan(choice, intensity, camera_slot)
@@ -104,5 +104,5 @@ def plan_channel(
         strata = torch.randperm(count, generator=generator).to(torch.float64)
         jitter = torch.rand(count, generator=generator, dtype=torch.float64)
         intensity[members] = (low + (high - low) * (strata + jitter) / count).to(torch.float32)
-    camera_slot[order] = torch.randperm(attacked, generator=generator) % num_camera_slots
+    camera_slot[order] = (torch.randperm(attacked, generator=generator) % num_camera_slots).to(torch.int16)
     return ChannelPlan(choice, intensity, camera_slot)

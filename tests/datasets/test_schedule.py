@@ -72,7 +72,7 @@ def test_fixed_intensity_is_used_as_is():
 def test_camera_slots_are_dealt_evenly():
     plan = _plan(1000, rate=0.3, slots=2)
     slots = plan.camera_slot[plan.choice >= 0]
-    assert sorted(torch.bincount(slots).tolist()) == [150, 150]
+    assert sorted(torch.bincount(slots.long()).tolist()) == [150, 150]
 
 
 def test_plan_is_pure_in_seed_and_epoch():
