@@ -12,7 +12,7 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import MISSING, dataclass, field
 from pathlib import Path
 
 from lerobot.configs import parser
@@ -25,6 +25,21 @@ from lerobot_phantom.eval.results import CLEAN
 from lerobot_phantom.transforms.instruction import MODES as INSTRUCTION_MODES
 from lerobot_phantom.transforms.intensity import parse_intensity
 from lerobot_phantom.transforms.registry import ATTACK_NAMES
+
+# PhantomConfig fields that only mean something when mixing attacks into training data -> what to use instead.
+TRAINING_ONLY = {
+    "weights": "--phantom.attacks (every attack is evaluated)",
+    "intensity": "--phantom.intensities (one condition per level)",
+    "instruction_attacks": "--phantom.attacks, which takes instruction attacks too",
+    "instruction_rate": "--phantom.attacks, which takes instruction attacks too",
+    "where": "nothing: evaluation attacks the env observations",
+}
+
+
+def training_default(name: str):
+    """PhantomConfig's default for field ``name`` (read from the class, so the two never drift apart)."""
+    spec = PhantomConfig.__dataclass_fields__[name]
+    return spec.default_factory() if spec.default_factory is not MISSING else spec.default
 
 
 @dataclass
@@ -52,6 +67,9 @@ class EvalPhantomConfig(PhantomConfig):
             # Accepted for convenience; the clean control is always run once.
             self.attacks = [a for a in self.attacks if a != CLEAN]
         super().validate()
+        for name, instead in TRAINING_ONLY.items():
+            if getattr(self, name) != training_default(name):
+                raise ValueError(f"--phantom.{name} is a training option; in evaluation use {instead}")
         if len(set(self.attacks)) != len(self.attacks):
             raise ValueError(f"--phantom.attacks lists an attack twice: {self.attacks}")
         if not self.intensities and self.attacks:

@@ -40,13 +40,16 @@ SIGNIFICANCE = 0.05
 
 @dataclass
 class ReportConfig:
-    # eval.json files (or directories holding one) for the robustness table, one column group each.
+    # eval.json files (or directories holding one) for the robustness table; one column group per label, and files
+    # sharing a label (e.g. one per suite) merge into one group. Offline (--dataset) results get their own table.
     inputs: list[str] = field(default_factory=list)
     # Column-group name per input; default: the policy checkpoint's name, else the file's parent directory.
     labels: list[str] | None = None
     # Before/after pairs for the adversarial-training table: before[i] is compared with after[i].
     before: list[str] = field(default_factory=list)
+    # The after-training eval.json of each before[i] (same env, seeds and episodes).
     after: list[str] = field(default_factory=list)
+    # Where tables, figures and summary.md are written.
     output_dir: str = "outputs/phantom_report"
     # Figures need matplotlib; tables do not.
     figures: bool = True

@@ -76,6 +76,13 @@ def test_bad_phantom_values_are_refused():
         EvalPhantomConfig(duration=0)
     with pytest.raises(ValueError, match=r"instruction_mode"):
         EvalPhantomConfig(instruction_mode="loud")
+    with pytest.raises(
+        ValueError,
+        match=r"--phantom\.intensity is a training option; in evaluation use --phantom\.intensities",
+    ):
+        EvalPhantomConfig(intensity="strong")
+    with pytest.raises(ValueError, match=r"--phantom\.instruction_attacks is a training option"):
+        EvalPhantomConfig(instruction_attacks=["voice_dos"])
 
 
 def test_env_xor_dataset():
