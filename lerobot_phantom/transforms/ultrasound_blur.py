@@ -31,6 +31,10 @@ Deviations from the paper's code (and why):
   of pixels and the paper's ``int()`` then truncates one pixel short; likewise ``N`` comes out one short for
   ~0.8 % of pixels. A 1e-6 pixel snap before truncation removes this round-off noise.
 
+Distortion grows with the intensity on camera-like (smooth) frames. On tiny noise images it can dip: when the
+path is only a pixel or two long, ``int()`` quantises its direction, so a slightly longer path may average a
+different (not a larger) set of neighbours.
+
 Fast path: with no rotation and no radial part (the paper's levels) the path offsets are the same for every pixel,
 so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds count map: ``~N`` strided adds per
 image. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical parameters,
