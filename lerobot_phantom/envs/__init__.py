@@ -7,9 +7,11 @@ Stable API (importing this package is cheap: mujoco is only imported when an env
   ``task_id=None`` draws a task of the suite at every reset from the env's seeded RNG; an int pins one task.
 - ``SUITES``: suite name -> list of task dicts ``{"name", "language", "goals"}`` (see suites.py);
   ``SUITE_NAMES = ("spatial", "object", "goal", "long")``.
-- ``scripted_expert(env) -> callable(obs) -> action`` (reads privileged sim state; ``ScriptedExpert`` class).
+- ``scripted_expert(env) -> callable(obs) -> action`` (reads privileged sim state; ``ScriptedExpert`` class);
+  ``record_expert_episode(env, seed, task_id=None)`` -> {"language", "success", "frames", "actions"}.
 - ``collect(CollectConfig)`` / the ``lerobot-phantom-collect`` CLI (collect.py) write LeRobotDataset v3.
-- ``PhantomTableEnvConfig`` (lerobot_config.py): the LeRobot ``EnvConfig`` registered as type ``phantom_table``.
+- ``PhantomTableEnvConfig`` (lerobot_config.py): the LeRobot ``EnvConfig`` registered as type ``phantom_table``;
+  ``make_phantom_vector_envs(cfg, n_envs, use_async_envs, suites)`` -> LIBERO-style {suite: {task_id: vec_env}}.
 
 Gymnasium ids: ``lerobot_phantom/PhantomTable-v0`` (kwargs: suite, task_id, image_size, obs_type, render_mode,
 episode_length, render_size) and one per suite, e.g. ``lerobot_phantom/PhantomTable-Goal-v0``. They are registered
@@ -56,9 +58,11 @@ _LAZY = {
     "PhantomTableEnv": "lerobot_phantom.envs.table_env",
     "scripted_expert": "lerobot_phantom.envs.experts",
     "ScriptedExpert": "lerobot_phantom.envs.experts",
+    "record_expert_episode": "lerobot_phantom.envs.experts",
     "collect": "lerobot_phantom.envs.collect",
     "CollectConfig": "lerobot_phantom.envs.collect",
     "PhantomTableEnvConfig": "lerobot_phantom.envs.lerobot_config",
+    "make_phantom_vector_envs": "lerobot_phantom.envs.lerobot_config",
 }
 
 __all__ = ["GYM_ID", "SUITES", "SUITE_NAMES", "register_gym_envs", "suite_gym_id", *_LAZY]

@@ -78,3 +78,27 @@ class ScriptedExpert:
 def scripted_expert(env) -> Callable[[object], np.ndarray]:
     """The scripted expert for ``env`` (a PhantomTableEnv, possibly wrapped): a callable ``obs -> action``."""
     return ScriptedExpert(env)
+
+
+def record_expert_episode(env, seed: int, task_id: int | None = None) -> dict:
+    """Run the scripted expert for one episode; returns the instruction, success and per-step observations/actions.
+
+    ``frames`` holds the observations seen before each action plus the final one (for GIFs and demos).
+    """
+    options = None if task_id is None else {"task_id": task_id}
+    obs, info = env.reset(seed=seed, options=options)
+    expert = scripted_expert(env)
+    frames, actions = [obs], []
+    while True:
+        action = expert(obs)
+        obs, _, terminated, truncated, info = env.step(action)
+        frames.append(obs)
+        actions.append(action)
+        if terminated or truncated:
+            break
+    return {
+        "language": env.unwrapped.task_description,
+        "success": bool(info["is_success"]),
+        "frames": frames,
+        "actions": np.stack(actions),
+    }

@@ -39,6 +39,9 @@ class PhantomTableEnvConfig(EnvConfig):
     render_mode: str = "rgb_array"
     observation_height: int = 96
     observation_width: int = 96
+    render_size: int | None = (
+        None  # side of the frames lerobot-eval saves as videos; None: the observation size
+    )
     features: dict[str, PolicyFeature] = field(
         default_factory=lambda: {ACTION: PolicyFeature(type=FeatureType.ACTION, shape=(ACTION_DIM,))}
     )
@@ -85,6 +88,7 @@ class PhantomTableEnvConfig(EnvConfig):
             "obs_type": self.obs_type,
             "render_mode": self.render_mode,
             "episode_length": self.episode_length,
+            "render_size": self.render_size,
         }
 
 

@@ -37,7 +37,13 @@ def probe_backend(backend: str, timeout_s: float = 60.0) -> tuple[bool, str]:
 
 
 def select_gl_backend() -> str:
-    """Export a working ``MUJOCO_GL`` (egl, else osmesa) unless the user already set one; return the choice."""
+    """Export a working ``MUJOCO_GL`` (egl, else osmesa) unless the user already set one; return the choice.
+
+    Also defaults ``LP_NUM_THREADS=0`` (Mesa llvmpipe renders in the calling thread): llvmpipe's worker threads do
+    not survive ``fork``, so without this an ``AsyncVectorEnv`` forked after the parent rendered deadlocks in its
+    children; at 96x96 the worker threads bring nothing anyway.
+    """
+    os.environ.setdefault("LP_NUM_THREADS", "0")
     chosen = os.environ.get("MUJOCO_GL")
     if chosen:
         return chosen

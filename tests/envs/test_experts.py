@@ -66,3 +66,20 @@ def test_expert_rejects_foreign_envs():
 
     with pytest.raises(TypeError, match="PhantomTableEnv"):
         scripted_expert(gym.make("CartPole-v1"))
+
+
+def test_record_expert_episode_returns_aligned_frames_and_actions():
+    from lerobot_phantom.envs import record_expert_episode
+
+    env = make_phantom_env("object")
+    try:
+        episode = record_expert_episode(env, seed=4, task_id=3)
+        assert episode["success"]
+        assert episode["language"] == SUITES["object"][3]["language"]
+        assert len(episode["frames"]) == len(episode["actions"]) + 1
+        assert episode["actions"].shape[1] == 4
+        # The last frame shows the object in the basket, not where it started.
+        first, last = episode["frames"][0]["pixels"]["front"], episode["frames"][-1]["pixels"]["front"]
+        assert not (first == last).all()
+    finally:
+        env.close()

@@ -74,3 +74,25 @@ def test_nested_vector_envs_per_suite_and_task():
                 vec.close()
     with pytest.raises(ValueError, match="'all'"):
         make_phantom_vector_envs(PhantomTableEnvConfig(), suites="kitchen")
+
+
+@pytest.mark.timeout(120)
+def test_async_vector_env_works_after_the_parent_rendered():
+    """LeRobot's use_async_envs forks; forked children must still render once the parent holds a GL context."""
+    import gymnasium as gym
+
+    from lerobot_phantom.envs import GYM_ID, make_phantom_env
+
+    parent = make_phantom_env("goal", seed=0)
+    vec = gym.vector.AsyncVectorEnv(
+        [lambda: gym.make(GYM_ID, suite="long", task_id=1) for _ in range(2)],
+        autoreset_mode=gym.vector.AutoresetMode.SAME_STEP,
+    )
+    try:
+        obs, _ = vec.reset(seed=[0, 1])
+        assert obs["pixels"]["front"].shape == (2, 96, 96, 3)
+        assert obs["pixels"]["front"][0].std() > 0
+        assert not np.array_equal(obs["pixels"]["front"][0], obs["pixels"]["front"][1])
+    finally:
+        vec.close()
+        parent.close()
