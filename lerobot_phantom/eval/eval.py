@@ -14,7 +14,6 @@ With ``--dataset.*`` instead of ``--env.*`` it runs the offline mode (``lerobot_
 """
 
 import json
-import logging
 import platform
 import time
 from contextlib import nullcontext
@@ -33,8 +32,6 @@ from lerobot_phantom.eval.config import PhantomEvalConfig
 from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT, pooled_summary, summarize
 from lerobot_phantom.eval.rollout import AttackStep, build_conditions, episode_outcomes
 from lerobot_phantom.transforms.base import derive_seed
-
-logger = logging.getLogger(__name__)
 
 
 def identity_processors():

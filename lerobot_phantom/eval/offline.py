@@ -24,6 +24,7 @@ from tqdm import tqdm
 
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
+from lerobot_phantom.eval.eval import identity_processors, policy_metadata, versions, with_step
 from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT
 from lerobot_phantom.eval.rollout import AttackStep, build_conditions
 from lerobot_phantom.transforms.base import derive_seed
@@ -80,8 +81,10 @@ def evaluate_offline(
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
     from torch.utils.data import Subset, default_collate
 
-    from lerobot_phantom.eval.eval import identity_processors, versions, with_step
-
+    if cfg.phantom.onset != 0 or cfg.phantom.duration is not None:
+        raise ValueError(
+            "--phantom.onset/--phantom.duration need rollouts (--env.*); offline frames are single steps"
+        )
     started = time.time()
     dataset = LeRobotDataset(
         cfg.dataset.repo_id,
@@ -144,10 +147,7 @@ def evaluate_offline(
         "metadata": {
             "created": datetime.now(UTC).isoformat(timespec="seconds"),
             "duration_s": round(time.time() - started, 3),
-            "policy": {
-                "path": None if cfg.policy is None else str(cfg.policy.pretrained_path),
-                "type": getattr(policy.config, "type", None) or type(policy).__name__,
-            },
+            "policy": policy_metadata(cfg, policy),
             "dataset": {
                 "repo_id": cfg.dataset.repo_id,
                 "root": None if cfg.dataset.root is None else str(cfg.dataset.root),

@@ -55,6 +55,12 @@ def test_offline_deviation_separates_image_and_state_policies(dataset_root, tmp_
     assert (tmp_path / "c" / "eval.json").is_file()
 
 
+def test_offline_refuses_temporal_options(dataset_root, tmp_path):
+    cfg = offline_cfg(dataset_root, tmp_path, attacks=["laser_blinding"], intensities=["weak"], onset=3)
+    with pytest.raises(ValueError, match=r"need rollouts"):
+        evaluate(cfg, policy=kit.make_toy_policy("colour"))
+
+
 def test_frame_indices_spread_evenly():
     assert frame_indices(10, 4) == [0, 3, 6, 9]
     assert frame_indices(3, 100) == [0, 1, 2]
