@@ -202,13 +202,15 @@ def normalize_argv(argv: list[str]) -> list[str]:
     return out
 
 
-def main(argv: list[str] | None = None) -> CollectResult:
+def main(argv: list[str] | None = None) -> None:
     import draccus
 
     cfg = draccus.parse(CollectConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
-    result = collect(cfg)
+    try:
+        result = collect(cfg)
+    except (FileExistsError, ValueError) as err:  # user errors: one clear line instead of a traceback
+        raise SystemExit(f"lerobot-phantom-collect: {err}") from err
     print(
         f"wrote {result.root} ({result.episodes} episodes, {result.frames} frames, "
         f"{result.failed_attempts} failed attempts discarded, {result.frames_per_second:.1f} frames/s)"
     )
-    return result
