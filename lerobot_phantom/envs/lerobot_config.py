@@ -63,6 +63,11 @@ class PhantomTableEnvConfig(EnvConfig):
                 f"task_id {self.task_id} out of range for suite {self.task!r}: "
                 f"valid 0..{len(SUITES[self.task]) - 1}"
             )
+        if not self.disable_env_checker:
+            raise ValueError(
+                "phantom_table needs disable_env_checker=True: gymnasium's checker wrapper hides the env's "
+                "task_description from lerobot-eval, and policies would silently receive empty instructions"
+            )
         if self.obs_type not in OBS_TYPES:
             raise ValueError(f"unknown obs_type {self.obs_type!r}; valid: {', '.join(OBS_TYPES)}")
         image_shape = (self.observation_height, self.observation_width, 3)

@@ -40,6 +40,8 @@ def test_invalid_config_values_name_valid_ones():
         PhantomTableEnvConfig(task="spatial", task_id=4)
     with pytest.raises(ValueError, match="obs_type"):
         PhantomTableEnvConfig(obs_type="state")
+    with pytest.raises(ValueError, match="empty instructions"):
+        PhantomTableEnvConfig(disable_env_checker=False)
 
 
 def test_stock_make_env_passes_the_instruction_as_task():
