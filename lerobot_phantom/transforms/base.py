@@ -74,15 +74,19 @@ def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
     return x, alpha
 
 
+def _shares_storage(a: torch.Tensor, b: torch.Tensor) -> bool:
+    return a.untyped_storage().data_ptr() == b.untyped_storage().data_ptr()
+
+
 def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tensor) -> torch.Tensor:
     """Inverse of ``to_float_rgb``: back to the dtype, channel count and shape of ``like``."""
     if like.shape[-3] == 1:
         x = x.mean(dim=1, keepdim=True)
     elif alpha is not None:
         x = torch.cat([x, alpha], dim=1)
-    # clamp allocates the output once; the uint8 path then scales and rounds it in place (the kernel's result
-    # may alias the caller's float input, so it is never modified in place itself)
-    x = x.clamp(0.0, 1.0)
+    # In place when the kernel's result is its own tensor; a result that aliases the caller's float input
+    # (an identity, a view) must not be modified, so it gets one copy.
+    x = x.clamp(0.0, 1.0) if _shares_storage(x, like) else x.clamp_(0.0, 1.0)
     x = x.mul_(255.0).round_().to(torch.uint8) if like.dtype == torch.uint8 else x.to(like.dtype)
     return x.reshape(like.shape)
 
