@@ -170,12 +170,12 @@ class PhantomTableEnv(gym.Env):
     def reset(self, *, seed: int | None = None, options: dict[str, Any] | None = None):
         super().reset(seed=seed)
         options = options or {}
+        # Always consume the task draw, so a seed gives the same layout whichever way the task is chosen.
+        task_id = int(self.np_random.integers(len(self.spec_suite.tasks)))
         if "task_id" in options:
             task_id = int(options["task_id"])
         elif self.fixed_task_id is not None:
             task_id = self.fixed_task_id
-        else:
-            task_id = int(self.np_random.integers(len(self.spec_suite.tasks)))
         self._set_task(task_id)
 
         layout = sample_layout(self.spec_suite, self.np_random)

@@ -150,6 +150,11 @@ def test_task_selection_fixed_drawn_and_validated():
         assert len(drawn) > 1 and drawn <= set(range(len(SUITES["goal"])))
         _, info = env.reset(seed=0, options={"task_id": 4})
         assert info["task_id"] == 4 and env.task_description == SUITES["goal"][4]["language"]
+        layout_with_option = env.data.qpos.copy()
+        env.reset(seed=0)
+        np.testing.assert_array_equal(
+            env.data.qpos, layout_with_option
+        )  # the task choice never moves objects
     finally:
         env.close()
     with pytest.raises(ValueError, match="valid suites: spatial, object, goal, long"):
