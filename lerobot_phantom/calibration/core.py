@@ -8,13 +8,55 @@ lowers the inner cross-validated RMSE is kept if it lowers it by a clear relativ
 
 from __future__ import annotations
 
+import ctypes
+import glob
 import math
-from collections.abc import Callable, Sequence
+import os
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 import torch
 from scipy.optimize import least_squares
+
+
+def _openblas_libraries() -> list[tuple[ctypes.CDLL, str, str]]:
+    """The OpenBLAS builds numpy and scipy bundle (wheels), with their get/set thread-count symbols."""
+    import scipy
+
+    found = []
+    for package in (np, scipy):
+        folder = os.path.join(os.path.dirname(os.path.dirname(package.__file__)), f"{package.__name__}.libs")
+        for path in glob.glob(os.path.join(folder, "libscipy_openblas*.so")):
+            lib = ctypes.CDLL(path)
+            for suffix in ("64_", ""):
+                getter, setter = (
+                    f"scipy_openblas_get_num_threads{suffix}",
+                    f"scipy_openblas_set_num_threads{suffix}",
+                )
+                if hasattr(lib, getter) and hasattr(lib, setter):
+                    found.append((lib, getter, setter))
+                    break
+    return found
+
+
+@contextmanager
+def single_threaded() -> Iterator[None]:
+    """Run fits on one thread: the many small dense products of least squares slow down badly when BLAS and
+    torch spread them over cores that other processes also use (measured: 6x on a loaded 2-core machine)."""
+    torch_threads = torch.get_num_threads()
+    libraries = _openblas_libraries()
+    previous = [getattr(lib, getter)() for lib, getter, _ in libraries]
+    torch.set_num_threads(1)
+    for lib, _, setter in libraries:
+        getattr(lib, setter)(1)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(torch_threads)
+        for (lib, _, setter), value in zip(libraries, previous, strict=True):
+            getattr(lib, setter)(value)
 
 
 @dataclass(frozen=True)
@@ -51,11 +93,13 @@ def fit_least_squares(
     max_nfev: int = 200,
     starts: Sequence[dict[str, float]] = (),
     autodiff: bool = True,
+    warm: dict[str, float] | None = None,
 ) -> dict[str, float]:
     """Bounded least squares (scipy's trust-region reflective) over named parameters; best of several starts.
 
     ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor; with ``autodiff`` its Jacobian
-    comes from torch forward-mode differentiation, otherwise from finite differences.
+    comes from torch forward-mode differentiation, otherwise from finite differences. ``warm`` (a nested model's
+    fitted values) replaces the default start for the parameters it names.
     """
     if not params:
         return {}
@@ -76,7 +120,10 @@ def fit_least_squares(
         return torch.func.jacfwd(call)(torch.from_numpy(z)).detach().numpy()
 
     best: tuple[float, dict[str, float]] | None = None
-    for init in [{p.name: p.init for p in params}, *starts]:
+    default = {p.name: p.init for p in params}
+    if warm:
+        default.update({k: float(v) for k, v in warm.items() if k in default})
+    for init in [default, *starts]:
         z0 = np.array([init.get(p.name, p.init) for p in params], dtype=np.float64) / scale.numpy()
         z0 = np.clip(z0, low + 1e-9 * (high - low), high - 1e-9 * (high - low))
         result = least_squares(
@@ -111,7 +158,8 @@ class Problem:
     def n_items(self) -> int:
         raise NotImplementedError
 
-    def fit(self, effects: frozenset[str], items: np.ndarray) -> Fit:
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        """Least-squares fit of the model with ``effects`` on ``items``; ``start``: a nested model's fit."""
         raise NotImplementedError
 
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
@@ -176,13 +224,16 @@ class Step:
     tried: dict[str, float]
 
 
-def cross_validated_rmse(problem: Problem, effects: frozenset[str], splits) -> float:
-    total, count = 0.0, 0
-    for train, val in splits:
-        fit = problem.fit(effects, train)
+def cross_validated(
+    problem: Problem, effects: frozenset[str], splits, parents: list[Fit] | None
+) -> tuple[float, list[Fit]]:
+    total, count, fits = 0.0, 0, []
+    for k, (train, val) in enumerate(splits):
+        fit = problem.fit(effects, train, None if parents is None else parents[k])
         sq, n = problem.squared_errors(fit, val)
         total, count = total + sq, count + n
-    return math.sqrt(total / max(count, 1))
+        fits.append(fit)
+    return math.sqrt(total / max(count, 1)), fits
 
 
 def forward_select(
@@ -197,14 +248,17 @@ def forward_select(
     """Forward selection of extensions by inner k-fold validation RMSE, each step needing a ``margin`` gain."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
     chosen: frozenset[str] = frozenset()
-    current = cross_validated_rmse(problem, chosen, splits)
+    current, parents = cross_validated(problem, chosen, splits, None)
     steps = [Step([], current, {})]
     while True:
         tried: dict[str, float] = {}
+        fits: dict[str, list[Fit]] = {}
         for effect in problem.candidates:
             if effect.name in chosen or not set(effect.requires) <= chosen:
                 continue
-            tried[effect.name] = cross_validated_rmse(problem, chosen | {effect.name}, splits)
+            tried[effect.name], fits[effect.name] = cross_validated(
+                problem, chosen | {effect.name}, splits, parents
+            )
         if not tried:
             break
         best = min(tried, key=tried.__getitem__)
@@ -212,9 +266,17 @@ def forward_select(
         if tried[best] > (1.0 - margin) * current:
             break
         chosen = chosen | {best}
-        current = tried[best]
+        current, parents = tried[best], fits[best]
         steps.append(Step(sorted(chosen), current, {}))
     return chosen, steps
+
+
+def fit_chain(problem: Problem, steps: list[Step], items: np.ndarray) -> list[Fit]:
+    """Fits of the base and of every model selection kept, each started from the previous one."""
+    fits = [problem.fit(frozenset(), items)]
+    for step in steps[1:]:
+        fits.append(problem.fit(frozenset(step.effects), items, fits[-1]))
+    return fits
 
 
 def binned_rmse(x: np.ndarray, residual: np.ndarray, bins: int = 8) -> dict[str, list[float]]:

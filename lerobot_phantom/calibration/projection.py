@@ -93,6 +93,18 @@ def projection_predict(
     return total.clamp(0.0, 1.0)
 
 
+def projection_warm(start: Fit | None) -> dict[str, float] | None:
+    """Start values from a nested fit; a scalar strength seeds the diagonal of a cross-talk matrix."""
+    if start is None:
+        return None
+    warm = dict(start.params)
+    level = warm.get("strength", warm.get("opacity"))
+    if level is not None:
+        for i in range(3):
+            warm.setdefault(f"crosstalk_{i}{i}", level)
+    return warm
+
+
 def projection_kwargs(fit: Fit) -> dict:
     effects, p = fit.effects, fit.params
     if "additive_light" not in effects:
@@ -150,10 +162,12 @@ class TripleProblem(Problem):
             self.surface[index], self.projected[index], self.strength[index], fit_effects, params
         )
 
-    def fit(self, effects: frozenset[str], items: np.ndarray) -> Fit:
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         target = self.captured[torch.as_tensor(items)]
         params = fit_least_squares(
-            projection_specs(effects), lambda p: (self.predict(effects, p, items) - target).ravel()
+            projection_specs(effects),
+            lambda p: (self.predict(effects, p, items) - target).ravel(),
+            warm=projection_warm(start),
         )
         return Fit(effects, params)
 

@@ -116,10 +116,12 @@ class StripeProblem(Problem):
             periodic="stripe_period" in effects,
         )
 
-    def fit(self, effects: frozenset[str], items: np.ndarray) -> Fit:
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         target = torch.as_tensor(self.rows[items])
         params = fit_least_squares(
-            self.param_specs(effects), lambda p: self.predict(effects, p, items) - target
+            self.param_specs(effects),
+            lambda p: self.predict(effects, p, items) - target,
+            warm=None if start is None else start.params,
         )
         return Fit(effects, params)
 

@@ -89,6 +89,16 @@ def radial_distance(
     return torch.sqrt((xs - center[:, 0:1]) ** 2 + (ys - center[:, 1:2]) ** 2)
 
 
+def power_law_halo(
+    radius: torch.Tensor,
+    amplitude: float | torch.Tensor,
+    exponent: float | torch.Tensor,
+    scale: float | torch.Tensor,
+) -> torch.Tensor:
+    """Glare around a bright source: ``amplitude * (1 + r / scale) ** -exponent`` (finite at the centre)."""
+    return _as(amplitude, radius) * (1.0 + radius / _as(scale, radius)) ** (-_as(exponent, radius))
+
+
 def laser_spot_profile(
     radius: torch.Tensor,
     core_sigma: float | torch.Tensor,
@@ -283,7 +293,7 @@ def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torc
 
 def blur_taps(dx: float, dy: float) -> int:
     """Enough taps that neighbouring samples are at most half a pixel apart."""
-    return max(3, int(math.ceil(2.0 * math.hypot(dx, dy))) + 1)
+    return max(3, math.ceil(2.0 * math.hypot(dx, dy)) + 1)
 
 
 # ---------------------------------------------------------------------------------------------------------------

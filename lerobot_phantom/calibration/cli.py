@@ -1,0 +1,164 @@
+"""``lerobot-phantom-calibrate``: fit an attack simulation to measured data, name what it gets wrong, extend it.
+
+    lerobot-phantom-calibrate --attack laser_color_strip --measured ../shared/measured/rolling_shutter/logitech_stripe_rows.csv --out outputs/cal/stripes
+    lerobot-phantom-calibrate --attack light_projection --measured slap_stop_sign_triples.csv --out outputs/cal/stop
+    lerobot-phantom-calibrate --attack laser_blinding --measured ../shared/measured/blinding --out outputs/cal/laser
+    lerobot-phantom-calibrate --attack ultrasound_blur --measured my_captures/ --out outputs/cal/blur   # pairs.csv
+
+Inputs (recognised from the path and the table columns):
+  stripe tables (frequency, exposure, duty_cycle, affected_rows_mean)   -> laser_color_strip
+  colour-triple tables (origin_*, addition_*, outcome_*)                -> light_projection
+  laser captures without scene (image file or folder of images)         -> laser_blinding
+  frame pairs (folder with pairs.csv: clean,attacked[,pattern][,intensity],...) -> laser_blinding,
+      light_projection, ultrasound_blur, em_color_strip
+"""
+
+from __future__ import annotations
+
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
+from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select, seeded_split, single_threaded
+from lerobot_phantom.calibration.frames import FRAME_PROBLEMS, load_pairs
+from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
+from lerobot_phantom.calibration.report import build_report, write_outputs
+from lerobot_phantom.calibration.stripes import StripeProblem, is_stripe_table
+from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
+
+SUPPORTED = {
+    "stripe_table": ("laser_color_strip",),
+    "colour_triples": ("light_projection",),
+    "laser_captures": ("laser_blinding",),
+    "frame_pairs": tuple(FRAME_PROBLEMS),
+}
+
+
+@dataclass
+class CalibrateConfig:
+    # Attack whose simulation is calibrated (one of the camera attacks).
+    attack: str = ""
+    # Measured data: a stripe/colour-triple CSV, a laser capture (file or folder), or a folder with pairs.csv.
+    measured: str = ""
+    # Output directory for report.json, report.md (+ figures) and calibrated.json.
+    out: str = ""
+    # Seed of the held-out split, the inner folds and the pixel samples.
+    seed: int = 0
+    # Share of items (table rows, capture tiles, whole image pairs) held out for the final score.
+    heldout: float = 0.2
+    # Relative validation-RMSE reduction an extension must bring to be kept.
+    margin: float = 0.05
+    # Inner cross-validation folds for selection.
+    folds: int = 4
+    # Stripe tables: image rows of the camera's frames.
+    image_height: int = 720
+    # Stripe tables: seconds per unit of the table's exposure setting (UVC cameras: 100 microseconds).
+    exposure_unit_s: float = 1e-4
+    # Frame pairs: frames are resized so their longer side is at most this many pixels.
+    max_side: int = 256
+    # Laser captures: captures are resized so their longer side is at most this many pixels.
+    capture_max_side: int = 128
+
+
+def detect_input(path: Path) -> str:
+    if not path.exists():
+        raise FileNotFoundError(f"--measured {path} does not exist")
+    if path.is_dir():
+        if (path / "pairs.csv").is_file():
+            return "frame_pairs"
+        if any(p.suffix.lower() in IMAGE_SUFFIXES for p in path.iterdir()):
+            return "laser_captures"
+        raise ValueError(f"{path}: a folder must hold pairs.csv (frame pairs) or laser capture images")
+    if path.suffix.lower() in IMAGE_SUFFIXES:
+        return "laser_captures"
+    if path.suffix.lower() == ".csv":
+        columns = pd.read_csv(path, nrows=0).columns
+        if is_stripe_table(columns):
+            return "stripe_table"
+        if is_triple_table(columns):
+            return "colour_triples"
+        raise ValueError(
+            f"{path}: unknown table; stripe tables need frequency, exposure, duty_cycle, affected_rows_mean and "
+            "colour-triple tables origin_r..outcome_b"
+        )
+    raise ValueError(f"{path}: not a CSV table, an image ({', '.join(IMAGE_SUFFIXES)}) or a folder")
+
+
+def build_problem(cfg: CalibrateConfig) -> Problem:
+    if cfg.attack not in CAMERA_ATTACKS:
+        raise ValueError(f"unknown --attack {cfg.attack!r}; valid: {', '.join(CAMERA_ATTACKS)}")
+    path = Path(cfg.measured)
+    kind = detect_input(path)
+    if cfg.attack not in SUPPORTED[kind]:
+        raise ValueError(
+            f"--measured {path} is {kind.replace('_', ' ')}, which calibrates {', '.join(SUPPORTED[kind])}, "
+            f"not {cfg.attack!r}"
+        )
+    if kind == "stripe_table":
+        return StripeProblem(path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s)
+    if kind == "colour_triples":
+        return TripleProblem(path)
+    if kind == "laser_captures":
+        return MultiCapture(path, max_side=cfg.capture_max_side, seed=cfg.seed)
+    return FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
+
+
+def calibrate(cfg: CalibrateConfig) -> dict:
+    """Run the whole calibration, write the outputs into ``cfg.out`` and return the report."""
+    if not cfg.out:
+        raise ValueError("--out is required (a directory for report.json, report.md and calibrated.json)")
+    measured, out = Path(cfg.measured).resolve(), Path(cfg.out).resolve()
+    if out == measured or (measured.is_dir() and out.is_relative_to(measured)):
+        raise ValueError(
+            f"--out {out} lies inside the measured data {measured}; calibration never writes there"
+        )
+    if not 0.0 <= cfg.margin < 1.0:
+        raise ValueError(f"--margin must lie in [0, 1), got {cfg.margin}")
+    with single_threaded():
+        problem = build_problem(cfg)
+        fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+        _effects, steps = forward_select(problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds)
+        chain = fit_chain(problem, steps, fit_items)
+        base, extended = chain[0], chain[-1]
+        report = build_report(
+            problem,
+            input_path=Path(cfg.measured),
+            fit_items=fit_items,
+            heldout_items=heldout_items,
+            chain=chain,
+            steps=steps,
+            seed=cfg.seed,
+            margin=cfg.margin,
+        )
+        write_outputs(problem, report, base, extended, heldout_items, out)
+    return report
+
+
+def normalize_argv(argv: list[str]) -> list[str]:
+    """Accept dashed option names (``--image-height``) for draccus's underscored fields."""
+    out = []
+    for arg in argv:
+        if arg.startswith("--"):
+            name, sep, value = arg[2:].partition("=")
+            arg = "--" + name.replace("-", "_") + sep + value
+        out.append(arg)
+    return out
+
+
+def main(argv: list[str] | None = None) -> None:
+    import draccus
+
+    cfg = draccus.parse(CalibrateConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
+    report = calibrate(cfg)
+    print(
+        f"{report['attack']}: base held-out RMSE {report['base']['heldout_rmse']:.3g} {report['units']}, "
+        f"extended {report['extended']['heldout_rmse']:.3g} with {report['extended']['effects'] or 'no extension'} "
+        f"(ratio {report['gain']['rmse_ratio']:.2f}) -> {cfg.out}"
+    )
+
+
+if __name__ == "__main__":
+    main()
