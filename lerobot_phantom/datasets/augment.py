@@ -493,17 +493,24 @@ def normalize_argv(argv: list[str]) -> list[str]:
     return out
 
 
-def main(argv: list[str] | None = None) -> AugmentResult:
+def main(argv: list[str] | None = None) -> None:
+    """Entry point; bad flags, bad settings and refused outputs end with a one-line error (exit status 1)."""
     import draccus
     from datasets.utils.logging import disable_progress_bar
 
     logging.basicConfig(level=logging.WARNING, format="%(message)s")
     disable_progress_bar()  # one bar (ours, in frames/s) instead of one per parquet file
-    cfg = draccus.parse(AugmentConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
-    result = augment(cfg)
+    try:
+        cfg = draccus.parse(AugmentConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
+    except draccus.utils.ParsingError as err:
+        # draccus reports "couldn't instantiate"; the reason (e.g. the list of valid attacks) is the cause.
+        raise SystemExit(f"lerobot-phantom-augment: error: {err.__cause__ or err}") from err
+    try:
+        result = augment(cfg)
+    except (ValueError, FileExistsError) as err:
+        raise SystemExit(f"lerobot-phantom-augment: error: {err}") from err
     print(f"wrote {result.output_root} ({result.num_episodes} episodes, {result.num_frames} frames)")
     print(format_summary(result.summary))
-    return result
 
 
 if __name__ == "__main__":

@@ -305,3 +305,14 @@ def test_an_attack_error_stops_the_run_with_its_context(image_dataset_root, tmp_
     notes = "\n".join(info.value.__notes__)
     assert "sample index 0" in notes and "source episode 0" in notes and "em_truncation" in notes
     assert not output.exists() and temporary_dir(output).exists()  # nothing half-written in place; resumable
+
+
+def test_cli_reports_bad_settings_in_one_line(image_dataset_root, tmp_path):
+    base = ["--repo-id", REPO, "--root", str(image_dataset_root), "--output-repo-id", "x", "--output-root"]
+    with pytest.raises(SystemExit) as info:
+        main([*base, str(tmp_path / "a"), "--phantom.attacks=[laser]"])
+    assert "valid attacks: laser_blinding" in str(info.value.code)
+    with pytest.raises(SystemExit) as info:
+        main([*base, str(image_dataset_root)])
+    assert "is the source dataset" in str(info.value.code)
+    assert not (tmp_path / "a").exists()
