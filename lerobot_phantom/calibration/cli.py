@@ -120,7 +120,9 @@ def calibrate(cfg: CalibrateConfig) -> dict:
     with single_threaded():
         problem = build_problem(cfg)
         fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
-        _effects, steps = forward_select(problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds)
+        _effects, steps = forward_select(
+            problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
+        )
         chain = fit_chain(problem, steps, fit_items)
         base, extended = chain[0], chain[-1]
         report = build_report(

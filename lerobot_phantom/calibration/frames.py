@@ -24,6 +24,7 @@ from lerobot_phantom.calibration.projection import (
     projection_kwargs,
     projection_predict,
     projection_specs,
+    projection_warm,
 )
 from lerobot_phantom.transforms import physics
 
