@@ -10,6 +10,9 @@ gains two columns, ``phantom_attack`` (attack name or ``"none"``) and ``phantom_
 channel (``--phantom.instruction_rate``) also ``phantom_instruction_attack``. Attacked instructions become new task
 strings in the task table. Image and video datasets alike are decoded, attacked and re-encoded; statistics are
 recomputed by LeRobot (per-episode stats when each episode is saved, aggregated when the episodes are merged).
+Frame timestamps are LeRobot's ``frame_index / fps`` (``add_frame`` does not take them). The run's settings and
+its summary (frames per attack and per nearest intensity level, also printed at the end) are kept in
+``meta/phantom_augment.json``.
 
 How it stays safe and resumable:
 
