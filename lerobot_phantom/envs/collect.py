@@ -1,12 +1,11 @@
 """lerobot-phantom-collect: record scripted-expert demonstrations as a LeRobotDataset v3.
 
     lerobot-phantom-collect --suite goal --episodes 100 --repo-id local/phantom_goal --root DIR \\
-        [--video] [--seed 0] [--overwrite] [--task-id K] [--image-size 96]
+        [--video] [--seed 0] [--overwrite] [--task-id K] [--image-size 96] [--action-noise 0.3]
 
 Episodes cycle round-robin over the selected (suite, task) pairs, so ``--episodes`` is the total count and every
 task gets an equal share; ``--suite all`` cycles over every task of every suite (interleaving the suites) into one
-multi-task dataset. Only
-successful expert episodes are kept: a failed attempt is discarded and retried with the next seed (the number of
+multi-task dataset. Only successful expert episodes are kept: a failed attempt is discarded and retried with the next seed (the number of
 discarded attempts is reported). Episode seeds are drawn from ``numpy.random.default_rng(seed)``, so a given
 ``--seed`` always produces the same dataset. Features: ``observation.images.front`` / ``observation.images.wrist``
 (images, or AV1 videos with ``--video``), ``observation.state`` (TCP xyz + finger opening), ``action``
@@ -40,6 +39,9 @@ class CollectConfig:
     seed: int = 0
     overwrite: bool = False  # delete an existing dataset at root first
     task_id: int | None = None  # only this task of the suite (not with --suite all)
+    action_noise: float = (
+        0.0  # relative std of noise on the executed (not the recorded) motion; 0.3 is a good start
+    )
     image_size: int = 96
     vcodec: str = "libsvtav1"
     image_writer_threads: int = 2  # PNG writing overlaps the simulation; 2 threads suit a 2-core machine
@@ -94,12 +96,25 @@ def dataset_features(image_size: int, video: bool) -> dict:
     }
 
 
-def _record_episode(env, expert, seed: int, task_id: int, dataset) -> tuple[bool, int]:
-    """Roll the expert out once, adding every frame to the dataset's episode buffer; returns (success, frames)."""
+def _record_episode(
+    env, expert, seed: int, task_id: int, dataset, action_noise: float = 0.0
+) -> tuple[bool, int]:
+    """Roll the expert out once, adding every frame to the dataset's episode buffer; returns (success, frames).
+
+    With ``action_noise`` the executed motion is perturbed (each axis scaled by ``1 + N(0, action_noise)``) while
+    the recorded action stays the expert's, so the data shows how to recover from small drifts (DART-style).
+    """
     obs, info = env.reset(seed=seed, options={"task_id": task_id})
+    noise_rng = np.random.default_rng(seed)
     language = env.task_description
     for step in range(env.max_episode_steps):
         action = np.asarray(expert(obs), dtype=np.float32)
+        executed = action.copy()
+        if action_noise > 0:
+            # Relative noise: large during transit, vanishing as the expert homes in, so it still converges.
+            executed[:3] = np.clip(
+                executed[:3] * (1.0 + noise_rng.normal(0.0, action_noise, size=3)), -1.0, 1.0
+            )
         dataset.add_frame(
             {
                 **{f"observation.images.{cam}": obs["pixels"][cam] for cam in CAMERAS},
@@ -108,7 +123,7 @@ def _record_episode(env, expert, seed: int, task_id: int, dataset) -> tuple[bool
                 "task": language,
             }
         )
-        obs, _, terminated, truncated, info = env.step(action)
+        obs, _, terminated, truncated, info = env.step(executed)
         if terminated or truncated:
             return bool(info["is_success"]), step + 1
     return False, env.max_episode_steps
@@ -124,6 +139,8 @@ def collect(cfg: CollectConfig) -> CollectResult:
 
     if cfg.episodes < 1:
         raise ValueError("--episodes must be at least 1")
+    if not 0.0 <= cfg.action_noise <= 1.0:
+        raise ValueError(f"--action-noise must be in [0, 1] (relative std), got {cfg.action_noise}")
     plan = _task_plan(cfg)
     repo_id = cfg.repo_id or f"local/phantom_{cfg.suite}"
     root = Path(cfg.root) if cfg.root is not None else HF_LEROBOT_HOME / repo_id
@@ -159,8 +176,9 @@ def collect(cfg: CollectConfig) -> CollectResult:
                     envs[suite] = (env, scripted_expert(env))
                 env, expert = envs[suite]
                 while True:
+                    episode_seed = int(rng.integers(2**31 - 1))
                     success, length = _record_episode(
-                        env, expert, int(rng.integers(2**31 - 1)), task_id, dataset
+                        env, expert, episode_seed, task_id, dataset, cfg.action_noise
                     )
                     if success:
                         break

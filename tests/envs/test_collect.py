@@ -110,3 +110,16 @@ def test_cli_collects_all_suites_as_videos(tmp_path):
     }
     frame = ds[ds.num_frames - 1]
     assert frame["observation.images.front"].shape == (3, 96, 96)
+
+
+def test_action_noise_perturbs_execution_but_keeps_successful_expert_labels(goal_dataset, tmp_path):
+    noisy = _collect(tmp_path / "noisy", seed=3, episodes=1, action_noise=0.4)
+    clean = LeRobotDataset(REPO_ID, root=goal_dataset.root, episodes=[0]).hf_dataset.with_format(None)
+    perturbed = LeRobotDataset(REPO_ID, root=noisy.root).hf_dataset.with_format(None)
+    assert noisy.failed_attempts == 0
+    assert perturbed["observation.state"] != clean["observation.state"]  # same layout, other path
+    actions = np.asarray(perturbed["action"])
+    assert np.abs(actions).max() <= 1.0
+    assert set(np.unique(actions[:, 3])) <= {-1.0, 1.0}  # the recorded gripper command is the expert's
+    with pytest.raises(ValueError, match="action-noise"):
+        _collect(tmp_path / "bad", action_noise=2.0)
