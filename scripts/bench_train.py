@@ -1,11 +1,14 @@
 """Seconds per training step of lerobot-phantom-train: rate 0 vs 0.3, dataloader vs device attacks, in one run.
 
 Builds a small dataset and a weightless SmolVLA backbone in a temporary directory (offline), runs LeRobot's loop
-through ``train_phantom`` for each setting, and times the wall clock between consecutive optimizer steps (data
-loading + preprocessing + attacks + forward/backward), median over the steps after a warm-up. Prints the ratios to
-the clean dataloader run and writes them as JSON.
+through ``train_phantom`` for each setting, and times the gap between consecutive optimizer steps (data loading +
+preprocessing + attacks + forward/backward), median over the steps after a warm-up, in CPU time of this process
+(robust to other jobs on a shared machine) and wall time. Each setting runs once per round, rounds alternate the
+order, the best round is kept. Separately, ``data_cpu_s_per_batch`` times reading, attacking and labelling one
+batch without a model, so the attack's own cost (rate 0.3 minus rate 0) can be set against any step time. Prints the
+ratios and writes them as JSON.
 
-    python scripts/bench_train.py [--steps 14] [--warmup 4] [--batch-size 8] [--image-size 96] [--out FILE]
+    python scripts/bench_train.py [--steps 30] [--warmup 5] [--batch-size 8] [--image-size 96] [--out FILE]
 
 The target is that ``--phantom.rate=0.3`` costs <= 5 % step time. Note the policy here is a CPU toy, so an attack's
 share of a step is far larger than next to a real VLA on a GPU; the ratio is an upper bound for that setting.
@@ -63,10 +66,35 @@ def time_run(args: list[str], warmup: int) -> dict[str, float]:
     }
 
 
+def time_batches(root: Path, rate: float, where: str, batch_size: int, batches: int) -> float:
+    """Median CPU seconds to read, attack and label one batch (mixer + collate + device step), no model."""
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+    from lerobot.processor import PolicyProcessorPipeline
+    from torch.utils.data import default_collate
+
+    from lerobot_phantom.config import PhantomConfig
+    from lerobot_phantom.datasets import PhantomDataset
+    from lerobot_phantom.train.device_step import PhantomAttackProcessorStep, TrainingPreprocessor
+
+    config = PhantomConfig(rate=rate, where=where)
+    dataset = PhantomDataset(LeRobotDataset("phantom/tiny", root=root), config, apply=where == "dataloader")
+    step = PhantomAttackProcessorStep(phantom=config, camera_keys=list(dataset.camera_keys))
+    preprocessor = TrainingPreprocessor(
+        PolicyProcessorPipeline(steps=[]), step if where == "device" else None
+    )
+    times = []
+    for b in range(batches):
+        start = time.process_time()
+        indices = [(b * batch_size + i) % len(dataset) for i in range(batch_size)]
+        preprocessor(default_collate([dataset[i] for i in indices]))
+        times.append(time.process_time() - start)
+    return statistics.median(times)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--steps", type=int, default=14)
-    parser.add_argument("--warmup", type=int, default=4)
+    parser.add_argument("--steps", type=int, default=30)
+    parser.add_argument("--warmup", type=int, default=5)
     parser.add_argument("--batch-size", type=int, default=8)
     parser.add_argument("--image-size", type=int, default=96)
     parser.add_argument("--vlm-size", default="tiny", choices=["tiny", "small"])
@@ -116,6 +144,9 @@ def main() -> None:
                 f"--phantom.where={where}",
             ]
             timing = time_run(args, opts.warmup)
+            timing["data_cpu_s_per_batch"] = time_batches(
+                tmp / "data", rate, where, opts.batch_size, batches=opts.steps
+            )
             best = results.get(name)
             if best is None or timing["cpu_s_per_step"] < best["cpu_s_per_step"]:
                 results[name] = {"rate": rate, "where": where, **timing}
@@ -130,6 +161,17 @@ def main() -> None:
         "rate0.3_over_rate0_dataloader": ratio("rate0.3_dataloader", "rate0_dataloader"),
         "rate0.3_over_rate0_device": ratio("rate0.3_device", "rate0_device"),
         "device_over_dataloader_at_rate0.3": ratio("rate0.3_device", "rate0.3_dataloader"),
+        # Portable figure: the attack's added CPU time per batch as a fraction of this toy policy's step time.
+        "attack_overhead_dataloader": (
+            results["rate0.3_dataloader"]["data_cpu_s_per_batch"]
+            - results["rate0_dataloader"]["data_cpu_s_per_batch"]
+        )
+        / results["rate0_dataloader"]["cpu_s_per_step"],
+        "attack_overhead_device": (
+            results["rate0.3_device"]["data_cpu_s_per_batch"]
+            - results["rate0_device"]["data_cpu_s_per_batch"]
+        )
+        / results["rate0_device"]["cpu_s_per_step"],
     }
     report = {
         "config": vars(opts) | {"out": str(opts.out)},
@@ -137,11 +179,14 @@ def main() -> None:
         "results": results,
         "summary": summary,
     }
-    print(f"{'setting':<22}{'cpu s/step':>11}{'ratio':>8}{'wall s/step':>12}{'ratio':>8}")
+    print(
+        f"{'setting':<22}{'cpu s/step':>11}{'ratio':>8}{'wall s/step':>12}{'ratio':>8}{'data cpu s/batch':>18}"
+    )
     for name, r in results.items():
         print(
             f"{name:<22}{r['cpu_s_per_step']:>11.4f}{r['cpu_ratio_to_rate0_dataloader']:>8.3f}"
             f"{r['wall_s_per_step']:>12.4f}{r['wall_ratio_to_rate0_dataloader']:>8.3f}"
+            f"{r['data_cpu_s_per_batch']:>18.4f}"
         )
     for key, value in summary.items():
         print(f"{key} (cpu time): {value:.3f}")
