@@ -133,7 +133,8 @@ def fit_least_squares(
             bounds=(low, high),
             max_nfev=max_nfev,
             x_scale=1.0,
-            tr_solver="lsmr",
+            # lsmr avoids a full SVD of the tall Jacobian, but its 2-D subspace needs >= 2 parameters
+            tr_solver="lsmr" if len(params) > 2 else "exact",
         )
         if best is None or result.cost < best[0]:
             best = (

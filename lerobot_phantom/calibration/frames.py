@@ -237,7 +237,7 @@ def _pixel_sample(pair: Pair, count: int, rng: np.random.Generator) -> np.ndarra
 class PixelProblem(FrameProblem):
     """Attacks that act pixel by pixel given per-pixel features; fits use a seeded sample of pixels per pair."""
 
-    pixels_per_pair = 4000
+    pixels_per_pair = 1500
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
         super().__init__(pairs, seed)
@@ -268,11 +268,12 @@ class PixelProblem(FrameProblem):
         params = fit_least_squares(
             self.param_specs(effects),
             lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
-            warm=self.warm(start),
+            warm=self.warm(start, effects),
+            starts=[{}] if start is not None else [],  # also from the defaults: saturated starts can stall
         )
         return Fit(effects, params)
 
-    def warm(self, start: Fit | None) -> dict[str, float] | None:
+    def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return None if start is None else start.params
 
 
@@ -313,8 +314,8 @@ class ProjectionFrames(PixelProblem):
     def param_specs(self, effects):
         return projection_specs(effects)
 
-    def warm(self, start: Fit | None) -> dict[str, float] | None:
-        return projection_warm(start)
+    def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
+        return projection_warm(start, effects)
 
     def transform_kwargs(self, fit: Fit) -> dict:
         return projection_kwargs(fit)
@@ -474,7 +475,7 @@ class BlurFrames(FrameProblem):
     base_model = "uniform line average along a fitted displacement (the paper's ultrasound blur, linear part)"
     extended_model = "resonant (sinusoidal) motion blur"
     candidates = BLUR_EFFECTS
-    taps = 33
+    taps = 25
 
     def param_specs(self, effects):
         specs = [
@@ -513,8 +514,8 @@ class BlurFrames(FrameProblem):
             return Fit(effects, params)
         # the blur length is not convex to fit from zero: start from the best of a coarse grid of displacements
         grid = []
-        for length in (1.0, 2.0, 4.0, 8.0, 16.0, 32.0):
-            for angle in np.arange(8) * np.pi / 8:
+        for length in (2.0, 6.0, 16.0, 40.0):
+            for angle in np.arange(6) * np.pi / 6:
                 grid.append({"dx_ref_px": length * np.cos(angle), "dy_ref_px": length * np.sin(angle)})
         base = {"gamma": torch.tensor(2.2, dtype=torch.float64)} if "sensor_gamma" in effects else {}
         costs = []
@@ -627,7 +628,7 @@ class EMStripFrames(FrameProblem):
                 params["period"] = float(min(costs, key=costs.__getitem__))
             placement = self.placements(effects, params, items)
             masks = {
-                int(i): self.mask(effects, params, int(i), placement[int(i)]).bool()[:, 0] for i in items
+                int(i): self.mask(effects, params, int(i), placement[int(i)])[0, :, 0].bool() for i in items
             }
 
             def residuals(p, masks=masks):

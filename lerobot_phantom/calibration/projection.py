@@ -93,11 +93,18 @@ def projection_predict(
     return total.clamp(0.0, 1.0)
 
 
-def projection_warm(start: Fit | None) -> dict[str, float] | None:
-    """Start values from a nested fit; a scalar strength seeds the diagonal of a cross-talk matrix."""
+def projection_warm(start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
+    """Start values from a nested fit, mapped to the new model's parameters (a blend's opacity becomes the
+    additive strength; a scalar strength seeds the diagonal of a cross-talk matrix)."""
     if start is None:
         return None
     warm = dict(start.params)
+    if "additive_light" in effects and "additive_light" not in start.effects:
+        opacity = warm.pop("opacity")
+        warm["strength"] = opacity
+        for name in CROSSTALK_NAMES:
+            if name in warm:
+                warm[name] *= opacity
     level = warm.get("strength", warm.get("opacity"))
     if level is not None:
         for i in range(3):
@@ -167,7 +174,8 @@ class TripleProblem(Problem):
         params = fit_least_squares(
             projection_specs(effects),
             lambda p: (self.predict(effects, p, items) - target).ravel(),
-            warm=projection_warm(start),
+            warm=projection_warm(start, effects),
+            starts=[{}] if start is not None else [],  # also from the defaults: saturated starts can stall
         )
         return Fit(effects, params)
 

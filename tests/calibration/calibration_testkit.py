@@ -1,0 +1,244 @@
+"""A ground-truth physical camera that renders synthetic "measured" frame pairs with chosen effects switched on.
+
+Written independently of ``lerobot_phantom.transforms.physics`` (numpy + scipy.ndimage only) so that the
+calibration tool is tested against a separate implementation of the physics, with randomised parameters and
+procedurally generated scenes.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+from scipy import ndimage
+
+
+def srgb_decode(v: np.ndarray) -> np.ndarray:
+    v = np.clip(v, 0.0, 1.0)
+    return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+
+def srgb_encode(v: np.ndarray) -> np.ndarray:
+    v = np.clip(v, 0.0, 1.0)
+    return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.maximum(v, 0.0031308) ** (1 / 2.4) - 0.055)
+
+
+def scene(rng: np.random.Generator, height: int, width: int, checkers: int = 0) -> np.ndarray:
+    """A procedural scene (H, W, 3) in [0.05, 0.95]: a colour gradient, random boxes and discs, texture, and
+    ``checkers`` high-contrast checkerboard patches (fine detail that blur visibly changes)."""
+    ys, xs = np.mgrid[0:height, 0:width] / max(height, width)
+    image = (
+        rng.uniform(0.2, 0.7, 3)
+        + rng.uniform(-0.3, 0.3, 3) * xs[..., None]
+        + rng.uniform(-0.3, 0.3, 3) * ys[..., None]
+    )
+    for _ in range(rng.integers(4, 9)):
+        colour = rng.uniform(0.05, 0.95, 3)
+        cx, cy = rng.uniform(0, width), rng.uniform(0, height)
+        size = rng.uniform(0.08, 0.3) * max(height, width)
+        px, py = np.mgrid[0:height, 0:width][::-1]
+        if rng.random() < 0.5:
+            mask = (np.abs(px - cx) < size) & (np.abs(py - cy) < 0.6 * size)
+        else:
+            mask = (px - cx) ** 2 + (py - cy) ** 2 < size**2
+        image[mask] = colour
+    for _ in range(checkers):
+        cell = int(rng.integers(2, 5))
+        y0, x0 = int(rng.integers(0, height - 16)), int(rng.integers(0, width - 16))
+        h, w = int(rng.integers(12, height // 2)), int(rng.integers(12, width // 2))
+        py, px = np.mgrid[0:h, 0:w]
+        board = ((py // cell + px // cell) % 2).astype(float)
+        dark, light = rng.uniform(0.05, 0.3, 3), rng.uniform(0.7, 0.95, 3)
+        image[y0 : y0 + h, x0 : x0 + w] = (dark + (light - dark) * board[..., None])[
+            : height - y0, : width - x0
+        ]
+    for _ in range(3):
+        fx, fy, phase = rng.uniform(2, 12), rng.uniform(2, 12), rng.uniform(0, 2 * np.pi)
+        image += rng.uniform(0.02, 0.06) * np.sin(2 * np.pi * (fx * xs + fy * ys) + phase)[..., None]
+    return np.clip(image, 0.05, 0.95)
+
+
+def save(path: Path, image: np.ndarray, rng: np.random.Generator, noise: float = 1.0 / 255.0) -> None:
+    """Sensor read noise, then 8-bit quantisation."""
+    noisy = np.clip(image + rng.normal(0.0, noise, image.shape), 0.0, 1.0)
+    Image.fromarray((noisy * 255).round().astype(np.uint8)).save(path)
+
+
+def sizes(rng: np.random.Generator, n: int) -> list[tuple[int, int]]:
+    return [(int(rng.integers(56, 72)), int(rng.integers(64, 84))) for _ in range(n)]
+
+
+def write_table(folder: Path, rows: list[dict]) -> None:
+    columns = list(rows[0])
+    lines = [",".join(columns)] + [",".join(str(r[c]) for c in columns) for r in rows]
+    (folder / "pairs.csv").write_text("\n".join(lines) + "\n")
+
+
+# ---------------------------------------------------------------------------------------------------------------
+
+
+def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np.ndarray, tuple, np.ndarray]:
+    """A recorded laser (no scene): a saturating coloured spot; returns (encoded pattern, centre, laser colour)."""
+    colour = np.array(rng.permutation([1.0, rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3)]))
+    cx, cy = rng.uniform(0.3, 0.7) * width, rng.uniform(0.3, 0.7) * height
+    sigma = rng.uniform(0.06, 0.12) * max(height, width)
+    ys, xs = np.mgrid[0:height, 0:width]
+    irradiance = rng.uniform(2.0, 6.0) * np.exp(-((xs - cx) ** 2 + (ys - cy) ** 2) / (2 * sigma**2))
+    return srgb_encode(irradiance[..., None] * colour), (cx, cy), colour
+
+
+def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
+    rng = np.random.default_rng(seed)
+    truth = {
+        "alpha": rng.uniform(0.4, 0.8),
+        "gain": rng.uniform(0.6, 1.5),
+        "halo_amplitude": rng.uniform(0.3, 0.6),
+        "halo_exponent": rng.uniform(1.5, 2.5),
+        "halo_scale": rng.uniform(10.0, 25.0),
+        "auto_exposure": rng.uniform(2.0, 5.0),
+    }
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width)
+        pattern, (cx, cy), colour = laser_pattern(rng, height, width)
+        s = rng.uniform(0.3, 1.0)
+        linear = "linear_light_saturation" in effects
+        decode = srgb_decode if linear else (lambda v: v)
+        encode = srgb_encode if linear else (lambda v: np.clip(v, 0, 1))
+        x, p = decode(clean), decode(pattern)
+        if linear:
+            light, weight = s * truth["gain"] * p, 1.0
+        else:
+            light, weight = truth["alpha"] * s * p, 1.0 - truth["alpha"] * s
+        if "halo_power_law" in effects:
+            ys, xs = np.mgrid[0:height, 0:width]
+            r = np.hypot(xs - cx, ys - cy) * 256 / max(height, width)
+            halo = truth["halo_amplitude"] * (1 + r / truth["halo_scale"]) ** -truth["halo_exponent"]
+            light = light + s * halo[..., None] * colour
+        total = weight * x + light
+        if "auto_exposure" in effects:
+            total = total / (1 + truth["auto_exposure"] * s * srgb_decode(pattern).mean())
+        attacked = encode(np.clip(total, 0, 1))
+        for name, image in (("clean", clean), ("attacked", attacked), ("pattern", pattern)):
+            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else 1.0 / 255.0)
+        rows.append(
+            {
+                "clean": f"clean_{i}.png",
+                "attacked": f"attacked_{i}.png",
+                "pattern": f"pattern_{i}.png",
+                "intensity": round(s, 4),
+            }
+        )
+    write_table(folder, rows)
+    return truth
+
+
+def projected_image(rng: np.random.Generator, height: int, width: int) -> np.ndarray:
+    """What an attacker projects: bold coloured blocks on black."""
+    image = np.zeros((height, width, 3))
+    for _ in range(rng.integers(3, 7)):
+        y0, x0 = rng.integers(0, height - 8), rng.integers(0, width - 8)
+        image[y0 : y0 + rng.integers(8, height // 2), x0 : x0 + rng.integers(8, width // 2)] = rng.choice(
+            [0.0, 0.5, 1.0], 3
+        )
+    return image
+
+
+def render_light_projection(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
+    rng = np.random.default_rng(seed)
+    crosstalk = np.eye(3) * rng.uniform(0.5, 0.8) + rng.uniform(0.1, 0.3, (3, 3)) * (1 - np.eye(3))
+    truth = {
+        "opacity": rng.uniform(0.3, 0.6),
+        "strength": rng.uniform(0.4, 0.8),
+        "crosstalk": crosstalk,
+        "floor": rng.uniform(0.1, 0.3),
+    }
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width)
+        projected = projected_image(rng, height, width)
+        s = rng.uniform(0.4, 1.0)
+        light = projected @ crosstalk.T if "channel_crosstalk" in effects else projected
+        if "additive_light" in effects:
+            light = s * light * (1.0 if "channel_crosstalk" in effects else truth["strength"])
+            if "albedo_modulation" in effects:
+                light = light * (clean + truth["floor"])
+            attacked = clean + light
+        else:
+            attacked = (1 - truth["opacity"] * s) * clean + truth["opacity"] * s * light
+        for name, image in (("clean", clean), ("attacked", np.clip(attacked, 0, 1)), ("pattern", projected)):
+            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else 1.0 / 255.0)
+        rows.append(
+            {
+                "clean": f"clean_{i}.png",
+                "attacked": f"attacked_{i}.png",
+                "pattern": f"pattern_{i}.png",
+                "intensity": round(s, 4),
+            }
+        )
+    write_table(folder, rows)
+    return truth
+
+
+def motion_blur(image: np.ndarray, dx: float, dy: float, positions: np.ndarray) -> np.ndarray:
+    height, width, _ = image.shape
+    ys, xs = np.mgrid[0:height, 0:width].astype(np.float64)
+    out = np.zeros_like(image)
+    for t in positions:
+        coords = [ys + t * dy, xs + t * dx]
+        for c in range(3):
+            out[..., c] += ndimage.map_coordinates(image[..., c], coords, order=1, mode="nearest")
+    return out / len(positions)
+
+
+def render_ultrasound_blur(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
+    rng = np.random.default_rng(seed)
+    angle = rng.uniform(0, np.pi)
+    length = rng.uniform(36.0, 56.0)  # pixels at full intensity on the 256-pixel reference scale
+    truth = {"angle": angle, "length": length}
+    phases = (np.arange(200) + 0.5) / 200
+    positions = 0.5 * np.sin(2 * np.pi * phases) if "sinusoidal_motion" in effects else phases - 0.5
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width, checkers=3)
+        s = rng.uniform(0.5, 1.0)
+        pixels = s * length * max(height, width) / 256
+        attacked = motion_blur(clean, pixels * np.cos(angle), pixels * np.sin(angle), positions)
+        save(folder / f"clean_{i}.png", clean, rng)
+        save(folder / f"attacked_{i}.png", attacked, rng)
+        rows.append({"clean": f"clean_{i}.png", "attacked": f"attacked_{i}.png", "intensity": round(s, 4)})
+    write_table(folder, rows)
+    return truth
+
+
+def render_em_color_strip(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
+    rng = np.random.default_rng(seed)
+    gain, offset = rng.uniform(1.3, 2.5), rng.uniform(0.0, 0.2)
+    period = rng.uniform(0.15, 0.4)
+    truth = {"gain": gain, "offset": offset, "period": period}
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width)
+        r = np.arange(height)
+        if "bayer_phase_flip" in effects:
+            mask = r >= rng.integers(int(0.2 * height), int(0.8 * height))
+        else:
+            mask = np.remainder(r - rng.uniform(0, period * height), period * height) < 0.5 * period * height
+        swapped = np.clip(gain * clean[..., 1], 0, 1)
+        mixed = np.clip(0.5 * (clean[..., 0] + clean[..., 2]) - offset, 0, 1)
+        wrong = np.stack([swapped, mixed, swapped], axis=-1)
+        attacked = np.where(mask[:, None, None], wrong, clean)
+        save(folder / f"clean_{i}.png", clean, rng)
+        save(folder / f"attacked_{i}.png", attacked, rng)
+        rows.append({"clean": f"clean_{i}.png", "attacked": f"attacked_{i}.png"})
+    write_table(folder, rows)
+    return truth
+
+
+RENDERERS = {
+    "laser_blinding": render_laser_blinding,
+    "light_projection": render_light_projection,
+    "ultrasound_blur": render_ultrasound_blur,
+    "em_color_strip": render_em_color_strip,
+}

@@ -1,0 +1,57 @@
+"""The calibration tool must find effects hidden in generated frame pairs (and add none when there are none)."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import pytest
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+import calibration_testkit as kit
+
+from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+
+CASES = [
+    ("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11),
+    ("laser_blinding", {"auto_exposure"}, 12),
+    ("light_projection", {"additive_light", "channel_crosstalk"}, 21),
+    ("ultrasound_blur", {"sinusoidal_motion"}, 31),
+    ("em_color_strip", {"bayer_phase_flip"}, 41),
+]
+
+
+@pytest.mark.parametrize(
+    ("attack", "planted", "seed"), CASES, ids=[f"{a}-{'+'.join(sorted(p))}" for a, p, _ in CASES]
+)
+def test_planted_effects_are_found(tmp_path, attack, planted, seed):
+    measured = tmp_path / "measured"
+    measured.mkdir()
+    kit.RENDERERS[attack](measured, planted, seed)
+    report = calibrate(
+        CalibrateConfig(attack=attack, measured=str(measured), out=str(tmp_path / "out"), seed=seed)
+    )
+
+    named = set(report["extended"]["effects"])
+    assert planted <= named, f"planted {planted}, named {named}"
+    assert len(named - planted) <= 1, f"unplanted effects added: {named - planted}"
+    assert report["gain"]["rmse_ratio"] >= 1.5
+    assert {f["effect"] for f in report["findings"]} == named
+    assert report["n_fit"] + report["n_heldout"] == 10
+    calibrated = json.loads((tmp_path / "out" / "calibrated.json").read_text())
+    assert calibrated["attack"] == attack and set(calibrated["effects"]) == named
+
+
+def test_no_planted_effect_keeps_the_base_model(tmp_path):
+    measured = tmp_path / "measured"
+    measured.mkdir()
+    kit.render_laser_blinding(measured, set(), seed=5)
+    report = calibrate(
+        CalibrateConfig(attack="laser_blinding", measured=str(measured), out=str(tmp_path / "out"))
+    )
+    assert report["extended"]["effects"] == []
+    assert report["findings"] == []
+    assert report["gain"]["rmse_ratio"] == pytest.approx(1.0)
+    # the base (alpha blend) recovers the generator's blend weight up to noise
+    assert report["base"]["heldout_rmse"] < 3.0
