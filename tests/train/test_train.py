@@ -174,3 +174,29 @@ def test_act_run_logs_per_attack_loss_with_log_step_forwards(tmp_path, tiny_data
     assert sum(record["loss_samples"].values()) == 4  # the log step's batch, split into its groups
     assert record["seen"]["total"] == 8
     assert_reloads_offline(pretrained_dir(out), tiny_dataset_root)
+
+
+@pytest.mark.slow
+def test_two_processes_share_one_epoch_plan(tmp_path, tiny_dataset_root, tiny_vlm):
+    """torchrun (what `accelerate launch` runs) with 2 CPU processes: each rank trains on its share of the sampler,
+    and the attacked count over one epoch, summed over both ranks, is still exactly round(rate * N)."""
+    import os
+    import subprocess
+    import sys
+
+    out = tmp_path / "ddp"
+    args = smolvla_args(tiny_dataset_root, tiny_vlm, out, "--batch_size=2", "--steps=6", "--log_freq=6")
+    command = [
+        sys.executable,
+        "-m",
+        "torch.distributed.run",
+        "--nproc_per_node=2",
+        "-m",
+        "lerobot_phantom.train.train",
+    ]
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "OMP_NUM_THREADS": "1"}
+    result = subprocess.run([*command, *args], env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    (record,) = loss_log(out)
+    assert record["seen"]["total"] == FRAMES  # 6 steps x batch 2 x 2 processes
+    assert record["seen"]["attacked"] == round(0.3 * FRAMES)
