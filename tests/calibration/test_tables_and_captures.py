@@ -1,0 +1,151 @@
+"""Stripe tables, colour-triple tables and laser captures, generated from known physics; input errors."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+from PIL import Image
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+import calibration_testkit as kit
+
+from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate, main
+from lerobot_phantom.transforms.calibrated import calibrated_kwargs
+
+
+def write_stripe_table(path, rng, row_time, offset, height=480, unit=1e-4, noise=1.0):
+    lines = ["frequency,exposure,duty_cycle,camera,affected_rows_mean"]
+    for exposure in (1, 4, 8, 12, 16, 20):
+        for duty in (2, 5, 10, 20, 30, 40):
+            rows = (duty / 100 / 40.0 + exposure * unit + offset) / row_time
+            lines.append(
+                f"40.0Hz,Exposure {exposure},{duty},Cam,{min(rows, height) + rng.normal(0, noise):.3f}"
+            )
+    path.write_text("\n".join(lines) + "\n")
+
+
+def test_stripe_table_names_overlap_and_offset(tmp_path):
+    rng = np.random.default_rng(3)
+    row_time, offset = rng.uniform(5e-5, 8e-5), rng.uniform(4e-4, 9e-4)
+    table = tmp_path / "stripes.csv"
+    write_stripe_table(table, rng, row_time, offset)
+    report = calibrate(
+        CalibrateConfig(
+            attack="laser_color_strip", measured=str(table), out=str(tmp_path / "out"), image_height=480
+        )
+    )
+    assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
+    assert report["extended"]["heldout_rmse"] < 3.0
+    assert report["gain"]["rmse_ratio"] > 10
+    assert report["extended"]["params"]["row_time_s"] == pytest.approx(row_time, rel=0.05)
+    kwargs = calibrated_kwargs("laser_color_strip", tmp_path / "out")
+    assert kwargs["model"] == "rolling_shutter" and kwargs["frame_rows"] == 480
+    assert (tmp_path / "out" / "report.md").read_text().count("exposure_overlap") >= 1
+
+
+def test_colour_triples_find_additive_light(tmp_path):
+    rng = np.random.default_rng(4)
+    surface = rng.uniform(0.05, 0.9, (600, 3))
+    projected = rng.choice([0.0, 127 / 255, 254 / 255], (600, 3))
+    captured = np.clip(surface + 0.5 * projected * (surface + 0.2) + rng.normal(0, 1 / 255, (600, 3)), 0, 1)
+    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
+    data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
+    table = tmp_path / "triples.csv"
+    table.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
+    report = calibrate(
+        CalibrateConfig(attack="light_projection", measured=str(table), out=str(tmp_path / "out"))
+    )
+    assert {"additive_light", "albedo_modulation"} <= set(report["extended"]["effects"])
+    assert report["extended"]["heldout_rmse"] < 3.0
+    assert report["gain"]["rmse_ratio"] >= 1.5
+
+
+def test_laser_capture_halo_exponent_is_recovered(tmp_path):
+    rng = np.random.default_rng(6)
+    height = width = 96
+    ys, xs = np.mgrid[0:height, 0:width]
+    r = np.hypot(xs - 50.3, ys - 44.7)
+    exponent = rng.uniform(1.6, 2.6)
+    profile = np.exp(-0.5 * (r / 4.0) ** 2) + 0.05 * (1 + r / 4.0) ** -exponent
+    irradiance = np.array([60.0, 3.0, 1.5]) * profile[..., None] + 0.01
+    for i in range(2):
+        kit.save(tmp_path / f"laser_{i}.png", kit.srgb_encode(irradiance), rng)
+    report = calibrate(
+        CalibrateConfig(
+            attack="laser_blinding", measured=str(tmp_path / "laser_0.png"), out=str(tmp_path / "out")
+        )
+    )
+    assert {"linear_light_saturation", "halo_power_law"} <= set(report["extended"]["effects"])
+    capture = report["extended"]["derived"]["captures"][0]
+    assert capture["halo_exponent"] == pytest.approx(exponent, abs=0.5)
+    # saturation: the red channel reaches white where 60 * profile = 1 (up to the sRGB background)
+    assert capture["saturation_radius_px"] == pytest.approx(4.0 * np.sqrt(2 * np.log(60.0)), rel=0.15)
+    assert report["gain"]["rmse_ratio"] >= 1.5
+
+
+def test_input_errors_are_clear(tmp_path):
+    table = tmp_path / "stripes.csv"
+    write_stripe_table(table, np.random.default_rng(0), 6e-5, 5e-4)
+    with pytest.raises(ValueError, match="stripe table.*laser_color_strip"):
+        calibrate(CalibrateConfig(attack="light_projection", measured=str(table), out=str(tmp_path / "o")))
+    with pytest.raises(ValueError, match="valid: laser_blinding"):
+        calibrate(CalibrateConfig(attack="laser_beam", measured=str(table), out=str(tmp_path / "o")))
+    (tmp_path / "other.csv").write_text("a,b\n1,2\n")
+    with pytest.raises(ValueError, match="unknown table"):
+        calibrate(
+            CalibrateConfig(
+                attack="light_projection", measured=str(tmp_path / "other.csv"), out=str(tmp_path / "o")
+            )
+        )
+    pairs = tmp_path / "pairs"
+    pairs.mkdir()
+    Image.new("RGB", (8, 8)).save(pairs / "a.png")
+    Image.new("RGB", (9, 8)).save(pairs / "b.png")
+    (pairs / "pairs.csv").write_text("clean,attacked\na.png,b.png\na.png,a.png\n")
+    with pytest.raises(ValueError, match="is \\(8, 8\\) but attacked"):
+        calibrate(CalibrateConfig(attack="ultrasound_blur", measured=str(pairs), out=str(tmp_path / "o")))
+    with pytest.raises(ValueError, match="inside the measured data"):
+        calibrate(CalibrateConfig(attack="ultrasound_blur", measured=str(pairs), out=str(pairs / "out")))
+    (pairs / "pairs.csv").write_text("clean,attacked\na.png,a.png\na.png,a.png\n")
+    with pytest.raises(ValueError, match="need a 'pattern' column"):
+        calibrate(CalibrateConfig(attack="light_projection", measured=str(pairs), out=str(tmp_path / "o")))
+
+
+def test_calibrated_kwargs_errors(tmp_path):
+    with pytest.raises(FileNotFoundError, match="lerobot-phantom-calibrate"):
+        calibrated_kwargs("laser_blinding", tmp_path)
+    (tmp_path / "calibrated.json").write_text(
+        json.dumps({"format": 1, "attack": "light_projection", "kwargs": {}})
+    )
+    with pytest.raises(ValueError, match="calibrates 'light_projection', not 'laser_blinding'"):
+        calibrated_kwargs("laser_blinding", tmp_path)
+    (tmp_path / "calibrated.json").write_text("{not json")
+    with pytest.raises(ValueError, match="not valid JSON"):
+        calibrated_kwargs("laser_blinding", tmp_path)
+
+
+def test_cli_main_accepts_dashed_options(tmp_path, capsys):
+    table = tmp_path / "stripes.csv"
+    write_stripe_table(table, np.random.default_rng(1), 6e-5, 5e-4, height=600)
+    main(
+        [
+            "--attack",
+            "laser_color_strip",
+            "--measured",
+            str(table),
+            "--out",
+            str(tmp_path / "out"),
+            "--image-height",
+            "600",
+            "--exposure-unit-s",
+            "1e-4",
+        ]
+    )
+    assert "laser_color_strip: base held-out RMSE" in capsys.readouterr().out
+    report = json.loads((tmp_path / "out" / "report.json").read_text())
+    assert set(report) >= {"attack", "input", "n_fit", "n_heldout", "base", "findings", "extended", "gain"}
+    assert calibrated_kwargs("laser_color_strip", tmp_path / "out")["frame_rows"] == 600

@@ -1,0 +1,103 @@
+"""Sensor-physics kernels: identities, limits and closed forms that could each fail."""
+
+from __future__ import annotations
+
+import math
+
+import pytest
+import torch
+
+from lerobot_phantom.transforms import physics
+
+
+def test_srgb_round_trip_and_reference_points():
+    x = torch.linspace(0, 1, 101, dtype=torch.float64)
+    assert torch.allclose(physics.linear_to_srgb(physics.srgb_to_linear(x)), x, atol=1e-9)
+    # sRGB mid-grey 0.5 is ~21.4% linear light (IEC 61966-2-1)
+    assert float(physics.srgb_to_linear(torch.tensor(0.5))) == pytest.approx(0.2140, abs=1e-3)
+
+
+def test_power_gamma_round_trip():
+    x = torch.rand(4, 3, 5, 5, generator=torch.Generator().manual_seed(0), dtype=torch.float64)
+    assert torch.allclose(physics.encode(physics.decode(x, 2.2), 2.2), x, atol=1e-9)
+
+
+def test_linear_light_injection_adds_clips_and_auto_exposure_darkens():
+    scene = torch.full((1, 3, 4, 4), 0.5)
+    none = physics.inject_linear_light(scene, torch.zeros_like(scene))
+    assert torch.allclose(none, scene, atol=1e-6)
+    strong = physics.inject_linear_light(scene, torch.full_like(scene, 5.0))
+    assert torch.allclose(strong, torch.ones_like(scene))  # saturates at white
+    light = torch.zeros_like(scene)
+    light[..., 0, 0] = 0.5
+    plain = physics.inject_linear_light(scene, light)
+    darker = physics.inject_linear_light(scene, light, auto_exposure=10.0)
+    assert (darker[..., 3, 3] < plain[..., 3, 3]).all()  # far from the light, the scene got darker
+
+
+def test_halo_is_power_law_and_saturation_radius_solves_profile():
+    r = torch.tensor([10.0, 20.0, 40.0], dtype=torch.float64)
+    halo = physics.power_law_halo(r, 1.0, 2.0, 1e-6)  # r >> scale: pure r^-2
+    assert float(halo[0] / halo[1]) == pytest.approx(4.0, rel=1e-4)
+    radius = physics.saturation_radius(10.0, 5.0)
+    value = 10.0 * math.exp(-0.5 * (radius / 5.0) ** 2)
+    assert value == pytest.approx(1.0, rel=1e-6)
+    assert physics.saturation_radius(0.5, 5.0) == 0.0
+
+
+def test_projected_light_on_black_surface_vanishes_with_albedo():
+    black = torch.zeros(1, 3, 2, 2)
+    pattern = torch.ones(1, 3, 2, 2)
+    assert torch.allclose(physics.project_light(black, pattern, 1.0, albedo=True), black)
+    lit = physics.project_light(black, pattern, 0.2, albedo=False)
+    assert (lit > 0.3).all()
+    swap = torch.tensor([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    red = torch.zeros(1, 3, 1, 1)
+    red[:, 0] = 1.0
+    out = physics.project_light(torch.zeros(1, 3, 1, 1), red, 0.5, albedo=False, crosstalk=swap)
+    assert out[0, 1, 0, 0] > 0.5 and out[0, 0, 0, 0] == 0  # red light seen in the green channel
+
+
+def test_rolling_shutter_rows_match_overlap_formula():
+    f, duty, exposure, row_time = torch.tensor([30.0]), torch.tensor([0.1]), torch.tensor([0.002]), 5e-5
+    rows = physics.rolling_shutter_rows_lit(f, duty, exposure, row_time, image_rows=720)
+    assert float(rows) == pytest.approx((0.1 / 30 + 0.002) / 5e-5)
+    offset = physics.rolling_shutter_rows_lit(
+        f, duty, exposure, row_time, image_rows=720, integration_offset_s=5e-4
+    )
+    assert float(offset - rows) == pytest.approx(10.0)
+    many = physics.rolling_shutter_rows_lit(
+        torch.tensor([1000.0]), torch.tensor([0.5]), exposure, row_time, image_rows=720, periodic=True
+    )
+    assert float(many) == pytest.approx(720.0)  # stripes repeat faster than they are wide: the frame is lit
+
+
+def test_rolling_shutter_row_light_counts_stripes():
+    light = physics.rolling_shutter_row_light(720, 750.0, 0.2, 3.2e-5, 4e-5, dtype=torch.float64)
+    lit = (light[0] > 0.5).to(torch.int8)
+    stripes = int((lit[1:] - lit[:-1] == 1).sum()) + int(lit[0])
+    period_rows = 1 / (750.0 * 4e-5)
+    assert abs(stripes - 720 / period_rows) <= 1.5
+
+
+def test_blur_paths_and_line_blur():
+    uniform = physics.blur_path_offsets("uniform", 1000, dtype=torch.float64)
+    sinus = physics.blur_path_offsets("sinusoidal", 1000, dtype=torch.float64)
+    # arcsine density: more samples near the ends than a uniform path
+    assert (sinus.abs() > 0.4).float().mean() > 2 * (uniform.abs() > 0.4).float().mean()
+    with pytest.raises(ValueError, match="uniform, sinusoidal"):
+        physics.blur_path_offsets("zigzag", 5)
+    x = torch.rand(2, 3, 16, 16, generator=torch.Generator().manual_seed(1))
+    assert torch.allclose(physics.line_blur(x, 0.0, 0.0, uniform.float()), x, atol=1e-5)
+    flat = torch.full((1, 3, 8, 8), 0.3)
+    assert torch.allclose(physics.line_blur(flat, 5.0, 2.0, sinus.float()[::50]), flat, atol=1e-6)
+
+
+def test_em_colour_map_and_masks():
+    x = torch.tensor([0.2, 0.3, 0.4]).reshape(1, 3, 1, 1)
+    y = physics.em_color_map(x, 2.0, 0.1)
+    assert torch.allclose(y.flatten(), torch.tensor([0.6, 0.2, 0.6]), atol=1e-6)
+    flip = physics.bayer_flip_mask(10, torch.tensor([4.0]))
+    assert flip.flatten().tolist() == [0.0] * 4 + [1.0] * 6
+    bands = physics.periodic_band_mask(8, 4.0)
+    assert bands.flatten().tolist() == [1, 1, 0, 0, 1, 1, 0, 0]
