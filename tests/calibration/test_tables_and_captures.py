@@ -90,7 +90,7 @@ def test_laser_capture_halo_exponent_is_recovered(tmp_path):
 def test_input_errors_are_clear(tmp_path):
     table = tmp_path / "stripes.csv"
     write_stripe_table(table, np.random.default_rng(0), 6e-5, 5e-4)
-    with pytest.raises(ValueError, match="stripe table.*laser_color_strip"):
+    with pytest.raises(ValueError, match=r"stripe table.*laser_color_strip"):
         calibrate(CalibrateConfig(attack="light_projection", measured=str(table), out=str(tmp_path / "o")))
     with pytest.raises(ValueError, match="valid: laser_blinding"):
         calibrate(CalibrateConfig(attack="laser_beam", measured=str(table), out=str(tmp_path / "o")))
