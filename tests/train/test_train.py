@@ -11,7 +11,16 @@ from safetensors.torch import load_file
 
 from lerobot_phantom.train.device_step import ATTACK_STEP_NAME
 from lerobot_phantom.train.loss_log import CLEAN, LOG_FILE_NAME
-from lerobot_phantom.train.train import main
+from lerobot_phantom.train.train import PhantomTrainPipelineConfig, main, train_phantom
+
+
+def parse_args(args: list[str]) -> PhantomTrainPipelineConfig:
+    import draccus
+
+    from lerobot_phantom import _lerobot_compat as compat
+
+    compat.train_script_module()  # registers LeRobot's policy config types
+    return draccus.parse(PhantomTrainPipelineConfig, args=args)
 
 
 def pretrained_dir(out: Path, step: str = "last") -> Path:
@@ -146,7 +155,8 @@ def test_lora_from_clean_checkpoint_then_resume_keeps_adapter_and_phantom(
 @pytest.mark.slow
 def test_act_run_logs_per_attack_loss_with_log_step_forwards(tmp_path, tiny_dataset_root):
     out = tmp_path / "act"
-    main(
+    # Built and run as a library call: train_phantom(cfg) (main() only adds argv handling for --policy.path/--resume).
+    cfg = parse_args(
         [
             *dataset_args(tiny_dataset_root),
             "--policy.type=act",
@@ -169,6 +179,7 @@ def test_act_run_logs_per_attack_loss_with_log_step_forwards(tmp_path, tiny_data
             "--phantom.rate=0.5",
         ]
     )
+    train_phantom(cfg)
     (record,) = loss_log(out)
     assert record["mode"] == "log_step_forward" and record["step"] == 2
     assert sum(record["loss_samples"].values()) == 4  # the log step's batch, split into its groups
