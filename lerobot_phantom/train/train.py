@@ -41,6 +41,12 @@ class PhantomTrainPipelineConfig(TrainPipelineConfig):
     def validate(self) -> None:
         super().validate()
         self.phantom.validate()
+        if self.dataset.streaming:
+            raise ValueError(
+                "--dataset.streaming=true is not supported by lerobot-phantom-train: the mixer plans exact attack "
+                "fractions per epoch over indexed samples. Train from a local copy, or write attacked data offline "
+                "with lerobot-phantom-augment and use plain lerobot-train."
+            )
 
 
 def _unwrap_policy(policy: Any) -> Any:

@@ -1,5 +1,6 @@
 """The hooks lerobot-phantom-train puts into LeRobot's loop: epoch counter, resume epoch, PEFT resume guard."""
 
+import pytest
 import torch
 
 from lerobot_phantom.config import PhantomConfig
@@ -78,3 +79,22 @@ def test_peft_guard_keeps_a_loaded_adapter_trainable_and_refuses_to_rewrap():
     # A plain policy, or no --peft.*, is left alone.
     plain = torch.nn.Linear(2, 2)
     assert guard_peft_resume(plain, peft_requested=True) is plain and not hasattr(plain, "wrap_with_peft")
+
+
+def test_streaming_datasets_are_refused_with_a_reason(tmp_path):
+    import draccus
+
+    from lerobot_phantom import _lerobot_compat as compat
+
+    compat.train_script_module()
+    cfg = draccus.parse(
+        PhantomTrainPipelineConfig,
+        args=[
+            "--dataset.repo_id=x",
+            "--dataset.streaming=true",
+            "--policy.type=act",
+            f"--output_dir={tmp_path / 'o'}",
+        ],
+    )
+    with pytest.raises(ValueError, match=r"--dataset\.streaming.*lerobot-phantom-augment"):
+        cfg.validate()
