@@ -93,6 +93,7 @@ def test_streaming_datasets_are_refused_with_a_reason(tmp_path):
             "--dataset.repo_id=x",
             "--dataset.streaming=true",
             "--policy.type=act",
+            "--policy.push_to_hub=false",
             f"--output_dir={tmp_path / 'o'}",
         ],
     )
