@@ -55,7 +55,7 @@ class CaptureProblem(Problem):
     base_model = "best-fitting Gaussian spot"
     extended_model = "saturating laser spot with glare"
     candidates = CAPTURE_EFFECTS
-    tile = 16
+    tile = 8
     max_fit_pixels = 6000
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
@@ -170,11 +170,15 @@ class CaptureProblem(Problem):
         if start is not None:
             warm = dict(start.params)
             if "linear_light_saturation" in effects and "linear_light_saturation" not in start.effects:
-                warm.pop("sigma")  # a saturating spot's core is narrower than the Gaussian that best fits it
+                # a saturating spot's core is narrower than the Gaussian that best fits it, and its glare is
+                # relative to a far higher peak
+                warm.pop("sigma")
+                warm.pop("log10_halo_amplitude", None)
         params = fit_least_squares(
             self.param_specs(effects),
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
+            starts=[{}] if warm else [],  # also from the defaults: saturated starts can stall
         )
         return Fit(effects, params)
 

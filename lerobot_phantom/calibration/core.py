@@ -264,10 +264,34 @@ def forward_select(
             break
         best = min(tried, key=tried.__getitem__)
         steps[-1].tried = tried
-        if tried[best] > (1.0 - margin) * current:
+        if tried[best] <= (1.0 - margin) * current:
+            chosen = chosen | {best}
+            current, parents = tried[best], fits[best]
+            steps.append(Step(sorted(chosen), current, {}))
+            continue
+        # Interacting effects can each be useless alone (a halo is invisible while the model cannot saturate):
+        # before stopping, try pairs, which must then bring twice the margin.
+        pairs: dict[tuple[str, str], tuple[float, list[Fit]]] = {}
+        for first in tried:
+            for effect in problem.candidates:
+                second = effect.name
+                if second in chosen or second <= first or (second not in tried and second != first):
+                    continue
+                if not set(effect.requires) <= chosen | {first}:
+                    continue
+                pairs[(first, second)] = cross_validated(
+                    problem, chosen | {first, second}, splits, fits[first]
+                )
+        if not pairs:
             break
-        chosen = chosen | {best}
-        current, parents = tried[best], fits[best]
+        pair = min(pairs, key=lambda k: pairs[k][0])
+        steps[-1].tried.update({"+".join(k): v[0] for k, v in pairs.items()})
+        if pairs[pair][0] > (1.0 - 2.0 * margin) * current:
+            break
+        first, second = sorted(pair, key=tried.__getitem__)
+        steps.append(Step(sorted(chosen | {first}), tried[first], {}))
+        chosen = chosen | {first, second}
+        current, parents = pairs[pair]
         steps.append(Step(sorted(chosen), current, {}))
     return chosen, steps
 

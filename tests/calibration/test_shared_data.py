@@ -1,0 +1,52 @@
+"""Acceptance on the measured third-party data in ../shared/measured (read by path; skipped when absent)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+
+MEASURED = Path(__file__).parents[2].parent / "shared" / "measured"
+
+pytestmark = [
+    pytest.mark.shared,
+    pytest.mark.skipif(not MEASURED.is_dir(), reason=f"measured data not found at {MEASURED}"),
+]
+
+
+def run(tmp_path, attack, relative):
+    return calibrate(
+        CalibrateConfig(attack=attack, measured=str(MEASURED / relative), out=str(tmp_path / "out"))
+    )
+
+
+def test_logitech_stripes(tmp_path):
+    report = run(tmp_path, "laser_color_strip", "rolling_shutter/logitech_stripe_rows.csv")
+    assert 80 <= report["base"]["heldout_rmse"] <= 140  # the paper's fixed band
+    assert report["extended"]["heldout_rmse"] <= 6.0
+    assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
+    # a 720-row frame read out in roughly one 30 fps frame time
+    assert 20 <= report["extended"]["derived"]["frame_readout_ms"] <= 40
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("name", "limit"), [("stop_sign", 12.0), ("bottle", 26.0)])
+def test_slap_triples(tmp_path, name, limit):
+    report = run(tmp_path, "light_projection", f"projection/slap_{name}_triples.csv")
+    assert 30 <= report["base"]["heldout_rmse"] <= 75  # the paper's alpha blend
+    assert report["extended"]["heldout_rmse"] <= limit
+    assert report["extended"]["effects"]
+
+
+@pytest.mark.slow
+def test_laser_capture_beats_gaussian_spot(tmp_path):
+    report = run(tmp_path, "laser_blinding", "blinding/phantom_green_laser.png")
+    assert report["extended"]["heldout_rmse"] <= 0.9 * report["base"]["heldout_rmse"]
+    capture = report["extended"]["derived"]["captures"][0]
+    assert "halo_power_law" in report["extended"]["effects"] and capture["halo_exponent"] > 0
+    assert capture["saturation_radius_px"] > 0
