@@ -371,7 +371,8 @@ class MakeVLMConfig:
     tasks: list[str] = field(default_factory=list)
 
 
-def main(args: Sequence[str] | None = None) -> Path:
+def main(args: Sequence[str] | None = None) -> None:
+    # Returns None: console scripts pass main()'s return value to sys.exit.
     cfg = draccus.parse(MakeVLMConfig, args=args)
     if not cfg.out:
         raise ValueError(
@@ -383,7 +384,6 @@ def main(args: Sequence[str] | None = None) -> Path:
         f"wrote {path}; train with --policy.vlm_model_name={path} --policy.load_vlm_weights=false "
         f"--policy.resize_imgs_with_padding='[{image_size},{image_size}]'"
     )
-    return path
 
 
 if __name__ == "__main__":
