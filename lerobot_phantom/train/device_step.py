@@ -50,6 +50,8 @@ class PhantomAttackProcessorStep(compat.processor_step_base()):
         if isinstance(self.phantom, dict):
             self.phantom = PhantomConfig(**self.phantom)
         config = self.phantom
+        # The mixer draws a sample's per-camera parameters in this order (explicit --phantom.cameras keep theirs).
+        self._camera_order = config.resolve_cameras(list(self.camera_keys)) if self.camera_keys else []
         self._attacks = {
             name: make_attack(name, intensity=config.intensity, calibration=config.calibration)
             for name in dict.fromkeys([*config.attacks, *config.instruction_attacks])
@@ -101,7 +103,7 @@ class PhantomAttackProcessorStep(compat.processor_step_base()):
             # One generator per sample is drawn from in camera order, so draw each sample's full list once.
             per_sample: dict[int, dict[str, dict[str, torch.Tensor]]] = {}
             for i in members:
-                cameras = [k for k in self.camera_keys if masks[i] >> self.camera_keys.index(k) & 1]
+                cameras = [k for k in self._camera_order if masks[i] >> self.camera_keys.index(k) & 1]
                 missing = [k for k in cameras if k not in observation]
                 if missing:
                     raise KeyError(

@@ -40,7 +40,7 @@ def identity_pipeline():
     return PolicyProcessorPipeline(steps=[], name="policy_preprocessor")
 
 
-@pytest.mark.parametrize("cameras", [["all"], ["random"]])
+@pytest.mark.parametrize("cameras", [["all"], ["random"], [CAMERAS[1], CAMERAS[0]]])
 def test_device_step_reproduces_the_dataloader_path(two_camera_dataset, cameras):
     config = PhantomConfig(
         rate=0.9,
