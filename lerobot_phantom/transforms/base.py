@@ -18,6 +18,7 @@ flattened into the batch), C in {1, 3, 4}; output has the input's dtype, shape a
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 import torch
@@ -31,6 +32,9 @@ REFERENCE_SIZE = 256
 """Pixel-sized parameters (blur displacement, pattern offsets) are defined on a 256x256 image and scale with size."""
 
 SUPPORTED_CHANNELS = (1, 3, 4)
+
+MAX_CACHED = 8
+"""Derived tensors (patterns, profiles) kept per attack instance, one per image size and device."""
 
 
 def derive_seed(*parts: int | str) -> int:
@@ -91,10 +95,77 @@ def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tens
     return x.reshape(like.shape)
 
 
-class CameraAttack(v2.Transform):
-    """Base class; see the module docstring for the contract."""
+class SeededAttack:
+    """What every attack shares: its intensity, a lazily seeded generator, a per-instance cache, pickling.
+
+    The generator is seeded from (attack name, ``seed``, dataloader worker id), so workers draw different streams
+    and no global RNG is ever touched. Pickling keeps the generator's state and drops the cache (derived tensors,
+    rebuilt on demand), so an attack travels cheaply to dataloader workers.
+    """
 
     name: ClassVar[str] = ""
+
+    def _init_attack(
+        self, intensity: IntensitySpec, seed: int | None, generator: torch.Generator | None
+    ) -> None:
+        self.intensity = intensity
+        self.intensity_range = parse_intensity(intensity)
+        self.seed = seed
+        self._generator = generator
+        self._cache: dict[Any, Any] = {}
+
+    def _get_generator(self) -> torch.Generator:
+        if self._generator is None:
+            worker = get_worker_info()
+            worker_id = worker.id if worker is not None else -1
+            self._generator = torch.Generator().manual_seed(
+                derive_seed(self.name, 0 if self.seed is None else self.seed, worker_id)
+            )
+        return self._generator
+
+    def _cached(self, key: Any, make: Callable[[], Any]) -> Any:
+        """``make()`` once per key (image size, device, ...); the oldest entry goes past ``MAX_CACHED``."""
+        if key not in self._cache:
+            if len(self._cache) >= MAX_CACHED:
+                self._cache.pop(next(iter(self._cache)))
+            self._cache[key] = make()
+        return self._cache[key]
+
+    def _intensities(
+        self,
+        batch_size: int,
+        intensity: IntensitySpec | torch.Tensor | None,
+        generator: torch.Generator | None,
+        device: torch.device | str | None = None,
+    ) -> torch.Tensor:
+        """Per-sample intensities ``(batch_size,)``: the attack's own, a spec, or an explicit tensor."""
+        if isinstance(intensity, torch.Tensor):
+            s = intensity.to(device=device, dtype=torch.float32).reshape(-1).expand(batch_size).clone()
+            if not bool(((s >= 0) & (s <= 1)).all()):
+                raise ValueError(f"intensity must lie in [0, 1], got {s.tolist()}")
+            return s
+        rng = self.intensity_range if intensity is None else parse_intensity(intensity)
+        return sample_intensity(rng, batch_size, generator, device)
+
+    def __getstate__(self) -> dict[str, Any]:
+        state = self.__dict__.copy()
+        generator = state.pop("_generator", None)
+        state["_generator_state"] = None if generator is None else generator.get_state()
+        state["_cache"] = {}
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        generator_state = state.pop("_generator_state", None)
+        self.__dict__.update(state)
+        self._generator = None
+        if generator_state is not None:
+            self._generator = torch.Generator()
+            self._generator.set_state(generator_state)
+
+
+class CameraAttack(SeededAttack, v2.Transform):
+    """Base class; see the module docstring for the contract."""
+
     _transformed_types = (torch.Tensor, tv_tensors.Image, tv_tensors.Video)
 
     def __init__(
@@ -105,34 +176,7 @@ class CameraAttack(v2.Transform):
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__()
-        self.intensity = intensity
-        self.intensity_range = parse_intensity(intensity)
-        self.seed = seed
-        self._generator = generator
-
-    # -- randomness -----------------------------------------------------------------------------------
-    def _get_generator(self) -> torch.Generator:
-        if self._generator is None:
-            worker = get_worker_info()
-            worker_id = worker.id if worker is not None else -1
-            self._generator = torch.Generator().manual_seed(
-                derive_seed(self.name, 0 if self.seed is None else self.seed, worker_id)
-            )
-        return self._generator
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = self.__dict__.copy()
-        generator = state.pop("_generator", None)
-        state["_generator_state"] = None if generator is None else generator.get_state()
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        generator_state = state.pop("_generator_state", None)
-        self.__dict__.update(state)
-        self._generator = None
-        if generator_state is not None:
-            self._generator = torch.Generator()
-            self._generator.set_state(generator_state)
+        self._init_attack(intensity, seed, generator)
 
     # -- torchvision v2 hooks -------------------------------------------------------------------------
     def make_params(self, flat_inputs: list[Any]) -> dict[str, Any]:
@@ -160,13 +204,7 @@ class CameraAttack(v2.Transform):
         device: torch.device | str | None = None,
     ) -> dict[str, torch.Tensor]:
         """Draw ``batch_size`` parameter sets. ``intensity`` overrides the attack's own (a tensor: per sample)."""
-        if isinstance(intensity, torch.Tensor):
-            s = intensity.to(device=device, dtype=torch.float32).reshape(-1).expand(batch_size).clone()
-            if not ((s >= 0) & (s <= 1)).all():
-                raise ValueError(f"intensity must lie in [0, 1], got {s.tolist()}")
-        else:
-            rng = self.intensity_range if intensity is None else parse_intensity(intensity)
-            s = sample_intensity(rng, batch_size, generator, device)
+        s = self._intensities(batch_size, intensity, generator, device)
         params = self._sample(s, int(height), int(width), generator, device)
         params["intensity"] = s
         return params

@@ -30,17 +30,14 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Sequence
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import torch
-from torch.utils.data import get_worker_info
 
-from lerobot_phantom.transforms.base import derive_seed
+from lerobot_phantom.transforms.base import SeededAttack
 from lerobot_phantom.transforms.intensity import (
     IntensitySpec,
     interpolate_levels,
-    parse_intensity,
-    sample_intensity,
 )
 
 MODES: tuple[str, ...] = ("paper", "graded")
@@ -63,10 +60,8 @@ def _per_sample(values: torch.Tensor, batch: int, what: str) -> list:
     return flat.tolist()
 
 
-class InstructionAttack:
+class InstructionAttack(SeededAttack):
     """Common machinery of the instruction attacks (intensity, mode, seeded generator, pickling)."""
-
-    name: ClassVar[str] = ""
 
     def __init__(
         self,
@@ -78,34 +73,8 @@ class InstructionAttack:
     ) -> None:
         if mode not in MODES:
             raise ValueError(f"unknown mode {mode!r}; valid: {', '.join(MODES)}")
-        self.intensity = intensity
-        self.intensity_range = parse_intensity(intensity)
+        self._init_attack(intensity, seed, generator)
         self.mode = mode
-        self.seed = seed
-        self._generator = generator
-
-    def _get_generator(self) -> torch.Generator:
-        if self._generator is None:
-            worker = get_worker_info()
-            worker_id = worker.id if worker is not None else -1
-            self._generator = torch.Generator().manual_seed(
-                derive_seed(self.name, 0 if self.seed is None else self.seed, worker_id)
-            )
-        return self._generator
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = self.__dict__.copy()
-        generator = state.pop("_generator", None)
-        state["_generator_state"] = None if generator is None else generator.get_state()
-        return state
-
-    def __setstate__(self, state: dict[str, Any]) -> None:
-        generator_state = state.pop("_generator_state", None)
-        self.__dict__.update(state)
-        self._generator = None
-        if generator_state is not None:
-            self._generator = torch.Generator()
-            self._generator.set_state(generator_state)
 
     def __call__(self, task: str | Sequence[str]) -> str | list[str]:
         single = isinstance(task, str)
@@ -122,13 +91,7 @@ class InstructionAttack:
         generator: torch.Generator | None = None,
     ) -> dict[str, torch.Tensor]:
         """Per-sample parameters: ``"intensity"`` (B,) and ``"word_seed"`` (B,) (drawn only when needed)."""
-        if isinstance(intensity, torch.Tensor):
-            s = intensity.to(torch.float32).reshape(-1).expand(batch_size).clone()
-            if not bool(((s >= 0) & (s <= 1)).all()):
-                raise ValueError(f"intensity must lie in [0, 1], got {s.tolist()}")
-        else:
-            rng = self.intensity_range if intensity is None else parse_intensity(intensity)
-            s = sample_intensity(rng, batch_size, generator)
+        s = self._intensities(batch_size, intensity, generator)
         if self._needs_word_seed():
             if generator is None:
                 raise ValueError(

@@ -40,7 +40,6 @@ from lerobot_phantom.transforms.patterns import (
 )
 
 ALPHA_LEVELS: tuple[float, float, float, float] = (0.0, 0.1, 0.5, 0.9)
-_MAX_CACHED = 8
 
 
 def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.device) -> torch.Tensor:
@@ -142,12 +141,6 @@ class LaserBlinding(CameraAttack):
         laser_spot(1, 1, center=(0.0, 0.0), **self.spot_kwargs)  # validate the shape parameters now
         # Loaded once here (not on every call, the paper code's defect); travels with the pickle.
         self._user_pattern = None if pattern is None else load_pattern_image(pattern, keep_alpha=False)
-        self._cache: dict[tuple, torch.Tensor] = {}
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = super().__getstate__()
-        state["_cache"] = {}
-        return state
 
     # -- parameters ---------------------------------------------------------------------------------------------
     def _sample(
@@ -170,16 +163,9 @@ class LaserBlinding(CameraAttack):
         return {"alpha": interpolate_levels(s, self.levels), "position": position.clone()}
 
     # -- pattern ---------------------------------------------------------------------------------------------------
-    def _remember(self, key: tuple, make: Any) -> torch.Tensor:
-        if key not in self._cache:
-            if len(self._cache) >= _MAX_CACHED:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = make()
-        return self._cache[key]
-
     def _resized_user_pattern(self, height: int, width: int, device: torch.device) -> torch.Tensor:
         assert self._user_pattern is not None
-        return self._remember(
+        return self._cached(
             ("user", height, width, str(device)),
             lambda: resize_pattern(self._user_pattern.to(device), height, width),
         )
@@ -214,7 +200,7 @@ class LaserBlinding(CameraAttack):
             shifted[:, dst_r, dst_c] = base[:, src_r, src_c]
             return shifted
 
-        return self._remember(("single", height, width, row, col, str(device)), make)
+        return self._cached(("single", height, width, row, col, str(device)), make)
 
     def _canvas(self, height: int, width: int, device: torch.device) -> torch.Tensor:
         """A ``(3, 2H-1, 2W-1)`` canvas with the pattern centred at (H-1, W-1): crops give every position."""
@@ -236,7 +222,7 @@ class LaserBlinding(CameraAttack):
             )
             return canvas
 
-        return self._remember(("canvas", height, width, str(device)), make)
+        return self._cached(("canvas", height, width, str(device)), make)
 
     def patterns_for(
         self, position: torch.Tensor, height: int, width: int, device: torch.device

@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import torch
 
@@ -40,7 +40,6 @@ from lerobot_phantom.transforms.patterns import check_levels
 
 STRENGTH_LEVELS: tuple[float, float, float, float] = (0.0, 500.0, 1500.0, 2500.0)
 PAPER_COLOR_FRACTIONS: tuple[float, float, float] = (0.6, 0.1, 0.1)
-_MAX_CACHED = 8
 
 
 def band_rows(height: int) -> tuple[int, int]:
@@ -117,12 +116,6 @@ class LaserColorStrip(CameraAttack):
                 f"color_fractions must be three values in [0, 1] (R, G, B), got {color_fractions!r}"
             )
         self.color_fractions = fractions
-        self._cache: dict[tuple, torch.Tensor] = {}
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = super().__getstate__()
-        state["_cache"] = {}
-        return state
 
     def _sample(
         self,
@@ -140,12 +133,7 @@ class LaserColorStrip(CameraAttack):
 
     def profile(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
         """The cached S = 1 band profile for this image size."""
-        key = (height, width, str(device))
-        if key not in self._cache:
-            if len(self._cache) >= _MAX_CACHED:
-                self._cache.pop(next(iter(self._cache)))
-            self._cache[key] = strip_profile(height, width, device)
-        return self._cache[key]
+        return self._cached((height, width, str(device)), lambda: strip_profile(height, width, device))
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         profile = self.profile(*x.shape[-2:], device=x.device)

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import ClassVar
 
 import torch
 
@@ -50,7 +50,6 @@ from lerobot_phantom.transforms.patterns import (
 
 TRANSPARENCY_LEVELS: tuple[float, float, float, float] = (0.0, 0.1, 0.5, 0.9)
 _ALPHA_EPS = 1e-4  # int(a * t) in float64 vs float32: keep exact products like 30 * 0.1 on the same side
-_MAX_CACHED = 8
 
 
 def _scaled_alpha(alpha: torch.Tensor, transparency: torch.Tensor) -> torch.Tensor:
@@ -179,12 +178,6 @@ class LightProjection(CameraAttack):
             raise ValueError(
                 f"unknown projection pattern {pattern!r}; valid: {', '.join(PROJECTION_SHAPES)} or an image path"
             )
-        self._cache: dict[tuple, torch.Tensor] = {}
-
-    def __getstate__(self) -> dict[str, Any]:
-        state = super().__getstate__()
-        state["_cache"] = {}
-        return state
 
     def _sample(
         self,
@@ -207,16 +200,13 @@ class LightProjection(CameraAttack):
     def watermark(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
         """The RGBA watermark ``(4, h, w)`` for an image of this size (alpha on the 1/255 grid); cached."""
         box = max(1, round(self.size * min(height, width)))
-        key = (box, str(device))
-        if key not in self._cache:
-            if len(self._cache) >= _MAX_CACHED:
-                self._cache.pop(next(iter(self._cache)))
+
+        def make() -> torch.Tensor:
             if self._user_pattern is None:
-                rgba = projection_shape(self.pattern, box)
-            else:
-                rgba = _resize_rgba(self._user_pattern, *fit_size(*self._user_pattern.shape[-2:], box))
-            self._cache[key] = rgba.to(device)
-        return self._cache[key]
+                return projection_shape(self.pattern, box).to(device)
+            return _resize_rgba(self._user_pattern, *fit_size(*self._user_pattern.shape[-2:], box)).to(device)
+
+        return self._cached((box, str(device)), make)
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         height, width = x.shape[-2:]
