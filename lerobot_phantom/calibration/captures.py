@@ -56,7 +56,7 @@ class CaptureProblem(Problem):
     extended_model = "saturating laser spot with glare"
     candidates = CAPTURE_EFFECTS
     tile = 8
-    max_fit_pixels = 6000
+    max_fit_pixels = 3000
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
         from PIL import Image
@@ -179,6 +179,7 @@ class CaptureProblem(Problem):
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
             starts=[{}] if warm else [],  # also from the defaults: saturated starts can stall
+            max_nfev=100,
         )
         return Fit(effects, params)
 

@@ -275,8 +275,8 @@ def forward_select(
         for first in tried:
             for effect in problem.candidates:
                 second = effect.name
-                if second in chosen or second <= first or (second not in tried and second != first):
-                    continue
+                if second == first or second in chosen or (second in tried and second < first):
+                    continue  # each unordered pair once
                 if not set(effect.requires) <= chosen | {first}:
                     continue
                 pairs[(first, second)] = cross_validated(

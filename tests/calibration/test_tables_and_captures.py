@@ -64,13 +64,14 @@ def test_colour_triples_find_additive_light(tmp_path):
     assert report["gain"]["rmse_ratio"] >= 1.5
 
 
+@pytest.mark.slow
 def test_laser_capture_halo_exponent_is_recovered(tmp_path):
     rng = np.random.default_rng(6)
-    height = width = 96
+    height = width = 64
     ys, xs = np.mgrid[0:height, 0:width]
-    r = np.hypot(xs - 50.3, ys - 44.7)
+    r = np.hypot(xs - 33.3, ys - 29.7)
     exponent = rng.uniform(1.6, 2.6)
-    profile = np.exp(-0.5 * (r / 4.0) ** 2) + 0.05 * (1 + r / 4.0) ** -exponent
+    profile = np.exp(-0.5 * (r / 3.0) ** 2) + 0.05 * (1 + r / 3.0) ** -exponent
     irradiance = np.array([60.0, 3.0, 1.5]) * profile[..., None] + 0.01
     for i in range(2):
         kit.save(tmp_path / f"laser_{i}.png", kit.srgb_encode(irradiance), rng)
@@ -83,7 +84,7 @@ def test_laser_capture_halo_exponent_is_recovered(tmp_path):
     capture = report["extended"]["derived"]["captures"][0]
     assert capture["halo_exponent"] == pytest.approx(exponent, abs=0.5)
     # saturation: the red channel reaches white where 60 * profile = 1 (up to the sRGB background)
-    assert capture["saturation_radius_px"] == pytest.approx(4.0 * np.sqrt(2 * np.log(60.0)), rel=0.15)
+    assert capture["saturation_radius_px"] == pytest.approx(3.0 * np.sqrt(2 * np.log(60.0)), rel=0.15)
     assert report["gain"]["rmse_ratio"] >= 1.5
 
 
