@@ -134,6 +134,7 @@ def calibrate(cfg: CalibrateConfig) -> dict:
             steps=steps,
             seed=cfg.seed,
             margin=cfg.margin,
+            folds=cfg.folds,
         )
         write_outputs(problem, report, base, extended, heldout_items, out)
     return report

@@ -365,7 +365,11 @@ class BlindingFrames(PixelProblem):
             )
         super().__init__(pairs, seed)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
-        self.mean_light = [float(physics.srgb_to_linear(p.pattern).mean()) for p in pairs]
+        # a fixed sample of each pattern's pixels: the mean light the exposure meter sees, for any tone curve
+        probe_rng = np.random.default_rng(seed + 7)
+        self.pattern_probe = torch.stack(
+            [_flat(p.pattern, torch.as_tensor(probe_rng.choice(p.height * p.width, 1024))) for p in pairs]
+        )
         self.colours = []
         for p in pairs:
             lin = physics.srgb_to_linear(p.pattern).reshape(3, -1)
@@ -393,7 +397,7 @@ class BlindingFrames(PixelProblem):
             "pattern": _flat(pair.pattern, pixels),
             "radius": radius,
             "strength": torch.full((n, 1), pair.intensity, dtype=torch.float64),
-            "mean_light": torch.full((n, 1), self.mean_light[index], dtype=torch.float64),
+            "pair": torch.full((n,), index, dtype=torch.long),
             "colour": self.colours[index].reshape(1, 3).expand(n, 3),
         }
 
@@ -429,7 +433,10 @@ class BlindingFrames(PixelProblem):
         else:
             opacity = (params["alpha"] * s).clamp(0.0, 1.0)
             light, scene_weight = opacity * pattern, 1.0 - opacity
-        mean_light = s * f["mean_light"]
+        # the exposure meter sees the injected pattern light (not the scene), as physics.laser_injection
+        pattern_mean = physics.decode(self.pattern_probe, gamma).mean(dim=(1, 2))[f["pair"]].unsqueeze(1)
+        level = params["gain"] if "linear_light_saturation" in effects else params["alpha"]
+        mean_light = level * s * pattern_mean
         if "halo_power_law" in effects:
             halo = physics.power_law_halo(
                 f["radius"], params["halo_amplitude"], params["halo_exponent"], params["halo_scale_ref_px"]

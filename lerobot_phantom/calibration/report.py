@@ -38,11 +38,11 @@ def build_report(
     steps: list[Step],
     seed: int,
     margin: float,
+    folds: int,
 ) -> dict:
     base, extended = chain[0], chain[-1]
     base_rmse = problem.rmse(base, heldout_items)
     extended_rmse = problem.rmse(extended, heldout_items)
-    order = [s.effects for s in steps]
     findings = []
     for k, (before_step, after_step) in enumerate(itertools.pairwise(steps)):
         (effect,) = set(after_step.effects) - set(before_step.effects)
@@ -77,8 +77,9 @@ def build_report(
             "selection_margin": margin,
         },
         "selection": {
-            "criterion": f"inner {len(order)}-step forward selection on the fit split, k-fold validation RMSE, "
-            f"each kept extension must lower it by >= {100 * margin:.0f}%",
+            "criterion": f"forward selection on the fit split by {folds}-fold cross-validated RMSE; each kept "
+            f"extension must lower it by >= {100 * margin:.0f}% (a pair of interacting extensions by "
+            f">= {200 * margin:.0f}%)",
             "steps": [
                 {"effects": s.effects, "validation_rmse": s.validation_rmse, "tried": s.tried} for s in steps
             ],

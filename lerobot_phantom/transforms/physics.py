@@ -64,19 +64,21 @@ def inject_linear_light(
     light: torch.Tensor,
     *,
     auto_exposure: float | torch.Tensor = 0.0,
+    metered_light: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
     gamma: float | torch.Tensor | None = None,
 ) -> torch.Tensor:
-    """Add ``light`` (linear irradiance, same shape as ``x`` or broadcastable) to the scene in linear light.
+    """Add ``light`` (linear irradiance, broadcastable to ``x``) to the scene in linear light, clip, re-encode.
 
-    ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean injected light)``, darkening the whole
-    frame; ``white``: linear level at which the sensor saturates (clipping); ``gamma``: None = sRGB tone curve.
+    ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean(metered_light))`` (default: the injected
+    light), darkening the whole frame; ``white``: linear level at which the sensor saturates; ``gamma``: None =
+    the sRGB tone curve, a number = a power law (1 = compose the encoded values).
     """
     scene = decode(x, gamma)
-    mean_light = light.mean(dim=tuple(range(1, light.ndim)))
-    gain = 1.0 / (1.0 + _as(auto_exposure, mean_light) * mean_light)
-    total = gain.reshape(-1, *([1] * (x.ndim - 1))) * (scene + light)
-    return encode(torch.minimum(total, _as(white, total)) / _as(white, total), gamma)
+    metered = light if metered_light is None else metered_light
+    mean_light = metered.reshape(metered.shape[0], -1).mean(dim=1).reshape(-1, *([1] * (x.ndim - 1)))
+    total = (scene + light) / (1.0 + _as(auto_exposure, scene) * mean_light)
+    return encode(torch.minimum(total.clamp(min=0.0), _as(white, total)), gamma)
 
 
 def radial_distance(
@@ -155,28 +157,60 @@ def project_light(
     pattern: torch.Tensor,
     strength: float | torch.Tensor,
     *,
-    albedo: bool = True,
-    ambient: float | torch.Tensor = 1.0,
+    albedo: bool = False,
+    reflectance_floor: float | torch.Tensor = 0.0,
     crosstalk: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
-    gamma: float | torch.Tensor | None = None,
+    gamma: float | torch.Tensor | None = 1.0,
 ) -> torch.Tensor:
-    """Projector light on a surface seen by a camera, in linear light.
+    """Projector light on a surface seen by a camera: light adds, it never blends.
 
-    The projected colour ``pattern`` (encoded, like an image) reaches the camera as ``crosstalk @ rgb`` (3x3: the
-    projector's primaries seen through the camera's filters), scaled by ``strength`` and, with ``albedo``, by the
-    surface reflectance estimated as scene linear colour / ``ambient`` (light only adds what the surface
-    reflects). The result clips at ``white`` and is re-encoded.
+    The projected colour ``pattern`` (encoded, like an image; black = no light) reaches the camera as
+    ``crosstalk @ rgb`` (3x3: the projector's primaries seen through the camera's filters), scaled by ``strength``
+    and, with ``albedo``, by the surface's reflectance estimated from its colour (``scene + reflectance_floor``).
+    The sum clips at ``white`` and is re-encoded; ``gamma`` as in ``decode`` (1 = compose the encoded values).
     """
     scene = decode(x, gamma)
     light = decode(pattern, gamma)
     if crosstalk is not None:
-        light = torch.einsum("ij,bjhw->bihw", crosstalk.to(light.dtype), light)
+        light = torch.einsum(
+            "ij,bjhw->bihw", torch.as_tensor(crosstalk, dtype=light.dtype, device=light.device), light
+        )
     light = _as(strength, light) * light
     if albedo:
-        light = light * scene / _as(ambient, scene)
-    total = scene + light
-    return encode(torch.minimum(total, _as(white, total)) / _as(white, total), gamma)
+        light = light * (scene + _as(reflectance_floor, scene))
+    total = torch.minimum(scene + light, _as(white, scene))
+    return encode(total.clamp(min=0.0), gamma)
+
+
+def laser_injection(
+    x: torch.Tensor,
+    pattern: torch.Tensor,
+    power: torch.Tensor,
+    *,
+    centre: torch.Tensor | None = None,
+    color: torch.Tensor | None = None,
+    halo_amplitude: float = 0.0,
+    halo_exponent: float = 2.0,
+    halo_scale_px: float = 1.0,
+    auto_exposure: float = 0.0,
+    gamma: float | None = None,
+) -> torch.Tensor:
+    """A laser shone into the camera, physically: the recorded ``pattern`` (encoded, ``(B or 1, 3, H, W)``) is
+    linear light scaled by ``power`` (per sample), plus an optional power-law glare around ``centre`` (``(B, 2)``
+    pixel (x, y)) in the laser's ``color``; the sum adds to the scene in linear light, the auto-exposure meters
+    the pattern's light, and the sensor clips before the tone curve."""
+    height, width = x.shape[-2:]
+    power = torch.as_tensor(power, dtype=x.dtype, device=x.device).reshape(-1, 1, 1, 1)
+    light = power * decode(pattern.to(x.dtype), gamma)
+    metered = light
+    if halo_amplitude > 0.0:
+        if centre is None or color is None:
+            raise ValueError("a halo needs the spot centre and the laser colour")
+        radius = radial_distance(height, width, centre, dtype=x.dtype, device=x.device)
+        glare = power_law_halo(radius, halo_amplitude, halo_exponent, halo_scale_px)
+        light = light + power * glare * color.to(x.dtype).reshape(1, 3, 1, 1)
+    return inject_linear_light(x, light, auto_exposure=auto_exposure, metered_light=metered, gamma=gamma)
 
 
 # ---------------------------------------------------------------------------------------------------------------

@@ -35,6 +35,29 @@ def test_linear_light_injection_adds_clips_and_auto_exposure_darkens():
     assert (darker[..., 3, 3] < plain[..., 3, 3]).all()  # far from the light, the scene got darker
 
 
+def test_laser_injection_adds_pattern_light_and_glare():
+    scene = torch.full((2, 3, 16, 16), 0.3)
+    pattern = torch.zeros(1, 3, 16, 16)
+    pattern[:, :, 7:9, 7:9] = 1.0
+    off = physics.laser_injection(scene, pattern, torch.zeros(2))
+    assert torch.allclose(off, scene, atol=1e-5)
+    on = physics.laser_injection(scene, pattern, torch.tensor([0.5, 2.0]))
+    assert (on[1, :, 8, 8] > 0.999).all() and (on[0, :, 8, 8] < 0.9).all()  # the stronger laser saturates
+    assert torch.allclose(on[:, :, 0, 0], scene[:, :, 0, 0], atol=1e-5)  # no light, no change
+    glare = physics.laser_injection(
+        scene,
+        pattern,
+        torch.tensor([1.0, 1.0]),
+        centre=torch.tensor([[8.0, 8.0], [8.0, 8.0]]),
+        color=torch.tensor([0.0, 1.0, 0.0]),
+        halo_amplitude=0.5,
+        halo_scale_px=2.0,
+    )
+    assert glare[0, 1, 0, 0] > on[0, 1, 0, 0] + 0.05 and glare[0, 0, 0, 0] == pytest.approx(0.3, abs=1e-5)
+    dimmed = physics.laser_injection(scene, pattern, torch.tensor([1.0, 1.0]), auto_exposure=50.0)
+    assert (dimmed[:, :, 0, 0] < 0.25).all()
+
+
 def test_halo_is_power_law_and_saturation_radius_solves_profile():
     r = torch.tensor([10.0, 20.0, 40.0], dtype=torch.float64)
     halo = physics.power_law_halo(r, 1.0, 2.0, 1e-6)  # r >> scale: pure r^-2
@@ -49,13 +72,18 @@ def test_projected_light_on_black_surface_vanishes_with_albedo():
     black = torch.zeros(1, 3, 2, 2)
     pattern = torch.ones(1, 3, 2, 2)
     assert torch.allclose(physics.project_light(black, pattern, 1.0, albedo=True), black)
+    assert (physics.project_light(black, pattern, 1.0, albedo=True, reflectance_floor=0.2) > 0.1).all()
     lit = physics.project_light(black, pattern, 0.2, albedo=False)
-    assert (lit > 0.3).all()
+    assert torch.allclose(lit, torch.full_like(lit, 0.2))  # gamma 1: composes the encoded values
+    lit_srgb = physics.project_light(black, pattern, 0.2, albedo=False, gamma=None)
+    assert (lit_srgb > 0.45).all()  # 20% linear light is ~48% in sRGB
     swap = torch.tensor([[0.0, 1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
     red = torch.zeros(1, 3, 1, 1)
     red[:, 0] = 1.0
     out = physics.project_light(torch.zeros(1, 3, 1, 1), red, 0.5, albedo=False, crosstalk=swap)
-    assert out[0, 1, 0, 0] > 0.5 and out[0, 0, 0, 0] == 0  # red light seen in the green channel
+    assert (
+        float(out[0, 1, 0, 0]) == pytest.approx(0.5, abs=1e-5) and float(out[0, 0, 0, 0]) < 1e-6
+    )  # red light seen in the green channel
 
 
 def test_rolling_shutter_rows_match_overlap_formula():
