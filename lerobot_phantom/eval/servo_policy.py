@@ -200,6 +200,7 @@ OBJECT_PLANE_Z = OBJECT_HALF_SIZE
 PLATE_PLANE_Z = PLATE_TOP / 2
 BASKET_PLANE_Z = 0.012
 MIN_BLOB_PIXELS = 3
+TRACK_RADIUS_PX = 7 / 96  # x image height; identical objects are >= 10 cm (~16 px at 96x96) apart (spatial)
 HUE_RANGES = {  # degrees
     "red": ((345.0, 360.0), (0.0, 15.0)),
     "orange": ((18.0, 38.0),),
@@ -367,6 +368,9 @@ class _EpisodeState:
     )  # ObjectRef -> xy of the chosen one of the identical objects
 
 
+LOOK_POSE = np.array([-0.2, 0.0, 0.2])  # the env's start pose: the gripper is at the top edge of the image
+
+
 def _move_towards(tcp: np.ndarray, waypoint: np.ndarray) -> np.ndarray:
     delta = (waypoint - tcp) / MAX_STEP_M
     largest = float(np.max(np.abs(delta)))
@@ -451,15 +455,15 @@ class PhantomServoPolicy(PreTrainedPolicy):
                 continue
             points = np.stack([xs + 0.5, ys + 0.5], axis=1)
             if isinstance(entity, ObjectRef) and entity.side is not None:
-                if len(points) < 2 * MIN_BLOB_PIXELS:
-                    continue
-                groups = sorted(two_clusters(points), key=lambda g: g[:, 0].mean())
                 chosen = episode.side_choice.get(entity)
-                if chosen is None:
+                if chosen is None:  # pick left or right once, while both are in view
+                    if len(points) < 2 * MIN_BLOB_PIXELS:
+                        continue
+                    groups = sorted(two_clusters(points), key=lambda g: g[:, 0].mean())
                     blob = groups[SIDES.index(entity.side)]
-                else:  # follow the object chosen at the start, wherever it went since
+                else:  # then follow that object: the pixels of its colour around where it was last seen
                     centre = camera.project(np.array([*chosen, OBJECT_PLANE_Z]), height, width)[0]
-                    blob = min(groups, key=lambda g: float(np.linalg.norm(g.mean(0) - centre)))
+                    blob = points[np.linalg.norm(points - centre, axis=1) <= TRACK_RADIUS_PX * height]
             else:
                 blob = points
             if len(blob) < MIN_BLOB_PIXELS:
@@ -482,6 +486,12 @@ class PhantomServoPolicy(PreTrainedPolicy):
         if abs(tcp[2] - goal_z) > tol:
             return _move_towards(tcp, np.array([*goal_xy, goal_z]))
         return None
+
+    def _towards_look_pose(self, tcp: np.ndarray) -> np.ndarray:
+        """Up first, then to the start pose, from where the gripper hides nothing on the table."""
+        if tcp[2] < self.config.travel_z - self.config.reach_tolerance:
+            return _move_towards(tcp, np.array([*tcp[:2], self.config.travel_z]))
+        return _move_towards(tcp, LOOK_POSE)
 
     def _control(self, episode: _EpisodeState, tcp, opening, still) -> np.ndarray:
         goals = episode.plan.goals
@@ -507,8 +517,8 @@ class PhantomServoPolicy(PreTrainedPolicy):
             if opening < OPEN_OPENING:
                 return act(None, close=False)
             obj_xy = episode.estimates.get(goal.obj)
-            if obj_xy is None:
-                return act(None, close=False)  # nothing seen yet: wait
+            if obj_xy is None:  # not seen (yet): get the hand out of the camera's way and look again
+                return act(self._towards_look_pose(tcp), close=False)
             move = self._go_via_travel_height(tcp, obj_xy, OBJECT_HALF_SIZE)
             if move is None:
                 episode.phase = "grasp"
@@ -521,7 +531,7 @@ class PhantomServoPolicy(PreTrainedPolicy):
                 return act(None, close=False)
             target_xy = episode.estimates.get(goal.target)
             if target_xy is None:
-                return act(None, close=True)
+                return act(self._towards_look_pose(tcp), close=True)
             if goal.relation == "stack":
                 support = 2 * OBJECT_HALF_SIZE
             else:
