@@ -50,7 +50,7 @@ def test_laser_injection_adds_pattern_light_and_glare():
         torch.tensor([1.0, 1.0]),
         centre=torch.tensor([[8.0, 8.0], [8.0, 8.0]]),
         color=torch.tensor([0.0, 1.0, 0.0]),
-        halo_amplitude=0.5,
+        halo_amplitude=5.0,
         halo_scale_px=2.0,
     )
     assert glare[0, 1, 0, 0] > on[0, 1, 0, 0] + 0.05 and glare[0, 0, 0, 0] == pytest.approx(0.3, abs=1e-5)
