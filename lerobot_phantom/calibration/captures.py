@@ -328,27 +328,17 @@ class MultiCapture(Problem):
         return out
 
     def transform_kwargs(self, fit: Fit) -> dict:
+        """``LaserBlinding`` options shaping its procedural spot like the captures (the recorded pattern's own
+        glare), and the physical injection when the captures saturate."""
         d = self.derived(fit)
-        per = d["captures"]
-        kwargs = {"model": "physical" if "linear_light_saturation" in fit.effects else "paper"}
+        kwargs: dict = {}
+        if "linear_light_saturation" in fit.effects:
+            kwargs["model"] = "physical"
         if "halo_power_law" in fit.effects:
             kwargs["halo_exponent"] = d["median_halo_exponent"]
-            halo_ref = [f.params["halo_scale"] for f in fit.extra["fits"]]
-            kwargs["halo_scale_ref_px"] = float(
-                np.median([h * cap.to_reference for h, cap in zip(halo_ref, self.captures, strict=True)])
-            )
-            kwargs["halo_amplitude"] = float(
-                np.median([10.0 ** f.params["log10_halo_amplitude"] for f in fit.extra["fits"]])
-            )
-        kwargs["saturation_radius_ref_px"] = float(np.median([c["saturation_radius_ref_px"] for c in per]))
-        kwargs["core_sigma_ref_px"] = float(
-            np.median(
-                [
-                    f.params["sigma"] * cap.to_reference
-                    for f, cap in zip(fit.extra["fits"], self.captures, strict=True)
-                ]
-            )
-        )
+        radius = float(np.median([c["saturation_radius_ref_px"] for c in d["captures"]])) / 256.0
+        if radius > 0:  # the procedural spot's saturated core, as a share of the 256-pixel reference side
+            kwargs["core_radius"] = radius
         return kwargs
 
     def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir: Path) -> list[str]:

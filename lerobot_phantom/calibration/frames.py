@@ -448,20 +448,22 @@ class BlindingFrames(PixelProblem):
         return physics.encode(total.clamp(0.0, 1.0), gamma)
 
     def transform_kwargs(self, fit: Fit) -> dict:
+        """``LaserBlinding`` options: the paper's alpha levels, or the physical model (``physics.laser_injection``)."""
         p, effects = fit.params, fit.effects
         if not effects:
-            return {"model": "paper", "alpha": p["alpha"]}
-        kwargs = {
-            "model": "physical" if "linear_light_saturation" in effects else "paper",
-            "gain": p.get("gain", p.get("alpha")),
-            "halo_amplitude": p.get("halo_amplitude", 0.0),
-            "halo_exponent": p.get("halo_exponent", 2.0),
-            "halo_scale_ref_px": p.get("halo_scale_ref_px", 8.0),
+            alpha = min(p["alpha"], 1.0)
+            return {"levels": [0.0, alpha / 3, 2 * alpha / 3, alpha]}
+        linear = "linear_light_saturation" in effects
+        return {
+            "model": "physical",
+            "gain": p["gain"] if linear else p["alpha"],
+            "glare_amplitude": p.get("halo_amplitude", 0.0),
+            "glare_exponent": p.get("halo_exponent", 2.0),
+            "glare_scale_ref_px": p.get("halo_scale_ref_px", 8.0),
             "auto_exposure": p.get("auto_exposure", 0.0),
+            # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0)
+            "gamma": p["gamma"] if "sensor_gamma" in effects else (None if linear else 1.0),
         }
-        if "sensor_gamma" in effects:
-            kwargs["gamma"] = p["gamma"]
-        return kwargs
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -545,11 +547,19 @@ class BlurFrames(FrameProblem):
         return Fit(effects, params)
 
     def transform_kwargs(self, fit: Fit) -> dict:
+        """``UltrasoundBlur`` options: the blur path (camera physics); its length stays the attack's setting."""
+        kwargs: dict = {}
+        if "sinusoidal_motion" in fit.effects:
+            kwargs["path"] = "sinusoidal"
+        if "sensor_gamma" in fit.effects:
+            kwargs["gamma"] = fit.params["gamma"]
+        return kwargs
+
+    def derived(self, fit: Fit) -> dict:
+        dx, dy = fit.params["dx_ref_px"], fit.params["dy_ref_px"]
         return {
-            "path": "sinusoidal" if "sinusoidal_motion" in fit.effects else "uniform",
-            "dx_ref_px": fit.params["dx_ref_px"],
-            "dy_ref_px": fit.params["dy_ref_px"],
-            **({"gamma": fit.params["gamma"]} if "sensor_gamma" in fit.effects else {}),
+            "blur_length_ref_px_at_intensity_1": float(np.hypot(dx, dy)),
+            "direction_deg": float(np.degrees(np.arctan2(dy, dx))),
         }
 
 
@@ -668,9 +678,10 @@ class EMStripFrames(FrameProblem):
         return Fit(effects, params)
 
     def transform_kwargs(self, fit: Fit) -> dict:
+        """``EMColorStrip`` options: the Bayer-flip model with the fitted colour map (the paper's bands: none)."""
         if "bayer_phase_flip" in fit.effects:
             return {"model": "bayer_phase_flip", "gain": fit.params["gain"], "offset": fit.params["offset"]}
-        return {"model": "paper", "gain": fit.params["gain"], "offset": fit.params["offset"]}
+        return {}
 
 
 FRAME_PROBLEMS = {

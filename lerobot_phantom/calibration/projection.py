@@ -113,22 +113,28 @@ def projection_warm(start: Fit | None, effects: frozenset[str]) -> dict[str, flo
 
 
 def projection_kwargs(fit: Fit) -> dict:
+    """``LightProjection`` options: the paper's transparency levels, or the physical model (additive light, or
+    the blend when only other effects were found) at ``strength`` x intensity."""
     effects, p = fit.effects, fit.params
-    if "additive_light" not in effects:
-        kwargs: dict = {"model": "paper", "opacity": p["opacity"]}
-    else:
-        kwargs = {
-            "model": "additive",
-            "strength": 1.0 if "channel_crosstalk" in effects else p["strength"],
-            "albedo": "albedo_modulation" in effects,
-            "reflectance_floor": p.get("reflectance_floor", 0.0),
-        }
+    if not effects:
+        opacity = min(p["opacity"], 1.0)
+        return {"levels": [0.0, opacity / 3, 2 * opacity / 3, opacity]}
+    additive = "additive_light" in effects
+    kwargs: dict = {
+        "model": "additive" if additive else "blend",
+        "strength": 1.0
+        if "channel_crosstalk" in effects and additive
+        else p.get("strength", p.get("opacity")),
+        "albedo": "albedo_modulation" in effects,
+        "reflectance_floor": p.get("reflectance_floor", 0.0),
+        "gamma": p.get("gamma", 1.0),
+    }
+    if "channel_crosstalk" in effects and not additive:
+        kwargs["strength"] = p["opacity"]
     if "channel_crosstalk" in effects:
         kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
-    if "sensor_gamma" in effects:
-        kwargs["gamma"] = p["gamma"]
     return kwargs
 
 

@@ -172,7 +172,7 @@ class StripeProblem(Problem):
 
     def transform_kwargs(self, fit: Fit) -> dict:
         if "exposure_overlap" not in fit.effects:
-            return {"model": "paper", "band_fraction": fit.params["band_rows"] / self.image_height}
+            return {}  # the paper's fixed band has nothing the transform takes
         return {
             "model": "rolling_shutter",
             # row time at frame_rows rows; the transform rescales it to its image height (same readout time)

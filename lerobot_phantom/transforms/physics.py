@@ -162,8 +162,10 @@ def project_light(
     crosstalk: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
     gamma: float | torch.Tensor | None = 1.0,
+    blend: bool = False,
 ) -> torch.Tensor:
-    """Projector light on a surface seen by a camera: light adds, it never blends.
+    """Projector light on a surface seen by a camera: light adds, it never blends (``blend=True`` keeps the
+    paper's blend, ``(1 - strength) * scene + strength * light``, with the other terms).
 
     The projected colour ``pattern`` (encoded, like an image; black = no light) reaches the camera as
     ``crosstalk @ rgb`` (3x3: the projector's primaries seen through the camera's filters), scaled by ``strength``
@@ -179,6 +181,8 @@ def project_light(
     light = _as(strength, light) * light
     if albedo:
         light = light * (scene + _as(reflectance_floor, scene))
+    if blend:
+        scene = (1.0 - _as(strength, scene)) * scene
     total = torch.minimum(scene + light, _as(white, scene))
     return encode(total.clamp(min=0.0), gamma)
 
