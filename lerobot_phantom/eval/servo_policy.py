@@ -56,9 +56,10 @@ SHAPES = ("cube", "cylinder")
 SIDES = ("left", "right")
 OBJECT_COLOURS = ("red", "green", "blue", "yellow", "orange")
 
-# Finger opening seen in the state: open 8 cm, closed on an object 4.8 cm, closed on nothing 1.2 cm.
-HOLDING_OPENING = (2 * FINGER_CLOSED_HALF_GAP + 2 * (OBJECT_HALF_SIZE + FINGER_HALF_THICKNESS)) / 2
-OPEN_OPENING = (2 * FINGER_OPEN_HALF_GAP + 2 * (OBJECT_HALF_SIZE + FINGER_HALF_THICKNESS)) / 2
+# Finger opening seen in the state: open 8 cm, closed on an object 4.8 cm, closed on nothing 1.2 cm; thresholds
+# half-way between them tell the three apart.
+GRASP_MIN_OPENING = FINGER_CLOSED_HALF_GAP + OBJECT_HALF_SIZE + FINGER_HALF_THICKNESS
+OPEN_MIN_OPENING = FINGER_OPEN_HALF_GAP + OBJECT_HALF_SIZE + FINGER_HALF_THICKNESS
 
 
 # ---------------------------------------------------------------------------------------------- instruction
@@ -281,28 +282,29 @@ def dilate(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+# Where the gripper can cover the image, relative to the TCP (metres; see scene.py): the box around the palm and
+# the open fingers, and points along the arm rod.
+GRIPPER_BOX = ((-0.018, 0.018), (-FINGER_OPEN_HALF_GAP, FINGER_OPEN_HALF_GAP), (-0.015, 0.07))
+ARM_ROD = ((0.0, 0.0, 0.07), (-0.05, 0.0, 0.45))
+
+
 def gripper_mask(camera: CameraModel, tcp: np.ndarray, height: int, width: int, margin_px: int) -> np.ndarray:
     """Pixels the gripper (fingers, palm, arm rod) may cover, from the known TCP (proprioception)."""
-    offsets = [
-        (dx, dy, dz)
-        for dx in (-0.015, 0.015)
-        for dy in (-FINGER_OPEN_HALF_GAP, 0.0, FINGER_OPEN_HALF_GAP)
-        for dz in (-0.02, 0.02, 0.07)
-    ]
-    offsets += [(-0.05 * k / 4, 0.0, 0.07 + 0.38 * k / 4) for k in range(5)]  # the rod up to the arm
-    pixels = camera.project(np.asarray(tcp)[None] + np.asarray(offsets), height, width)
+    corners = np.array(list(itertools.product(*GRIPPER_BOX)))
+    box = camera.project(np.asarray(tcp)[None] + corners, height, width)
+    low = np.floor(box.min(0)).astype(int) - margin_px
+    high = np.ceil(box.max(0)).astype(int) + margin_px
     mask = np.zeros((height, width), dtype=bool)
-    # The gripper's silhouette is tall and thin: mask the bounding box of its lower part and a band for the rod.
-    lower = pixels[:-4]
-    l_low = np.floor(lower.min(0)).astype(int) - margin_px
-    l_high = np.ceil(lower.max(0)).astype(int) + margin_px
-    mask[max(l_low[1], 0) : max(l_high[1] + 1, 0), max(l_low[0], 0) : max(l_high[0] + 1, 0)] = True
-    rod = pixels[-5:]
-    for (u0, v0), (u1, v1) in itertools.pairwise(rod):
-        for t in np.linspace(0.0, 1.0, 8):
-            u, v = round(float(u0 + t * (u1 - u0))), round(float(v0 + t * (v1 - v0)))
-            rows = slice(max(v - margin_px, 0), max(v + margin_px + 1, 0))
-            mask[rows, max(u - margin_px, 0) : max(u + margin_px + 1, 0)] = True
+    mask[max(low[1], 0) : max(high[1] + 1, 0), max(low[0], 0) : max(high[0] + 1, 0)] = True
+    start, end = np.asarray(ARM_ROD)
+    rod = camera.project(
+        np.asarray(tcp) + start + np.linspace(0, 1, 33)[:, None] * (end - start), height, width
+    )
+    for u, v in np.round(rod).astype(int):
+        mask[
+            max(v - margin_px, 0) : max(v + margin_px + 1, 0),
+            max(u - margin_px, 0) : max(u + margin_px + 1, 0),
+        ] = True
     return mask
 
 
@@ -384,6 +386,7 @@ class PhantomServoPolicy(PreTrainedPolicy):
     name = POLICY_TYPE
 
     def __init__(self, config: PhantomServoConfig, **kwargs):
+        # kwargs: make_policy passes dataset_stats / dataset_meta when built from a dataset; nothing to normalise.
         super().__init__(config)
         config.validate_features()
         self.config: PhantomServoConfig = config
@@ -415,21 +418,20 @@ class PhantomServoPolicy(PreTrainedPolicy):
             raise ValueError(f"got {len(tasks)} task strings for a batch of {batch_size}")
         if len(self._episodes) != batch_size:
             self._episodes = [_EpisodeState() for _ in range(batch_size)]
-        frames = images.detach().to("cpu", torch.float32)
-        if frames.dtype == torch.uint8 or frames.max() > 1.5:
-            frames = frames / 255.0
+        for i, task in enumerate(tasks):
+            if self._episodes[i].instruction != task:  # a new episode, or the instruction changed mid-way
+                self._episodes[i] = _EpisodeState(instruction=task, plan=parse_instruction(task))
+        frames = images.detach().to("cpu")
+        # LeRobot hands images over as float in [0, 1]; raw uint8 frames are accepted too.
+        frames = frames.float() / 255.0 if frames.dtype == torch.uint8 else frames.float()
         frames = frames.permute(0, 2, 3, 1).numpy()
-        actions = [self._act(self._episodes[i], frames[i], states[i], tasks[i]) for i in range(batch_size)]
+        actions = [self._act(self._episodes[i], frames[i], states[i]) for i in range(batch_size)]
         return torch.as_tensor(np.stack(actions), dtype=torch.float32, device=images.device)
 
     # ------------------------------------------------------------------------------------------ one env
-    def _act(self, episode: _EpisodeState, image: np.ndarray, state: np.ndarray, task: str) -> np.ndarray:
-        if episode.instruction != task:
-            episode.__init__()
-            episode.instruction = task
-            episode.plan = parse_instruction(task)
+    def _act(self, episode: _EpisodeState, image: np.ndarray, state: np.ndarray) -> np.ndarray:
         tcp, opening = state[:3], float(state[3])
-        still = np.array([0.0, 0.0, 0.0, -1.0 if opening > OPEN_OPENING else 1.0], dtype=np.float32)
+        still = np.array([0.0, 0.0, 0.0, -1.0 if opening > OPEN_MIN_OPENING else 1.0], dtype=np.float32)
         if episode.plan is None or episode.plan.hold:
             return still  # not understood or told to stay: do not guess
         self._perceive(episode, image, tcp)
@@ -442,10 +444,7 @@ class PhantomServoPolicy(PreTrainedPolicy):
         occlusion_border = dilate(occluded) & ~occluded
         visible = workspace_mask(height, width) & ~occluded
         masks = colour_masks(image)
-        wanted: set = set()
-        for goal in episode.plan.goals:
-            wanted.add(goal.obj)
-            wanted.add(goal.target)
+        wanted = dict.fromkeys(ref for goal in episode.plan.goals for ref in (goal.obj, goal.target))
         for entity in wanted:
             key = entity if isinstance(entity, str) else entity.colour
             # "the left cube": the identical objects of the spatial suite, whatever their colour
@@ -498,7 +497,7 @@ class PhantomServoPolicy(PreTrainedPolicy):
         if episode.goal_index >= len(goals):
             return still
         goal = goals[episode.goal_index]
-        holding = opening > HOLDING_OPENING and opening < OPEN_OPENING
+        holding = opening > GRASP_MIN_OPENING and opening < OPEN_MIN_OPENING
 
         def act(move, close):
             return np.array([*(np.zeros(3) if move is None else move), 1.0 if close else -1.0], np.float32)
@@ -514,7 +513,7 @@ class PhantomServoPolicy(PreTrainedPolicy):
                     episode.goal_index = len(goals)
                 return act(None, close=False)
         if episode.phase == "approach":
-            if opening < OPEN_OPENING:
+            if opening < OPEN_MIN_OPENING:
                 return act(None, close=False)
             obj_xy = episode.estimates.get(goal.obj)
             if obj_xy is None:  # not seen (yet): get the hand out of the camera's way and look again
