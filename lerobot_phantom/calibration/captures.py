@@ -179,7 +179,7 @@ class CaptureProblem(Problem):
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
             starts=[{}] if warm else [],  # also from the defaults: saturated starts can stall
-            max_nfev=100,
+            max_nfev=60,
         )
         return Fit(effects, params)
 
