@@ -102,7 +102,7 @@ def _item_name(problem: Problem) -> str:
     return {
         "stripe_table": "table rows",
         "colour_triples": "table rows",
-        "laser_captures": "8x8-pixel tiles of each capture (at most 128 px wide)",
+        "laser_captures": "8x8-pixel tiles (captures resized to at most 128 px)",
         "frame_pairs": "whole image pairs",
     }.get(problem.input_kind, "items")
 
