@@ -20,6 +20,11 @@ colours move the estimates, and the task success rate drops, which is the point 
     from lerobot_phantom.eval.servo_policy import save_servo_policy
     path = save_servo_policy("outputs/servo")
     # lerobot-phantom-eval --policy.path=outputs/servo --env.type=phantom_table --env.task=goal ...
+
+Importing this module registers the ``phantom_servo`` config type with LeRobot (draccus needs it to read the
+checkpoint's config.json); LeRobot's ``make_policy`` / ``make_pre_post_processors`` then find
+``PhantomServoPolicy`` and ``make_phantom_servo_pre_post_processors`` here by their naming convention, and a saved
+checkpoint carries its own pass-through processor pipelines.
 """
 
 from __future__ import annotations
