@@ -367,7 +367,8 @@ class _EpisodeState:
     instruction: str | None = None
     plan: Plan | None = None
     goal_index: int = 0
-    phase: str = "approach"  # approach -> grasp -> carry -> release -> retreat -> (next goal) ... -> done
+    # approach (open, above, down, close) -> grasp (check) -> carry (up, across, down, open) -> retreat (up)
+    phase: str = "approach"
     grasp_attempts: int = 0
     estimates: dict = field(default_factory=dict)  # entity key -> table xy (np.ndarray)
     side_choice: dict = field(
