@@ -13,12 +13,13 @@ import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 
+SLOW = pytest.mark.slow  # > 10 s each on 2 cores
 CASES = [
-    ("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11),
-    ("laser_blinding", {"auto_exposure"}, 12),
-    ("light_projection", {"additive_light", "channel_crosstalk"}, 21),
-    ("ultrasound_blur", {"sinusoidal_motion"}, 31),
-    ("em_color_strip", {"bayer_phase_flip"}, 41),
+    pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SLOW),
+    pytest.param("laser_blinding", {"auto_exposure"}, 12, marks=SLOW),
+    pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SLOW),
+    pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
+    pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
 ]
 
 
@@ -43,6 +44,7 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     assert calibrated["attack"] == attack and set(calibrated["effects"]) == named
 
 
+@pytest.mark.slow
 def test_no_planted_effect_keeps_the_base_model(tmp_path):
     measured = tmp_path / "measured"
     measured.mkdir()
