@@ -24,7 +24,9 @@ CASES = [
 
 
 @pytest.mark.parametrize(
-    ("attack", "planted", "seed"), CASES, ids=[f"{a}-{'+'.join(sorted(p))}" for a, p, _ in CASES]
+    ("attack", "planted", "seed"),
+    CASES,
+    ids=[f"{c.values[0]}-{'+'.join(sorted(c.values[1]))}" for c in CASES],
 )
 def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     measured = tmp_path / "measured"
