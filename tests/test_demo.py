@@ -1,0 +1,50 @@
+"""The README's main job (``lerobot-phantom-demo``) must keep working on a fresh machine: these tests run it."""
+
+import json
+
+import pytest
+
+from lerobot_phantom.demo import DemoConfig, demo
+
+
+def test_gallery_only_writes_the_gallery_and_refuses_to_overwrite(tmp_path):
+    out = tmp_path / "demo"
+    outputs = demo(DemoConfig(out=str(out), gallery_only=True))
+    assert outputs["gallery"].stat().st_size > 10_000
+    assert "$ lerobot-phantom-viz" in outputs["log"].read_text()
+    with pytest.raises(FileExistsError, match="--overwrite"):
+        demo(DemoConfig(out=str(out), gallery_only=True))
+    assert outputs["gallery"].exists()  # the refused run lost nothing
+
+
+def test_unknown_suite_is_refused_naming_the_valid_ones(tmp_path):
+    with pytest.raises(ValueError, match="spatial, object, goal, long"):
+        demo(DemoConfig(out=str(tmp_path / "demo"), suite="kitchen"))
+
+
+@pytest.mark.slow
+def test_the_whole_loop_runs_at_microscopic_scale(tmp_path):
+    outputs = demo(
+        DemoConfig(
+            out=str(tmp_path / "demo"),
+            episodes=2,
+            clean_steps=2,
+            phantom_steps=2,
+            batch_size=2,
+            eval_episodes=1,
+            servo_episodes=2,
+            attacks="[laser_blinding,voice_dos]",
+            intensities="[strong]",
+        )
+    )
+    servo = json.loads(outputs["eval_servo"].read_text())
+    conditions = {r["condition"] for r in servo["results"]}
+    assert conditions == {"clean", "laser_blinding@strong", "voice_dos"}
+    # the reference policy obeys an empty instruction by not moving: voice DoS can never succeed
+    assert all(r["successes"] == 0 for r in servo["results"] if r["condition"] == "voice_dos")
+    before = json.loads(outputs["eval_before"].read_text())
+    after = json.loads(outputs["eval_after"].read_text())
+    assert before["metadata"]["episode_seeds"] == after["metadata"]["episode_seeds"]
+    assert (outputs["report_servo"] / "robustness.md").exists()
+    assert (outputs["report"] / "before_after.md").exists()
+    assert (outputs["phantom_policy"] / "adapter_config.json").exists()  # stage 2 saved a LoRA adapter
