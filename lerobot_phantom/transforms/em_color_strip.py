@@ -43,6 +43,7 @@ from typing import ClassVar
 
 import torch
 
+from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
 from lerobot_phantom.transforms.intensity import IntensitySpec
 
@@ -167,15 +168,29 @@ class EMColorStrip(CameraAttack):
         intensity: IntensitySpec = "medium",
         *,
         num_stripes: int | None = None,
+        model: str = "paper",
+        gain: float = GREEN_GAIN,
+        offset: float = GREEN_OFFSET,
+        max_fraction: float = 0.75,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
+        # model="bayer_phase_flip" (lerobot-phantom-calibrate): the wrong colours run from a row to the frame's
+        # end; the flipped share of rows grows with the intensity up to max_fraction
+        if model not in ("paper", "bayer_phase_flip"):
+            raise ValueError(f"unknown EM color strip model {model!r}; valid: 'paper', 'bayer_phase_flip'")
+        if not (0.0 < max_fraction <= 1.0):
+            raise ValueError(f"max_fraction must lie in (0, 1], got {max_fraction!r}")
+        self.model = model
+        self.bayer = {"gain": float(gain), "offset": float(offset), "max_fraction": float(max_fraction)}
         if num_stripes is not None and int(num_stripes) < 1:
             raise ValueError(f"num_stripes must be >= 1, got {num_stripes!r}")
         self.num_stripes = None if num_stripes is None else int(num_stripes)
 
     def _sample(self, s, height, width, generator, device):
+        if self.model == "bayer_phase_flip":
+            return {"start_fraction": (1.0 - self.bayer["max_fraction"] * s.to(torch.float32)).to(device)}
         if self.num_stripes is not None:
             fixed = torch.full_like(s, float(self.num_stripes), dtype=torch.float32)
             ones = torch.ones_like(fixed)
@@ -183,6 +198,13 @@ class EMColorStrip(CameraAttack):
         return {k: v.to(device) for k, v in stripe_params_for(s).items()}
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.model == "bayer_phase_flip":
+            height = x.shape[-2]
+            mask = physics.bayer_flip_mask(
+                height, params["start_fraction"].to(x.device) * height, device=x.device
+            )
+            wrong = physics.em_color_map(x, self.bayer["gain"], self.bayer["offset"])
+            return torch.lerp(x, wrong, mask.to(x.dtype))
         return em_color_strip_float(
             x, params["num_stripes"], params["band_fraction"], params["next_num_stripes"], params["mix"]
         )

@@ -29,6 +29,7 @@ from typing import Any, ClassVar
 
 import torch
 
+from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
 from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
@@ -111,11 +112,35 @@ class LaserBlinding(CameraAttack):
         streak_width: float = 0.01,
         streak_angle: float = 15.0,
         levels: Sequence[float] = ALPHA_LEVELS,
+        model: str = "paper",
+        gain: float = 1.0,
+        glare_amplitude: float = 0.0,
+        glare_exponent: float = 2.0,
+        glare_scale_ref_px: float = 8.0,
+        auto_exposure: float = 0.0,
+        gamma: float | None = None,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "laser blinding alpha", upper=1.0)
+        # model="physical" (lerobot-phantom-calibrate): the pattern is linear light x intensity x gain added to
+        # the scene, with optional power-law glare, auto-exposure and tone curve (physics.laser_injection)
+        if model not in ("paper", "physical"):
+            raise ValueError(f"unknown laser blinding model {model!r}; valid: 'paper', 'physical'")
+        if gain < 0 or glare_amplitude < 0 or auto_exposure < 0 or glare_scale_ref_px <= 0:
+            raise ValueError(
+                "gain, glare_amplitude and auto_exposure must be >= 0 and glare_scale_ref_px > 0"
+            )
+        self.model = model
+        self.physical = {
+            "gain": float(gain),
+            "glare_amplitude": float(glare_amplitude),
+            "glare_exponent": float(glare_exponent),
+            "glare_scale_ref_px": float(glare_scale_ref_px),
+            "auto_exposure": float(auto_exposure),
+            "gamma": None if gamma is None else float(gamma),
+        }
         self.pattern_path = None if pattern is None else str(pattern)
         self.color = parse_color(color)
         self.position = position
@@ -246,7 +271,28 @@ class LaserBlinding(CameraAttack):
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         height, width = x.shape[-2:]
         pattern = self.patterns_for(params["position"], height, width, x.device)
+        if self.model == "physical":
+            return self._apply_physical(x, params, pattern)
         return blend(x, params["alpha"], pattern)
+
+    def _apply_physical(
+        self, x: torch.Tensor, params: dict[str, torch.Tensor], pattern: torch.Tensor
+    ) -> torch.Tensor:
+        height, width = x.shape[-2:]
+        p = self.physical
+        pixels = self.spot_pixel(params["position"].to(x.device), height, width)
+        return physics.laser_injection(
+            x,
+            pattern,
+            params["intensity"].to(x.device) * p["gain"],
+            centre=pixels.flip(1).to(x.dtype),
+            color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
+            halo_amplitude=p["glare_amplitude"],
+            halo_exponent=p["glare_exponent"],
+            halo_scale_px=p["glare_scale_ref_px"] * max(height, width) / 256.0,
+            auto_exposure=p["auto_exposure"],
+            gamma=p["gamma"],
+        )
 
     def extra_repr(self) -> str:
         source = self.pattern_path or f"procedural color={self.color}"

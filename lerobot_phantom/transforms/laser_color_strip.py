@@ -34,6 +34,7 @@ from typing import ClassVar
 
 import torch
 
+from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
 from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
 from lerobot_phantom.transforms.patterns import check_levels
@@ -105,11 +106,45 @@ class LaserColorStrip(CameraAttack):
         *,
         color_fractions: Sequence[float] = PAPER_COLOR_FRACTIONS,
         levels: Sequence[float] = STRENGTH_LEVELS,
+        model: str = "paper",
+        frequency_hz: float = 60.0,
+        duty: float = 0.1,
+        exposure_s: float = 1e-3,
+        row_time_s: float = 1.0 / (30.0 * 720.0),
+        frame_rows: int = 720,
+        integration_offset_s: float = 0.0,
+        edge_threshold: float = 0.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "laser color strip strength")
+        # model="rolling_shutter" (lerobot-phantom-calibrate): rows lit where their exposure window overlaps a
+        # laser pulse (physics.rolling_shutter_row_light); the stripe phase is random per sample
+        if model not in ("paper", "rolling_shutter"):
+            raise ValueError(f"unknown laser color strip model {model!r}; valid: 'paper', 'rolling_shutter'")
+        if (
+            frequency_hz <= 0
+            or not (0.0 < duty <= 1.0)
+            or exposure_s < 0
+            or row_time_s <= 0
+            or frame_rows < 1
+        ):
+            raise ValueError(
+                "rolling shutter needs frequency_hz > 0, duty in (0, 1], exposure_s >= 0, row_time_s > 0"
+            )
+        self.model = model
+        self.rolling_shutter = {
+            "frequency_hz": float(frequency_hz),
+            "duty": float(duty),
+            "exposure_s": float(exposure_s),
+            "row_time_s": float(row_time_s),
+            "frame_rows": int(frame_rows),
+            "integration_offset_s": float(integration_offset_s),
+            "edge_threshold": float(
+                edge_threshold
+            ),  # the measurement's detection threshold, kept for reference
+        }
         fractions = tuple(float(v) for v in color_fractions)
         if len(fractions) != 3 or any(not (0.0 <= v <= 1.0) for v in fractions):
             raise ValueError(
@@ -126,18 +161,46 @@ class LaserColorStrip(CameraAttack):
         device: torch.device | str | None,
     ) -> dict[str, torch.Tensor]:
         fractions = torch.tensor(self.color_fractions, dtype=torch.float32, device=device)
-        return {
+        params = {
             "strength": interpolate_levels(s, self.levels),
             "color_fractions": fractions.expand(s.shape[0], 3).clone(),
         }
+        if self.model == "rolling_shutter":
+            period = 1.0 / self.rolling_shutter["frequency_hz"]
+            if generator is None:
+                params["phase_s"] = torch.zeros(s.shape[0], device=device)
+            else:
+                u = torch.rand(s.shape[0], generator=generator, device=generator.device)
+                params["phase_s"] = (u * period).to(device)
+        return params
 
     def profile(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
         """The cached S = 1 band profile for this image size."""
         return self._cached((height, width, str(device)), lambda: strip_profile(height, width, device))
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.model == "rolling_shutter":
+            return self._apply_rolling_shutter(x, params)
         profile = self.profile(*x.shape[-2:], device=x.device)
         return add_strip(x, params["strength"], params["color_fractions"], profile)
+
+    def _apply_rolling_shutter(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        height = x.shape[-2]
+        rs = self.rolling_shutter
+        rows = physics.rolling_shutter_row_light(
+            height,
+            rs["frequency_hz"],
+            rs["duty"],
+            rs["exposure_s"],
+            rs["row_time_s"] * rs["frame_rows"] / height,  # same readout time at any image height
+            integration_offset_s=rs["integration_offset_s"],
+            phase_s=params["phase_s"].to(x.device),
+            device=x.device,
+        )  # (B, H)
+        # the paper's peak gain 4 S / pi grey levels, spread over whole rows
+        gain = params["strength"].reshape(-1, 1).to(x.device) * (4.0 / math.pi / 255.0)
+        added = (gain * params["color_fractions"].reshape(-1, 3).to(x.device))[:, :, None, None]
+        return (x + added * rows[:, None, :, None]).clamp(0.0, 1.0)
 
     def extra_repr(self) -> str:
         return f"{super().extra_repr()}, color_fractions={self.color_fractions}"

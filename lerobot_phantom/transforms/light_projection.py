@@ -31,6 +31,7 @@ from typing import ClassVar
 
 import torch
 
+from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import (
     REFERENCE_SIZE,
     CameraAttack,
@@ -149,11 +150,34 @@ class LightProjection(CameraAttack):
         position: str = "fixed",
         max_offset: float = 96.0,
         levels: Sequence[float] = TRANSPARENCY_LEVELS,
+        model: str = "paper",
+        strength: float = 1.0,
+        albedo: bool = False,
+        reflectance_floor: float = 0.0,
+        crosstalk: Sequence[Sequence[float]] | None = None,
+        white: float = 1.0,
+        gamma: float | None = 1.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "light projection transparency", upper=1.0)
+        # model="additive"/"blend" (lerobot-phantom-calibrate): projector light at strength x intensity through
+        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve)
+        if model not in ("paper", "additive", "blend"):
+            raise ValueError(f"unknown light projection model {model!r}; valid: 'paper', 'additive', 'blend'")
+        matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float32)
+        if matrix is not None and matrix.shape != (3, 3):
+            raise ValueError(f"crosstalk must be a 3x3 matrix, got shape {tuple(matrix.shape)}")
+        self.model = model
+        self.physical = {
+            "strength": float(strength),
+            "albedo": bool(albedo),
+            "reflectance_floor": float(reflectance_floor),
+            "crosstalk": matrix,
+            "white": float(white),
+            "gamma": None if gamma is None else float(gamma),
+        }
         if not (0.0 < float(size) <= 4.0):
             raise ValueError(f"size (watermark side / image shorter side) must be in (0, 4], got {size!r}")
         if position not in ("fixed", "random"):
@@ -212,6 +236,22 @@ class LightProjection(CameraAttack):
         height, width = x.shape[-2:]
         rgba = self.watermark(height, width, x.device)
         top, left = placement(height, width, rgba.shape[-2], rgba.shape[-1], params["offset"].to(x.device))
+        if self.model != "paper":
+            p = self.physical
+            projected = composite(
+                torch.zeros_like(x), rgba, torch.ones_like(params["transparency"]), top, left
+            )
+            return physics.project_light(
+                x,
+                projected,
+                params["intensity"].to(x.device) * p["strength"],
+                albedo=p["albedo"],
+                reflectance_floor=p["reflectance_floor"],
+                crosstalk=p["crosstalk"],
+                white=p["white"],
+                gamma=p["gamma"],
+                blend=self.model == "blend",
+            )
         return composite(x, rgba, params["transparency"], top, left)
 
     def extra_repr(self) -> str:

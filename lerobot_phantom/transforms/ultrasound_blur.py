@@ -48,6 +48,7 @@ from typing import ClassVar
 
 import torch
 
+from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import (
     REFERENCE_SIZE,
     CameraAttack,
@@ -245,10 +246,24 @@ class UltrasoundBlur(CameraAttack):
         random_direction: bool = False,
         rotation_deg: float = 0.0,
         radial_scale: float = 0.0,
+        path: str = "uniform",
+        gamma: float | None = None,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
+        # path="sinusoidal" / gamma (lerobot-phantom-calibrate): a resonating gyroscope's arcsine-weighted blur
+        # path centred on the pixel, optionally averaged in linear light (physics.line_blur)
+        if path not in physics.BLUR_PATHS:
+            raise ValueError(f"unknown blur path {path!r}; valid: {', '.join(physics.BLUR_PATHS)}")
+        if (path != "uniform" or gamma is not None) and (
+            float(rotation_deg) != 0.0 or float(radial_scale) != 0.0
+        ):
+            raise ValueError(
+                "path='sinusoidal' and gamma= model the linear blur only (rotation_deg = radial_scale = 0)"
+            )
+        self.path = path
+        self.gamma = None if gamma is None else float(gamma)
         for what, value in (("displacement_px", displacement_px), ("rotation_deg", rotation_deg)):
             if value is not None and not math.isfinite(float(value)):
                 raise ValueError(f"{what} must be finite, got {value!r}")
@@ -283,6 +298,14 @@ class UltrasoundBlur(CameraAttack):
         }
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.path != "uniform" or self.gamma is not None:
+            dx, dy = params["dx"].to(x.device, x.dtype), params["dy"].to(x.device, x.dtype)
+            taps = physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
+            offsets = physics.blur_path_offsets(self.path, taps, dtype=x.dtype, device=x.device)
+            gamma = 1.0 if self.gamma is None else self.gamma
+            blurred = physics.encode(physics.line_blur(physics.decode(x, gamma), dx, dy, offsets), gamma)
+            still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
+            return torch.where(still, x, blurred)
         return ultrasound_blur_float(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
 
     def extra_repr(self) -> str:

@@ -1,0 +1,120 @@
+"""``make_attack(name, calibration=DIR)``: attacks running the calibrated physics, tested like the others."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import pytest
+import torch
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+from lerobot_phantom.transforms.registry import make_attack
+
+CALIBRATED = {
+    "laser_blinding": {
+        "model": "physical",
+        "gain": 1.5,
+        "glare_amplitude": 0.3,
+        "glare_exponent": 2.0,
+        "glare_scale_ref_px": 12.0,
+        "auto_exposure": 2.0,
+        "gamma": None,
+    },
+    "light_projection": {
+        "model": "additive",
+        "strength": 0.6,
+        "albedo": True,
+        "reflectance_floor": 0.2,
+        "crosstalk": [[0.8, 0.1, 0.0], [0.1, 0.7, 0.1], [0.0, 0.2, 0.9]],
+        "gamma": 1.0,
+    },
+    "laser_color_strip": {
+        "model": "rolling_shutter",
+        "row_time_s": 4.8e-5,
+        "frame_rows": 720,
+        "integration_offset_s": 5e-4,
+        "edge_threshold": 0.08,
+    },
+    "ultrasound_blur": {"path": "sinusoidal", "gamma": 2.2},
+    "em_color_strip": {"model": "bayer_phase_flip", "gain": 1.8, "offset": 0.05},
+}
+
+
+def write(tmp_path, name, kwargs):
+    folder = tmp_path / name
+    folder.mkdir()
+    (folder / "calibrated.json").write_text(json.dumps({"format": 1, "attack": name, "kwargs": kwargs}))
+    return folder
+
+
+def scene(batch=2, height=48, width=64, seed=0):
+    g = torch.Generator().manual_seed(seed)
+    base = torch.rand(batch, 3, height // 8, width // 8, generator=g)
+    return torch.nn.functional.interpolate(base, size=(height, width), mode="nearest")
+
+
+@pytest.mark.parametrize("name", sorted(CALIBRATED))
+def test_calibrated_attack_identity_dtype_shape_and_difference(tmp_path, name):
+    calibration = write(tmp_path, name, CALIBRATED[name])
+    attack = make_attack(name, intensity=1.0, calibration=str(calibration), seed=0)
+    assert type(attack).__name__ == type(make_attack(name, intensity=1.0, seed=0)).__name__
+    x = scene()
+    # identity at s = 0
+    zero = make_attack(name, intensity=0.0, calibration=str(calibration), seed=0)
+    assert torch.allclose(zero(x), x, atol=1e-5)
+    as_uint8 = (x[0] * 255).round().to(torch.uint8)
+    assert torch.equal(zero(as_uint8), as_uint8)
+    # dtype and shape preserved
+    out = attack(x)
+    assert out.shape == x.shape and out.dtype == x.dtype
+    out8 = attack(as_uint8)
+    assert out8.shape == as_uint8.shape and out8.dtype == torch.uint8
+    # the calibrated physics differs from the paper's simulation and from the clean image
+    params = attack.sample_params(2, 48, 64, generator=torch.Generator().manual_seed(1))
+    paper = make_attack(name, intensity=1.0, seed=0)
+    paper_params = paper.sample_params(2, 48, 64, generator=torch.Generator().manual_seed(1))
+    calibrated_out = attack.apply_params(x, params)
+    assert (calibrated_out - x).abs().mean() > 0.01
+    assert (calibrated_out - paper.apply_params(x, paper_params)).abs().mean() > 0.005
+
+
+def test_explicit_kwargs_override_the_calibration(tmp_path):
+    calibration = write(tmp_path, "em_color_strip", CALIBRATED["em_color_strip"])
+    attack = make_attack("em_color_strip", intensity=1.0, calibration=str(calibration), model="paper")
+    assert attack.model == "paper"
+
+
+def test_bad_model_names_are_rejected(tmp_path):
+    for name, kwargs in (
+        ("laser_blinding", {"model": "laser"}),
+        ("light_projection", {"model": "glow"}),
+        ("laser_color_strip", {"model": "global_shutter"}),
+        ("em_color_strip", {"model": "random"}),
+        ("ultrasound_blur", {"path": "zigzag"}),
+    ):
+        with pytest.raises(ValueError, match="valid"):
+            make_attack(name, **kwargs)
+
+
+def test_calibration_to_attack_end_to_end(tmp_path):
+    import calibration_testkit as kit
+
+    from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+
+    measured = tmp_path / "measured"
+    measured.mkdir()
+    kit.render_em_color_strip(measured, {"bayer_phase_flip"}, seed=3)
+    report = calibrate(
+        CalibrateConfig(attack="em_color_strip", measured=str(measured), out=str(tmp_path / "out"))
+    )
+    attack = make_attack("em_color_strip", intensity=0.5, calibration=str(tmp_path / "out"))
+    assert attack.model == "bayer_phase_flip"
+    assert attack.bayer["gain"] == pytest.approx(report["extended"]["params"]["gain"])
+    x = scene(1)
+    out = attack(x)
+    changed_rows = ((out - x).abs().amax(dim=(0, 1, 3)) > 1e-4).nonzero().flatten()
+    assert len(changed_rows) > 0 and int(changed_rows.min()) > 0
+    # the flip runs to the frame's end: every row after the first changed one may differ, none before
+    assert int(changed_rows.max()) >= x.shape[-2] - 8
