@@ -10,6 +10,7 @@ import pytest
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.transforms.registry import make_attack
 
 MEASURED = Path(__file__).parents[2].parent / "shared" / "measured"
 
@@ -32,6 +33,9 @@ def test_logitech_stripes(tmp_path):
     assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
     # a 720-row frame read out in roughly one 30 fps frame time
     assert 20 <= report["extended"]["derived"]["frame_readout_ms"] <= 40
+    attack = make_attack("laser_color_strip", intensity=1.0, calibration=str(tmp_path / "out"))
+    assert attack.model == "rolling_shutter"
+    assert attack.rolling_shutter["row_time_s"] == pytest.approx(report["extended"]["params"]["row_time_s"])
 
 
 @pytest.mark.slow
