@@ -109,14 +109,20 @@ def main() -> None:
 
     torch.set_num_threads(opts.threads)
 
+    from lerobot_phantom.datasets.synthetic import TASKS, build_synthetic_dataset
     from lerobot_phantom.train.make_vlm import VLM_SIZES, make_vlm
-    from lerobot_phantom.train.tiny import TINY_TASKS, make_tiny_dataset
 
     results: dict[str, dict] = {}
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        make_tiny_dataset(tmp / "data", episodes=4, frames_per_episode=24, image_size=opts.image_size)
-        vlm = make_vlm(tmp / "vlm", opts.vlm_size, tasks=TINY_TASKS)
+        build_synthetic_dataset(
+            tmp / "data",
+            "phantom/tiny",
+            episode_lengths=(24,) * 4,
+            size=opts.image_size,
+            cameras=("observation.images.front",),
+        )
+        vlm = make_vlm(tmp / "vlm", opts.vlm_size, tasks=TASKS)
         side = VLM_SIZES[opts.vlm_size]["image_size"]
         # Alternate the order between rounds so a drift in machine load does not favour one setting.
         order = [s for r in range(opts.rounds) for s in (SETTINGS if r % 2 == 0 else SETTINGS[::-1])]

@@ -15,14 +15,16 @@ CAMERAS = ("observation.images.front", "observation.images.wrist")
 TASKS = ("put the red block in the bowl", "stack the green block on the blue block")
 
 
-def synthetic_features(use_videos: bool, size: int = 32) -> dict[str, dict[str, Any]]:
+def synthetic_features(
+    use_videos: bool, size: int = 32, cameras: tuple[str, ...] = CAMERAS
+) -> dict[str, dict[str, Any]]:
     features: dict[str, dict[str, Any]] = {
         key: {
             "dtype": "video" if use_videos else "image",
             "shape": (size, size, 3),
             "names": ["height", "width", "channels"],
         }
-        for key in CAMERAS
+        for key in cameras
     }
     features["observation.state"] = {"dtype": "float32", "shape": (4,), "names": [f"q{i}" for i in range(4)]}
     features["action"] = {"dtype": "float32", "shape": (3,), "names": ["x", "y", "z"]}
@@ -38,15 +40,18 @@ def build_synthetic_dataset(
     size: int = 32,
     fps: int = 10,
     seed: int = 0,
+    cameras: tuple[str, ...] = CAMERAS,
 ) -> Any:
-    """Write the dataset under ``root`` (which must not exist) and return it reopened as a ``LeRobotDataset``."""
+    """Write the dataset under ``root`` (which must not exist) and return it reopened as a ``LeRobotDataset``.
+
+    ``cameras`` are full feature keys (default: front and wrist)."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
     rng = np.random.default_rng(seed)
     dataset = LeRobotDataset.create(
         repo_id=repo_id,
         fps=fps,
-        features=synthetic_features(use_videos, size),
+        features=synthetic_features(use_videos, size, cameras),
         root=root,
         use_videos=use_videos,
     )
@@ -54,7 +59,7 @@ def build_synthetic_dataset(
     for episode, length in enumerate(episode_lengths):
         for frame in range(length):
             sample: dict[str, Any] = {"task": TASKS[episode % len(TASKS)]}
-            for k, key in enumerate(CAMERAS):
+            for k, key in enumerate(cameras):
                 base = np.stack([xx * 7 + frame, yy * 5 + 40 * k, (xx + yy) * 3 + 13 * episode], axis=-1)
                 noise = rng.integers(0, 40, size=(size, size, 3))
                 sample[key] = ((base + noise) % 256).astype(np.uint8)

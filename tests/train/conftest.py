@@ -15,19 +15,21 @@ FRAMES = 24  # 2 episodes x 12 frames
 
 @pytest.fixture(scope="session")
 def tiny_dataset_root(tmp_path_factory) -> Path:
-    from lerobot_phantom.train.tiny import make_tiny_dataset
+    from lerobot_phantom.datasets.synthetic import build_synthetic_dataset
 
     root = tmp_path_factory.mktemp("data") / "tiny"
-    make_tiny_dataset(root, episodes=2, frames_per_episode=FRAMES // 2, image_size=32)
+    build_synthetic_dataset(
+        root, "phantom/tiny", episode_lengths=(FRAMES // 2,) * 2, cameras=("observation.images.front",)
+    )
     return root
 
 
 @pytest.fixture(scope="session")
 def tiny_vlm(tmp_path_factory) -> Path:
+    from lerobot_phantom.datasets.synthetic import TASKS
     from lerobot_phantom.train.make_vlm import make_vlm
-    from lerobot_phantom.train.tiny import TINY_TASKS
 
-    return make_vlm(tmp_path_factory.mktemp("vlm") / "tiny_vlm", "tiny", tasks=TINY_TASKS)
+    return make_vlm(tmp_path_factory.mktemp("vlm") / "tiny_vlm", "tiny", tasks=TASKS)
 
 
 def dataset_args(root: Path) -> list[str]:

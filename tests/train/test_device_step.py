@@ -23,10 +23,10 @@ def two_camera_dataset(tmp_path_factory):
     """Two cameras; the front one as a 2-frame stack (delta_timestamps), the wrist one as a single frame."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    from lerobot_phantom.train.tiny import make_tiny_dataset
+    from lerobot_phantom.datasets.synthetic import build_synthetic_dataset
 
     root = tmp_path_factory.mktemp("two_cams") / "ds"
-    make_tiny_dataset(root, episodes=1, frames_per_episode=16, image_size=24, cameras=("front", "wrist"))
+    build_synthetic_dataset(root, "phantom/tiny", episode_lengths=(16,), size=24)
     return LeRobotDataset("phantom/tiny", root=root, delta_timestamps={CAMERAS[0]: [-0.1, 0.0]})
 
 

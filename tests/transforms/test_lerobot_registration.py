@@ -3,7 +3,6 @@ import os
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
-import numpy as np
 import pytest
 import torch
 
@@ -87,36 +86,6 @@ def test_every_camera_attack_has_a_class_name():
     assert resolve_camera_attack("LightProjection").name == "light_projection"
 
 
-def _make_tiny_dataset(root):
-    from lerobot.datasets.lerobot_dataset import LeRobotDataset
-
-    features = {
-        "observation.image": {
-            "dtype": "image",
-            "shape": (24, 32, 3),
-            "names": ["height", "width", "channels"],
-        },
-        "observation.state": {"dtype": "float32", "shape": (2,), "names": None},
-        "action": {"dtype": "float32", "shape": (2,), "names": None},
-    }
-    dataset = LeRobotDataset.create(
-        repo_id="phantom/tiny", fps=10, root=root, features=features, use_videos=False
-    )
-    rng = np.random.default_rng(0)
-    for _ in range(3):
-        dataset.add_frame(
-            {
-                "observation.image": rng.integers(0, 256, (24, 32, 3), dtype=np.uint8),
-                "observation.state": rng.random(2, dtype=np.float32),
-                "action": rng.random(2, dtype=np.float32),
-                "task": "push the block",
-            }
-        )
-    dataset.save_episode()
-    dataset.finalize()
-    return dataset
-
-
 def test_dataset_config_from_json_goes_through_make_dataset(registered, tmp_path):
     import draccus
     from lerobot.configs.default import DatasetConfig
@@ -125,8 +94,10 @@ def test_dataset_config_from_json_goes_through_make_dataset(registered, tmp_path
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
     from lerobot.policies.act.configuration_act import ACTConfig
 
+    from lerobot_phantom.datasets.synthetic import build_synthetic_dataset
+
     root = tmp_path / "tiny"
-    _make_tiny_dataset(root)
+    build_synthetic_dataset(root, "phantom/tiny", episode_lengths=(3,), cameras=("observation.image",))
     text = json.dumps(
         {
             "repo_id": "phantom/tiny",
