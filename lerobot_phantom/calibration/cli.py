@@ -10,7 +10,7 @@ Inputs (recognised from the path and the table columns):
   colour-triple tables (origin_*, addition_*, outcome_*)                -> light_projection
   laser captures without scene (image file or folder of images)         -> laser_blinding
   frame pairs (folder with pairs.csv: clean,attacked[,pattern][,intensity],...) -> laser_blinding,
-      light_projection, ultrasound_blur, em_color_strip
+      light_projection, ultrasound_blur, em_color_strip, em_truncation, laser_color_strip
 """
 
 from __future__ import annotations
@@ -26,14 +26,16 @@ from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select,
 from lerobot_phantom.calibration.frames import FRAME_PROBLEMS, load_pairs
 from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
 from lerobot_phantom.calibration.report import build_report, write_outputs
+from lerobot_phantom.calibration.row_frames import ROW_FRAME_PROBLEMS
 from lerobot_phantom.calibration.stripes import StripeProblem, is_stripe_table
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
+ALL_FRAME_PROBLEMS = {**FRAME_PROBLEMS, **ROW_FRAME_PROBLEMS}
 SUPPORTED = {
     "stripe_table": ("laser_color_strip",),
     "colour_triples": ("light_projection",),
     "laser_captures": ("laser_blinding",),
-    "frame_pairs": tuple(FRAME_PROBLEMS),
+    "frame_pairs": tuple(ALL_FRAME_PROBLEMS),
 }
 
 
@@ -103,7 +105,7 @@ def build_problem(cfg: CalibrateConfig) -> Problem:
         return TripleProblem(path)
     if kind == "laser_captures":
         return MultiCapture(path, max_side=cfg.capture_max_side, seed=cfg.seed)
-    return FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
+    return ALL_FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
 
 
 def calibrate(cfg: CalibrateConfig) -> dict:

@@ -59,9 +59,13 @@ def scene(rng: np.random.Generator, height: int, width: int, checkers: int = 0) 
     return np.clip(image, 0.05, 0.95)
 
 
-def save(path: Path, image: np.ndarray, rng: np.random.Generator, noise: float = 1.0 / 255.0) -> None:
-    """Sensor read noise, then 8-bit quantisation."""
-    noisy = np.clip(image + rng.normal(0.0, noise, image.shape), 0.0, 1.0)
+def save(
+    path: Path, image: np.ndarray, rng: np.random.Generator, noise: float = 1.0 / 255.0, shot: float = 0.0
+) -> None:
+    """Sensor read noise (sd ``noise``) plus photon shot noise (variance ``shot`` x signal), then 8-bit
+    quantisation."""
+    sd = np.sqrt(noise**2 + shot * np.clip(image, 0.0, 1.0))
+    noisy = np.clip(image + rng.normal(0.0, 1.0, image.shape) * sd, 0.0, 1.0)
     Image.fromarray((noisy * 255).round().astype(np.uint8)).save(path)
 
 
@@ -236,7 +240,34 @@ def render_em_color_strip(folder: Path, effects: set[str], seed: int, n_pairs: i
     return truth
 
 
+def render_em_truncation(
+    folder: Path, effects: set[str], seed: int, n_pairs: int = 10, shot: float = 0.0
+) -> dict:
+    """Rows lost from the frame buffer: ``num`` rows from ``start`` vanish, the rest moves up, the tail repeats.
+    The paper ties the start to the count (``start = num``); ``free_band_position`` draws it anywhere."""
+    rng = np.random.default_rng(seed)
+    truth = {"ratio_per_intensity": rng.uniform(0.15, 0.3)}
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width)
+        s = rng.uniform(0.4, 1.0)
+        num = max(2, int(height * truth["ratio_per_intensity"] * s))
+        if "free_band_position" in effects:
+            start = int(rng.integers(0, height - 2 * num + 1))
+        else:
+            start = max(0, min(num, height - 2 * num))
+        source = np.arange(height)
+        moved = (source >= start) & (source < height - num)
+        attacked = clean[np.where(moved, source + num, source)]
+        save(folder / f"clean_{i}.png", clean, rng, shot=shot)
+        save(folder / f"attacked_{i}.png", attacked, rng, shot=shot)
+        rows.append({"clean": f"clean_{i}.png", "attacked": f"attacked_{i}.png", "intensity": round(s, 4)})
+    write_table(folder, rows)
+    return truth
+
+
 RENDERERS = {
+    "em_truncation": render_em_truncation,
     "laser_blinding": render_laser_blinding,
     "light_projection": render_light_projection,
     "ultrasound_blur": render_ultrasound_blur,

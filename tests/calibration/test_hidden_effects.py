@@ -20,6 +20,7 @@ CASES = [
     pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SLOW),
     pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
     pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
+    pytest.param("em_truncation", {"free_band_position"}, 51),
 ]
 
 
@@ -59,3 +60,14 @@ def test_no_planted_effect_keeps_the_base_model(tmp_path):
     assert report["gain"]["rmse_ratio"] == pytest.approx(1.0)
     # the base (alpha blend) recovers the generator's blend weight up to noise
     assert report["base"]["heldout_rmse"] < 3.0
+
+
+@pytest.mark.parametrize("attack", ["em_truncation"])
+def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack):
+    measured = tmp_path / "measured"
+    measured.mkdir()
+    kit.RENDERERS[attack](measured, set(), seed=6)
+    report = calibrate(CalibrateConfig(attack=attack, measured=str(measured), out=str(tmp_path / "out")))
+    assert report["extended"]["effects"] == []
+    assert report["findings"] == []
+    assert report["base"]["heldout_rmse"] < 3.0  # the paper's model explains the frames up to sensor noise
