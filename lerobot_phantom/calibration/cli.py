@@ -23,7 +23,8 @@ import pandas as pd
 
 from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
 from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select, seeded_split, single_threaded
-from lerobot_phantom.calibration.frames import FRAME_PROBLEMS, load_pairs
+from lerobot_phantom.calibration.frames import FRAME_PROBLEMS, FrameProblem, load_pairs
+from lerobot_phantom.calibration.noise import apply_noise_finding, select_shot_noise
 from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
 from lerobot_phantom.calibration.report import build_report, write_outputs
 from lerobot_phantom.calibration.row_frames import ROW_FRAME_PROBLEMS
@@ -138,6 +139,12 @@ def calibrate(cfg: CalibrateConfig) -> dict:
             margin=cfg.margin,
             folds=cfg.folds,
         )
+        if isinstance(problem, FrameProblem):
+            # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)
+            noise = select_shot_noise(
+                problem, extended, fit_items, heldout_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
+            )
+            extended = apply_noise_finding(report, extended, noise)
         write_outputs(problem, report, base, extended, heldout_items, out)
     return report
 

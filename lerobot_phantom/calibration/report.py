@@ -202,6 +202,32 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         per = report["per_capture_heldout_rmse"]
         for name, value in per["base"].items():
             lines.append(f"| {name} | {value:.2f} | {per['extended'][name]:.2f} |")
+    if "noise" in report and "criterion" in report["noise"]:
+        noise = report["noise"]
+        lines += [
+            "",
+            "## Noise model (`shot_noise`)",
+            "",
+            "Noise cannot be predicted pixel by pixel and never lowers an RMSE, so `shot_noise` is judged as a "
+            "model of the residual's distribution instead: " + noise["criterion"] + ". "
+            f"Inner validation noise-scale ratio {noise['validation_noise_scale_ratio']:.3f}, held out "
+            f"{noise['heldout_noise_scale_ratio']:.3f}: "
+            + (
+                "kept"
+                if noise["kept"]
+                else "not kept (the residual's variance does not depend on the signal)"
+            )
+            + f". Fitted: read noise {noise['shot_noise']['read_noise_grey']:.3g} grey levels, shot gain "
+            f"{noise['shot_noise']['shot_gain_grey']:.3g} grey levels^2 per grey level. Held-out residual RMSE vs "
+            "predicted signal: "
+            + ", ".join(
+                f"{x:.0f}: {r:.2f}"
+                for x, r in zip(
+                    noise["residual_vs_signal"]["x"], noise["residual_vs_signal"]["rmse"], strict=True
+                )
+            )
+            + ".",
+        ]
     lines += ["", "## Selection", "", report["selection"]["criterion"] + ".", ""]
     for step in report["selection"]["steps"]:
         tried = ", ".join(f"{k}: {v:.3g}" for k, v in step["tried"].items())

@@ -241,15 +241,17 @@ def render_em_color_strip(folder: Path, effects: set[str], seed: int, n_pairs: i
 
 
 def render_em_truncation(
-    folder: Path, effects: set[str], seed: int, n_pairs: int = 10, shot: float = 0.0
+    folder: Path, effects: set[str], seed: int, n_pairs: int = 10, shot: float = 0.0, dim: float = 1.0
 ) -> dict:
     """Rows lost from the frame buffer: ``num`` rows from ``start`` vanish, the rest moves up, the tail repeats.
-    The paper ties the start to the count (``start = num``); ``free_band_position`` draws it anywhere."""
+    The paper ties the start to the count (``start = num``); ``free_band_position`` draws it anywhere.
+    ``shot``: photon shot-noise variance per unit signal; ``dim`` < 1: each pair is exposed at a random level
+    in [dim, 1] (dark and bright captures)."""
     rng = np.random.default_rng(seed)
     truth = {"ratio_per_intensity": rng.uniform(0.15, 0.3)}
     rows = []
     for i, (height, width) in enumerate(sizes(rng, n_pairs)):
-        clean = scene(rng, height, width)
+        clean = scene(rng, height, width) * (rng.uniform(dim, 1.0) if dim < 1.0 else 1.0)
         s = rng.uniform(0.4, 1.0)
         num = max(2, int(height * truth["ratio_per_intensity"] * s))
         if "free_band_position" in effects:
