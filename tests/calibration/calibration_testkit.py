@@ -268,7 +268,65 @@ def render_em_truncation(
     return truth
 
 
+def paper_strip_profile(height: int, width: int) -> np.ndarray:
+    """The paper's band weight (grey levels per unit strength) over the whole frame: zero outside rows
+    h//3 .. 2 (h//3), a Gaussian centred h/2 below the band start and at mid-width (sigma h/2, w/4)."""
+    start, end = height // 3, (height // 3) * 2
+    p, q = np.mgrid[0:height, 0:width].astype(np.float64)
+    sigma_p, sigma_q = height / 2.0, width / 4.0
+    gauss = np.exp(-0.5 * ((p - start - sigma_p) ** 2 / sigma_p**2 + (q - width / 2.0) ** 2 / sigma_q**2))
+    profile = gauss * height * width / (2 * np.pi * sigma_p * sigma_q)
+    profile[(p < start) | (p >= end)] = 0.0
+    return profile
+
+
+def stripe_rows(height: int, on: float, window: float, phase: float, period: float | None) -> np.ndarray:
+    """Lit share of each row of a rolling shutter (row r exposed during [r + phase, r + phase + window], in
+    rows) under a laser on during [k period, k period + on]: the overlap, over its largest possible value."""
+    starts = np.arange(height) + phase
+    pulses = [0.0] if period is None else np.arange(-2, height / period + 3) * period
+    lit = np.zeros(height)
+    for pulse in pulses:
+        lit += np.clip(np.minimum(starts + window, pulse + on) - np.maximum(starts, pulse), 0.0, None)
+    return np.clip(lit / min(on, window), 0.0, 1.0)
+
+
+def render_laser_color_strip(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
+    """Without effects: the paper's band. ``exposure_overlap``: a stripe across the width wherever the pulse
+    falls; with ``stripe_period`` it repeats."""
+    rng = np.random.default_rng(seed)
+    colour = np.array(rng.permutation([1.0, rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3)]))
+    truth = {
+        "strength": rng.uniform(150.0, 300.0),  # paper units (grey levels x 1000 / weight)
+        "peak": rng.uniform(0.3, 0.5),
+        "on_share": rng.uniform(0.06, 0.12),
+        "exposure_share": rng.uniform(0.03, 0.08),
+        "period_share": rng.uniform(0.35, 0.5),
+    }
+    rows = []
+    for i, (height, width) in enumerate(sizes(rng, n_pairs)):
+        clean = scene(rng, height, width)
+        s = rng.uniform(0.5, 1.0)
+        if "exposure_overlap" in effects:
+            period = truth["period_share"] * height if "stripe_period" in effects else None
+            # the stripe sits at rows -phase - window .. -phase + on
+            phase = -rng.uniform(0.1, 0.8) * height if period is None else rng.uniform(0, period)
+            light = stripe_rows(
+                height, truth["on_share"] * height, truth["exposure_share"] * height, phase, period
+            )
+            added = s * truth["peak"] * light[:, None, None] * colour
+        else:
+            added = s * truth["strength"] * paper_strip_profile(height, width)[..., None] * colour / 255.0
+        attacked = np.clip(clean + added, 0.0, 1.0)
+        save(folder / f"clean_{i}.png", clean, rng)
+        save(folder / f"attacked_{i}.png", attacked, rng)
+        rows.append({"clean": f"clean_{i}.png", "attacked": f"attacked_{i}.png", "intensity": round(s, 4)})
+    write_table(folder, rows)
+    return truth
+
+
 RENDERERS = {
+    "laser_color_strip": render_laser_color_strip,
     "em_truncation": render_em_truncation,
     "laser_blinding": render_laser_blinding,
     "light_projection": render_light_projection,

@@ -6,12 +6,14 @@ import json
 import os
 
 import pytest
+import torch
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.transforms.registry import make_attack
 
 SLOW = pytest.mark.slow  # > 10 s each on 2 cores
 CASES = [
@@ -21,6 +23,7 @@ CASES = [
     pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
     pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
     pytest.param("em_truncation", {"free_band_position"}, 51),
+    pytest.param("laser_color_strip", {"exposure_overlap"}, 62),
 ]
 
 
@@ -45,6 +48,11 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     assert report["n_fit"] + report["n_heldout"] == 10
     calibrated = json.loads((tmp_path / "out" / "calibrated.json").read_text())
     assert calibrated["attack"] == attack and set(calibrated["effects"]) == named
+    # the fitted model drives the attack transform
+    attack_transform = make_attack(attack, intensity="strong", calibration=str(tmp_path / "out"), seed=0)
+    image = torch.rand(1, 3, 48, 64, generator=torch.Generator().manual_seed(seed))
+    attacked = attack_transform(image)
+    assert attacked.shape == image.shape and not torch.equal(attacked, image)
 
 
 @pytest.mark.slow
@@ -62,11 +70,11 @@ def test_no_planted_effect_keeps_the_base_model(tmp_path):
     assert report["base"]["heldout_rmse"] < 3.0
 
 
-@pytest.mark.parametrize("attack", ["em_truncation"])
-def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack):
+@pytest.mark.parametrize(("attack", "seed"), [("em_truncation", 6), ("laser_color_strip", 61)])
+def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack, seed):
     measured = tmp_path / "measured"
     measured.mkdir()
-    kit.RENDERERS[attack](measured, set(), seed=6)
+    kit.RENDERERS[attack](measured, set(), seed=seed)
     report = calibrate(CalibrateConfig(attack=attack, measured=str(measured), out=str(tmp_path / "out")))
     assert report["extended"]["effects"] == []
     assert report["findings"] == []
