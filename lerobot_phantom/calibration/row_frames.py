@@ -257,7 +257,7 @@ class StripFrames(FrameProblem):
         starts = [self.initial_stripe(items)]
         if "stripe_period" in effects:
             specs.append(Param("period_share", 0.5, 0.05, 2.0, scale=0.3))
-            shares = (0.3, 0.6)
+            shares = (0.25, 0.4, 0.6)
             starts = [{**starts[0], "period_share": share} for share in shares]
         if start is not None and "exposure_overlap" in start.effects:
             starts.insert(0, {**starts[0], **start.params})

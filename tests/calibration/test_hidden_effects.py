@@ -23,7 +23,8 @@ CASES = [
     pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
     pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
     pytest.param("em_truncation", {"free_band_position"}, 51),
-    pytest.param("laser_color_strip", {"exposure_overlap"}, 62),
+    pytest.param("laser_color_strip", {"exposure_overlap"}, 62, marks=SLOW),
+    pytest.param("laser_color_strip", {"exposure_overlap", "stripe_period"}, 63, marks=SLOW),
 ]
 
 
@@ -70,7 +71,9 @@ def test_no_planted_effect_keeps_the_base_model(tmp_path):
     assert report["base"]["heldout_rmse"] < 3.0
 
 
-@pytest.mark.parametrize(("attack", "seed"), [("em_truncation", 6), ("laser_color_strip", 61)])
+@pytest.mark.parametrize(
+    ("attack", "seed"), [("em_truncation", 6), pytest.param("laser_color_strip", 61, marks=SLOW)]
+)
 def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack, seed):
     measured = tmp_path / "measured"
     measured.mkdir()
