@@ -65,6 +65,20 @@ def check_image(img: torch.Tensor) -> None:
             raise ValueError("image contains NaN or infinite values")
 
 
+def per_sample_values(
+    value: float | torch.Tensor, batch: int, device: torch.device, what: str
+) -> torch.Tensor:
+    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> float64 ``(batch,)`` on ``device``."""
+    t = torch.as_tensor(value, dtype=torch.float64).to(device).reshape(-1)
+    if t.numel() == 1:
+        return t.expand(batch)
+    if t.numel() != batch:
+        raise ValueError(
+            f"{what} must be a scalar or have one value per sample ({batch}), got {t.numel()} values"
+        )
+    return t
+
+
 def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
     """Any supported image -> (float32 (N, 3, H, W) in [0, 1], alpha channel or None)."""
     x = img.reshape(-1, *img.shape[-3:])

@@ -44,24 +44,18 @@ from typing import ClassVar
 import torch
 
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
+from lerobot_phantom.transforms.base import (
+    CameraAttack,
+    check_image,
+    from_float_rgb,
+    per_sample_values,
+    to_float_rgb,
+)
 from lerobot_phantom.transforms.intensity import IntensitySpec
 
 LEVEL_STRIPES: tuple[float, float, float] = (8.0, 12.0, 16.0)
 GREEN_GAIN = 2.5
 GREEN_OFFSET = 50.0 / 255.0
-
-
-def _per_sample(value: float | torch.Tensor, batch: int, device: torch.device, what: str) -> torch.Tensor:
-    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> float64 ``(batch,)`` on ``device``."""
-    t = torch.as_tensor(value, dtype=torch.float64).to(device).reshape(-1)
-    if t.numel() == 1:
-        return t.expand(batch)
-    if t.numel() != batch:
-        raise ValueError(
-            f"{what} must be a scalar or have one value per sample ({batch}), got {t.numel()} values"
-        )
-    return t
 
 
 def stripe_row_weights(height: int, num_stripes: torch.Tensor, band_fraction: torch.Tensor) -> torch.Tensor:
@@ -100,16 +94,16 @@ def em_color_strip_float(
 ) -> torch.Tensor:
     """``em_color_strip`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op)."""
     batch, _, height, _ = x.shape
-    stripes = _per_sample(num_stripes, batch, x.device, "num_stripes")
-    fraction = _per_sample(band_fraction, batch, x.device, "band_fraction")
+    stripes = per_sample_values(num_stripes, batch, x.device, "num_stripes")
+    fraction = per_sample_values(band_fraction, batch, x.device, "band_fraction")
     _check_stripes(stripes)
     if not ((fraction >= 0) & (fraction <= 1)).all():
         raise ValueError(f"band_fraction must lie in [0, 1], got {fraction.tolist()}")
     weights = stripe_row_weights(height, stripes, fraction)
     if next_num_stripes is not None:
-        following = _per_sample(next_num_stripes, batch, x.device, "next_num_stripes")
+        following = per_sample_values(next_num_stripes, batch, x.device, "next_num_stripes")
         _check_stripes(following)
-        weight_of_next = _per_sample(mix, batch, x.device, "mix")
+        weight_of_next = per_sample_values(mix, batch, x.device, "mix")
         if not ((weight_of_next >= 0) & (weight_of_next <= 1)).all():
             raise ValueError(f"mix must lie in [0, 1], got {weight_of_next.tolist()}")
         weight_of_next = weight_of_next.unsqueeze(1)

@@ -32,22 +32,10 @@ from typing import ClassVar
 
 import torch
 
-from lerobot_phantom.transforms.base import CameraAttack, check_image
+from lerobot_phantom.transforms.base import CameraAttack, check_image, per_sample_values
 from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
 
 MAX_RATIO = 0.5
-
-
-def _per_sample(value: float | torch.Tensor, batch: int, device: torch.device, what: str) -> torch.Tensor:
-    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> float64 ``(batch,)`` on ``device``."""
-    t = torch.as_tensor(value, dtype=torch.float64).to(device).reshape(-1)
-    if t.numel() == 1:
-        return t.expand(batch)
-    if t.numel() != batch:
-        raise ValueError(
-            f"{what} must be a scalar or have one value per sample ({batch}), got {t.numel()} values"
-        )
-    return t
 
 
 def truncation_row_index(height: int, ratio: torch.Tensor) -> torch.Tensor:
@@ -69,7 +57,7 @@ def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Ten
     check_image(image)
     flat = image.reshape(-1, *image.shape[-3:])
     batch, _, height, _ = flat.shape
-    r = _per_sample(ratio, batch, flat.device, "ratio")
+    r = per_sample_values(ratio, batch, flat.device, "ratio")
     if not torch.isfinite(r).all() or (r < 0).any() or (r > MAX_RATIO).any():
         raise ValueError(f"EM truncation ratio must lie in [0, {MAX_RATIO}], got {r.tolist()}")
     index = truncation_row_index(height, r)  # (B, H)
