@@ -47,15 +47,18 @@ def identity_processors():
     )
 
 
-def load_policy(cfg: PhantomEvalConfig):
-    """Policy and its pre/post processors from ``--policy.path``, exactly as ``lerobot-eval`` builds them."""
+def load_policy(cfg: PhantomEvalConfig, ds_meta=None):
+    """Policy and its pre/post processors from ``--policy.path``, exactly as ``lerobot-eval`` builds them
+    (``ds_meta``: a dataset's metadata instead of the env config, for the offline mode)."""
     from lerobot.policies.factory import make_policy, make_pre_post_processors
 
     if cfg.policy is None:
         raise ValueError(
             "no policy to evaluate: pass --policy.path=<checkpoint dir> (or policy= to evaluate())"
         )
-    policy = make_policy(cfg=cfg.policy, env_cfg=cfg.env, rename_map=cfg.rename_map)
+    # A dataset's metadata (offline mode) or the env config tells make_policy the features.
+    source = {"ds_meta": ds_meta} if ds_meta is not None else {"env_cfg": cfg.env}
+    policy = make_policy(cfg=cfg.policy, rename_map=cfg.rename_map, **source)
     preprocessor, postprocessor = make_pre_post_processors(
         policy_cfg=cfg.policy,
         pretrained_path=cfg.policy.pretrained_path,

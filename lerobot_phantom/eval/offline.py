@@ -24,7 +24,7 @@ from tqdm import tqdm
 
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
-from lerobot_phantom.eval.eval import identity_processors, policy_metadata, versions, with_step
+from lerobot_phantom.eval.eval import identity_processors, load_policy, policy_metadata, versions, with_step
 from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT
 from lerobot_phantom.eval.rollout import AttackStep, build_conditions
 from lerobot_phantom.transforms.base import derive_seed
@@ -35,25 +35,6 @@ def frame_indices(n_frames: int, wanted: int) -> list[int]:
     if n_frames < 1:
         raise ValueError("the dataset has no frames")
     return sorted({int(i) for i in np.linspace(0, n_frames - 1, min(wanted, n_frames)).round()})
-
-
-def load_offline_policy(cfg: PhantomEvalConfig, dataset):
-    from lerobot.policies.factory import make_policy, make_pre_post_processors
-
-    if cfg.policy is None:
-        raise ValueError(
-            "no policy to evaluate: pass --policy.path=<checkpoint dir> (or policy= to evaluate())"
-        )
-    policy = make_policy(cfg=cfg.policy, ds_meta=dataset.meta, rename_map=cfg.rename_map)
-    preprocessor, postprocessor = make_pre_post_processors(
-        policy_cfg=cfg.policy,
-        pretrained_path=cfg.policy.pretrained_path,
-        preprocessor_overrides={
-            "device_processor": {"device": str(policy.config.device)},
-            "rename_observations_processor": {"rename_map": cfg.rename_map},
-        },
-    )
-    return policy, preprocessor, postprocessor
 
 
 def act(policy, preprocessor, postprocessor, batch: dict[str, Any], seed: int) -> torch.Tensor:
@@ -96,7 +77,7 @@ def evaluate_offline(
     conditions = build_conditions(cfg.phantom)[1:]  # the clean frame is every condition's reference
     steps = [AttackStep(condition, cfg.phantom) for condition in conditions]
     if policy is None:
-        policy, preprocessor, postprocessor = load_offline_policy(cfg, dataset)
+        policy, preprocessor, postprocessor = load_policy(cfg, ds_meta=dataset.meta)
     elif preprocessor is None or postprocessor is None:
         preprocessor, postprocessor = identity_processors()
     policy.eval()
