@@ -32,7 +32,6 @@ import torch
 from lerobot.configs.default import EvalConfig
 from lerobot.configs.policies import PreTrainedConfig
 from lerobot.envs.factory import make_env
-from lerobot.optim.optimizers import AdamConfig
 from lerobot.policies.pretrained import PreTrainedPolicy
 from tqdm import tqdm
 
@@ -42,34 +41,14 @@ from lerobot_phantom.envs.lerobot_config import PhantomTableEnvConfig
 from lerobot_phantom.eval.config import EvalPhantomConfig, PhantomEvalConfig
 from lerobot_phantom.eval.eval import identity_processors, run_condition
 from lerobot_phantom.eval.rollout import AttackStep, build_conditions
+from lerobot_phantom.eval.servo_policy import NonLearnedPolicyConfig
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
 
 @PreTrainedConfig.register_subclass("phantom_bench_expert")
 @dataclass
-class ExpertConfig(PreTrainedConfig):
+class ExpertConfig(NonLearnedPolicyConfig):
     device: str | None = "cpu"
-
-    @property
-    def observation_delta_indices(self):
-        return None
-
-    @property
-    def action_delta_indices(self):
-        return None
-
-    @property
-    def reward_delta_indices(self):
-        return None
-
-    def get_optimizer_preset(self):
-        return AdamConfig()
-
-    def get_scheduler_preset(self):
-        return None
-
-    def validate_features(self) -> None:
-        return None
 
 
 class ExpertPolicy(PreTrainedPolicy):

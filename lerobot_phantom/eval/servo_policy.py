@@ -314,26 +314,12 @@ def gripper_mask(camera: CameraModel, tcp: np.ndarray, height: int, width: int, 
 
 
 # ------------------------------------------------------------------------------------------------- config
-@PreTrainedConfig.register_subclass(POLICY_TYPE)
 @dataclass
-class PhantomServoConfig(PreTrainedConfig):
-    """Settings of the scripted servo policy (nothing is learned; these are its controller constants)."""
+class NonLearnedPolicyConfig(PreTrainedConfig):
+    """Base of policy configs that are never trained (reference and test policies): no temporal deltas, and the
+    optimiser/scheduler presets LeRobot requires are placeholders."""
 
-    travel_z: float = 0.12  # metres; height of every horizontal move, as the scripted expert
-    reach_tolerance: float = 0.002  # metres; a waypoint is reached within this (the TCP is known exactly)
-    release_clearance: float = 0.008  # metres above the support at which the object is let go
-    mask_margin_px: int = 2  # pixels added around the projected gripper before ignoring blobs it touches
-    max_grasp_attempts: int = 3
     device: str | None = "cpu"
-    input_features: dict[str, PolicyFeature] = field(
-        default_factory=lambda: {
-            FRONT_IMAGE_KEY: PolicyFeature(type=FeatureType.VISUAL, shape=(3, 96, 96)),
-            STATE_KEY: PolicyFeature(type=FeatureType.STATE, shape=(STATE_DIM,)),
-        }
-    )
-    output_features: dict[str, PolicyFeature] = field(
-        default_factory=lambda: {"action": PolicyFeature(type=FeatureType.ACTION, shape=(ACTION_DIM,))}
-    )
 
     @property
     def observation_delta_indices(self):
@@ -352,6 +338,31 @@ class PhantomServoConfig(PreTrainedConfig):
 
     def get_scheduler_preset(self):
         return None
+
+    def validate_features(self) -> None:
+        return None
+
+
+@PreTrainedConfig.register_subclass(POLICY_TYPE)
+@dataclass
+class PhantomServoConfig(NonLearnedPolicyConfig):
+    """Settings of the scripted servo policy (nothing is learned; these are its controller constants)."""
+
+    travel_z: float = 0.12  # metres; height of every horizontal move, as the scripted expert
+    reach_tolerance: float = 0.002  # metres; a waypoint is reached within this (the TCP is known exactly)
+    release_clearance: float = 0.008  # metres above the support at which the object is let go
+    mask_margin_px: int = 2  # pixels added around the projected gripper before ignoring blobs it touches
+    max_grasp_attempts: int = 3
+    device: str | None = "cpu"
+    input_features: dict[str, PolicyFeature] = field(
+        default_factory=lambda: {
+            FRONT_IMAGE_KEY: PolicyFeature(type=FeatureType.VISUAL, shape=(3, 96, 96)),
+            STATE_KEY: PolicyFeature(type=FeatureType.STATE, shape=(STATE_DIM,)),
+        }
+    )
+    output_features: dict[str, PolicyFeature] = field(
+        default_factory=lambda: {"action": PolicyFeature(type=FeatureType.ACTION, shape=(ACTION_DIM,))}
+    )
 
     def validate_features(self) -> None:
         if FRONT_IMAGE_KEY not in self.input_features or STATE_KEY not in self.input_features:

@@ -15,8 +15,9 @@ import torch
 from gymnasium import spaces
 from lerobot.configs.policies import PreTrainedConfig
 from lerobot.envs.configs import EnvConfig
-from lerobot.optim.optimizers import AdamConfig
 from lerobot.policies.pretrained import PreTrainedPolicy
+
+from lerobot_phantom.eval.servo_policy import NonLearnedPolicyConfig
 
 GYM_ID = "eval_testkit/DotReach-v0"
 MAX_STEPS = 20
@@ -113,30 +114,9 @@ class DotReachEnvConfig(EnvConfig):
 
 @PreTrainedConfig.register_subclass("phantom_test_toy")
 @dataclass
-class ToyPolicyConfig(PreTrainedConfig):
+class ToyPolicyConfig(NonLearnedPolicyConfig):
     mode: str = "oracle"  # oracle | colour | instructed
     device: str | None = "cpu"
-
-    @property
-    def observation_delta_indices(self):
-        return None
-
-    @property
-    def action_delta_indices(self):
-        return None
-
-    @property
-    def reward_delta_indices(self):
-        return None
-
-    def get_optimizer_preset(self):
-        return AdamConfig()
-
-    def get_scheduler_preset(self):
-        return None
-
-    def validate_features(self) -> None:
-        return None
 
 
 def locate_red(front: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
