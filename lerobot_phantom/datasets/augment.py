@@ -45,6 +45,7 @@ import torch
 from tqdm import tqdm
 
 from lerobot_phantom import _lerobot_compat as compat
+from lerobot_phantom._cli import normalize_argv as normalize_cli_argv
 from lerobot_phantom.config import PhantomConfig
 from lerobot_phantom.datasets.mixer import PhantomDataset
 from lerobot_phantom.transforms.intensity import LEVELS
@@ -480,20 +481,7 @@ _FLAGS = ("resume", "overwrite")
 
 
 def normalize_argv(argv: list[str]) -> list[str]:
-    """Accept ``--repo-id`` for ``--repo_id`` and bare ``--resume`` / ``--overwrite`` (draccus wants values)."""
-    out: list[str] = []
-    for position, arg in enumerate(argv):
-        if not arg.startswith("--"):
-            out.append(arg)
-            continue
-        name, sep, value = arg[2:].partition("=")
-        name = name.replace("-", "_")
-        following = argv[position + 1] if position + 1 < len(argv) else None
-        if name in _FLAGS and not sep and (following is None or following.startswith("--")):
-            out.append(f"--{name}=true")
-        else:
-            out.append(f"--{name}{sep}{value}")
-    return out
+    return normalize_cli_argv(argv, _FLAGS)
 
 
 def main(argv: list[str] | None = None) -> None:

@@ -23,6 +23,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from lerobot_phantom._cli import normalize_argv as normalize_cli_argv
 from lerobot_phantom.envs.interface import ACTION_NAMES, CAMERAS, CONTROL_HZ, STATE_NAMES
 from lerobot_phantom.envs.suites import SUITE_NAMES, SUITES
 
@@ -204,20 +205,7 @@ _BARE_FLAGS = ("video", "overwrite", "progress")
 
 
 def normalize_argv(argv: list[str]) -> list[str]:
-    """Accept dashed names (``--repo-id``) and bare boolean flags (``--video``); draccus wants ``--video=true``."""
-    out: list[str] = []
-    for position, arg in enumerate(argv):
-        if not arg.startswith("--"):
-            out.append(arg)
-            continue
-        name, sep, value = arg[2:].partition("=")
-        name = name.replace("-", "_")
-        following = argv[position + 1] if position + 1 < len(argv) else None
-        if name in _BARE_FLAGS and not sep and (following is None or following.startswith("--")):
-            out.append(f"--{name}=true")
-        else:
-            out.append(f"--{name}{sep}{value}")
-    return out
+    return normalize_cli_argv(argv, _BARE_FLAGS)
 
 
 def main(argv: list[str] | None = None) -> None:
