@@ -48,7 +48,7 @@ from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 @PreTrainedConfig.register_subclass("phantom_bench_expert")
 @dataclass
 class ExpertConfig(NonLearnedPolicyConfig):
-    device: str | None = "cpu"
+    """The scripted expert behind LeRobot's policy interface (nothing to configure)."""
 
 
 class ExpertPolicy(PreTrainedPolicy):

@@ -116,7 +116,6 @@ class DotReachEnvConfig(EnvConfig):
 @dataclass
 class ToyPolicyConfig(NonLearnedPolicyConfig):
     mode: str = "oracle"  # oracle | colour | instructed
-    device: str | None = "cpu"
 
 
 def locate_red(front: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
