@@ -26,7 +26,13 @@ from torch.utils.data import get_worker_info
 from torchvision import tv_tensors
 from torchvision.transforms import v2
 
-from lerobot_phantom.transforms.intensity import IntensitySpec, parse_intensity, sample_intensity
+from lerobot_phantom.transforms.intensity import (
+    IntensitySpec,
+    is_random,
+    parse_intensity,
+    sample_intensity,
+    sample_random_intensity,
+)
 
 REFERENCE_SIZE = 256
 """Pixel-sized parameters (blur displacement, pattern offsets) are defined on a 256x256 image and scale with size."""
@@ -158,6 +164,8 @@ class SeededAttack:
             if not bool(((s >= 0) & (s <= 1)).all()):
                 raise ValueError(f"intensity must lie in [0, 1], got {s.tolist()}")
             return s
+        if is_random(self.intensity if intensity is None else intensity):  # the authors' AT distribution
+            return sample_random_intensity(self, batch_size, generator, device)
         rng = self.intensity_range if intensity is None else parse_intensity(intensity)
         return sample_intensity(rng, batch_size, generator, device)
 

@@ -31,7 +31,7 @@ import torch
 
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
     check_levels,
     laser_spot,
@@ -95,6 +95,8 @@ class LaserBlinding(CameraAttack):
     """Laser blinding; see the module docstring. ``levels`` overrides the alpha table (identity, weak, medium, strong)."""
 
     name: ClassVar[str] = "laser_blinding"
+    # the authors' adversarial training: weight uniform in [0.1, 0.9] per attacked sample
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(0.1, 0.9)
 
     def __init__(
         self,

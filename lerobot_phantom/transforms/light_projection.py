@@ -39,7 +39,7 @@ from lerobot_phantom.transforms.base import (
     from_float_rgb,
     to_float_rgb,
 )
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
     PROJECTION_SHAPES,
     check_levels,
@@ -138,6 +138,8 @@ class LightProjection(CameraAttack):
     """Light projection; see the module docstring. ``levels`` overrides the transparency table."""
 
     name: ClassVar[str] = "light_projection"
+    # the authors' adversarial training: weight uniform in [0.1, 0.9] per attacked sample
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(0.1, 0.9)
 
     def __init__(
         self,
