@@ -12,7 +12,9 @@ Contract (every attack in this package, and the mixer, eval and device-side step
 
 Images: uint8 (0-255) or floating (0-1) tensors, ``(C, H, W)`` or ``(B, C, H, W)`` (any further leading dims are
 flattened into the batch), C in {1, 3, 4}; output has the input's dtype, shape and device. Subclasses implement
-``_sample(s, height, width, generator, device)`` and ``_apply(x, params)`` on float32 ``(B, 3, H, W)`` in [0, 1].
+``_sample(s, height, width, generator, device)`` and ``_apply(x, params)`` on float32 ``(B, 3, H, W)`` in [0, 1],
+and optionally ``_apply_uint8(x, params)`` on uint8 ``(B, 3, H, W)``, which uint8 images then take with no float
+round trip (contract: ``CameraAttack._apply_uint8``).
 """
 
 from __future__ import annotations
@@ -96,6 +98,36 @@ def to_float_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
     elif x.shape[1] == 1:
         x = x.expand(-1, 3, -1, -1)
     return x, alpha
+
+
+def to_rgb(img: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor | None]:
+    """Any supported image -> ((N, 3, H, W) RGB in the image's own dtype, alpha channel or None).
+
+    Views of ``img`` where possible (an alpha split, a grey image expanded to three channels): read-only inputs.
+    """
+    x = img.reshape(-1, *img.shape[-3:])
+    if x.shape[1] == 4:
+        return x[:, :3], x[:, 3:]
+    if x.shape[1] == 1:
+        return x.expand(-1, 3, -1, -1), None
+    return x, None
+
+
+def from_uint8_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tensor) -> torch.Tensor:
+    """Inverse of ``to_rgb`` for a uint8 result: back to the channel count and shape of ``like`` (uint8).
+
+    A grey image gets the rounded channel mean, as ``from_float_rgb`` gives it (the mean of three integers is never
+    exactly half-way, so round-half-up in integers equals torch's round-half-even). The result never aliases
+    ``like``.
+    """
+    if like.shape[-3] == 1:
+        total = x.sum(dim=1, keepdim=True, dtype=torch.int16)
+        x = total.mul_(2).add_(3).div_(6, rounding_mode="floor").to(torch.uint8)
+    elif alpha is not None:
+        x = torch.cat([x, alpha], dim=1)
+    elif _shares_storage(x, like):
+        x = x.clone()
+    return x.reshape(like.shape)
 
 
 def _shares_storage(a: torch.Tensor, b: torch.Tensor) -> bool:
@@ -233,9 +265,19 @@ class CameraAttack(SeededAttack, v2.Transform):
 
     def apply_params(self, img: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         check_image(img)
+        if img.dtype == torch.uint8:  # the subclass's integer kernel, if it has one for these parameters
+            x, alpha = to_rgb(img)
+            y = self._run_kernel(self._apply_uint8, x, params, img)
+            if y is not NotImplemented:
+                return from_uint8_rgb(y, alpha, img)
         x, alpha = to_float_rgb(img)
+        return from_float_rgb(self._run_kernel(self._apply, x, params, img), alpha, img)
+
+    def _run_kernel(
+        self, kernel: Callable[..., Any], x: torch.Tensor, params: dict[str, torch.Tensor], img: torch.Tensor
+    ) -> Any:
         try:
-            y = self._apply(x, params)
+            return kernel(x, params)
         except Exception as err:  # re-raised with context: which attack, which parameters
             shown = {
                 k: (v.tolist() if isinstance(v, torch.Tensor) and v.numel() <= 8 else v)
@@ -244,7 +286,6 @@ class CameraAttack(SeededAttack, v2.Transform):
             raise RuntimeError(
                 f"{type(self).__name__} failed on image {tuple(img.shape)} with {shown}"
             ) from err
-        return from_float_rgb(y, alpha, img)
 
     # -- subclass hooks -----------------------------------------------------------------------------------
     def _sample(
@@ -259,6 +300,12 @@ class CameraAttack(SeededAttack, v2.Transform):
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         raise NotImplementedError
+
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> Any:
+        """Optional integer kernel: uint8 ``(N, 3, H, W)`` RGB (possibly a read-only view of the caller's image) ->
+        uint8 ``(N, 3, H, W)``, within one grey level of ``_apply`` on ``x / 255``. ``NotImplemented`` (the
+        default, or for parameters/options the integer kernel does not cover) falls back to the float path."""
+        return NotImplemented
 
     def extra_repr(self) -> str:
         return f"intensity={self.intensity!r}, seed={self.seed!r}"
