@@ -27,6 +27,7 @@ import torch
 from torch.utils.data import get_worker_info
 from torchvision import tv_tensors
 from torchvision.transforms import v2
+from torchvision.transforms.v2.functional import is_pure_tensor
 
 from lerobot_phantom.transforms.intensity import (
     IntensitySpec,
@@ -147,12 +148,41 @@ def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tens
     return x.reshape(like.shape)
 
 
-class SeededAttack:
-    """What every attack shares: its intensity, a lazily seeded generator, a per-instance cache, pickling.
+IMAGE_TYPES = (tv_tensors.Image, tv_tensors.Video, is_pure_tensor)
+"""What a camera attack transforms in a torchvision v2 call (``check_type`` accepts the predicate)."""
 
-    The generator is seeded from (attack name, ``seed``, dataloader worker id), so workers draw different streams
-    and no global RNG is ever touched. Pickling keeps the generator's state and drops the cache (derived tensors,
-    rebuilt on demand), so an attack travels cheaply to dataloader workers.
+
+def first_image(flat_inputs: list[Any]) -> torch.Tensor | None:
+    """The input a v2 call's parameters are drawn for: its first image, video or plain tensor (None: nothing to
+    attack, e.g. a call with masks only, which then passes through like any torchvision transform's)."""
+    for x in flat_inputs:
+        if isinstance(x, tv_tensors.Image | tv_tensors.Video) or is_pure_tensor(x):
+            return x
+    return None
+
+
+def rewrap(output: torch.Tensor, inpt: Any) -> Any:
+    """``output`` as ``inpt``'s tv_tensor type (Image stays Image, Video stays Video), plain tensors as they are."""
+    return tv_tensors.wrap(output, like=inpt) if isinstance(inpt, tv_tensors.TVTensor) else output
+
+
+class SeededAttack:
+    """What every attack shares: its intensity, a seeded random stream, a per-instance cache, pickling.
+
+    Streams follow the contract of torchvision and LeRobot, whose transforms draw from torch's global RNG, which a
+    ``DataLoader`` reseeds in every worker with ``base_seed + worker_id`` (``base_seed`` is drawn from the main
+    process's RNG, or the loader's ``generator``, each time an iterator is made):
+
+    * in the main process (no dataloader worker) the stream is ``torch.Generator`` seeded from (attack name,
+      ``seed``), or the ``generator`` the caller passed, used as is;
+    * in a dataloader worker it is seeded from (attack name, ``seed``, the worker's seed
+      ``get_worker_info().seed``, and the passed generator's ``initial_seed()`` if any): every worker gets its own
+      stream, non-persistent workers get a new one every epoch (persistent workers continue theirs), and a fixed
+      torch seed (LeRobot's ``--seed``) reproduces a run.
+
+    The stream is keyed by the process's worker seed, so whatever the attack drew before it reached a worker (a
+    preview in the main process, forked or pickled state) never leaks into the worker's stream. Pickling keeps the
+    stream (a copy in the same process continues it) and drops the cache (derived tensors, rebuilt on demand).
     """
 
     name: ClassVar[str] = ""
@@ -164,15 +194,25 @@ class SeededAttack:
         self.intensity_range = parse_intensity(intensity)
         self.seed = seed
         self._generator = generator
+        self._stream_key: int | None = None  # the worker seed the generator belongs to (None: main process)
+        self._user_seed = None if generator is None else generator.initial_seed()
         self._cache: dict[Any, Any] = {}
 
     def _get_generator(self) -> torch.Generator:
-        if self._generator is None:
-            worker = get_worker_info()
-            worker_id = worker.id if worker is not None else -1
-            self._generator = torch.Generator().manual_seed(
-                derive_seed(self.name, 0 if self.seed is None else self.seed, worker_id)
-            )
+        """The stream of this process: see the class docstring."""
+        worker = get_worker_info()
+        key = None if worker is None else int(worker.seed)
+        if self._generator is None or self._stream_key != key:
+            seed = 0 if self.seed is None else self.seed
+            if key is None:
+                # only reached without a caller's generator: a caller's generator is kept in the main process
+                derived = derive_seed(self.name, seed, -1)
+            else:
+                derived = derive_seed(
+                    self.name, seed, "worker", key, -1 if self._user_seed is None else self._user_seed
+                )
+            self._generator = torch.Generator().manual_seed(derived)
+            self._stream_key = key
         return self._generator
 
     def _cached(self, key: Any, make: Callable[[], Any]) -> Any:
@@ -210,9 +250,12 @@ class SeededAttack:
 
     def __setstate__(self, state: dict[str, Any]) -> None:
         generator_state = state.pop("_generator_state", None)
+        state.setdefault("_stream_key", None)
+        state.setdefault("_user_seed", None)
         self.__dict__.update(state)
         self._generator = None
         if generator_state is not None:
+            # Continued only in the process it belongs to: _get_generator reseeds when the worker seed differs.
             self._generator = torch.Generator()
             self._generator.set_state(generator_state)
 
@@ -220,7 +263,9 @@ class SeededAttack:
 class CameraAttack(SeededAttack, v2.Transform):
     """Base class; see the module docstring for the contract."""
 
-    _transformed_types = (torch.Tensor, tv_tensors.Image, tv_tensors.Video)
+    # torchvision v2 semantics: images, videos and plain tensors are attacked; masks, boxes, keypoints and any other
+    # tv_tensor (or non-tensor) pass through untouched.
+    _transformed_types = IMAGE_TYPES
 
     def __init__(
         self,
@@ -234,7 +279,9 @@ class CameraAttack(SeededAttack, v2.Transform):
 
     # -- torchvision v2 hooks -------------------------------------------------------------------------
     def make_params(self, flat_inputs: list[Any]) -> dict[str, Any]:
-        image = next(x for x in flat_inputs if isinstance(x, torch.Tensor))
+        image = first_image(flat_inputs)
+        if image is None:
+            return {}
         if image.ndim < 3:  # the full check runs once, in apply_params
             check_image(image)
         batch = int(torch.tensor(image.shape[:-3]).prod().item()) if image.ndim > 3 else 1
@@ -242,9 +289,7 @@ class CameraAttack(SeededAttack, v2.Transform):
         return self.sample_params(batch, height, width, generator=self._get_generator(), device=image.device)
 
     def transform(self, inpt: Any, params: dict[str, Any]) -> Any:
-        if not isinstance(inpt, torch.Tensor):
-            return inpt
-        return self.apply_params(inpt, params)
+        return rewrap(self.apply_params(inpt.as_subclass(torch.Tensor), params), inpt)
 
     # -- explicit API -----------------------------------------------------------------------------------
     def sample_params(
