@@ -37,6 +37,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -126,11 +127,27 @@ def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.devi
     return values.reshape(-1, 1, 1, 1)
 
 
+CHUNK_BYTES = 1 << 20
+"""Images are blended in chunks of about this many bytes, so each pass runs in cache: a batch costs no more per
+image than a single image."""
+
+
 def blend(x: torch.Tensor, alpha: torch.Tensor | float, pattern: torch.Tensor) -> torch.Tensor:
-    """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding)."""
+    """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding).
+
+    ``pattern``: ``(1 or B, 3, H, W)``. Returns a new tensor in [0, 1].
+    """
     weight = _as_batch_values(alpha, x.shape[0], x.device)
-    # a convex combination of values in [0, 1] stays in [0, 1]: the clip only guards patterns out of range
-    return torch.lerp(x, pattern.to(x.dtype), weight).clamp_(0.0, 1.0)
+    pattern = pattern.to(x.dtype)
+    out = torch.empty_like(x, memory_format=torch.contiguous_format)
+    step = max(1, CHUNK_BYTES // max(1, x[:1].numel() * x.element_size()))
+    for start in range(0, x.shape[0], step):
+        chunk = slice(start, start + step)
+        w = weight[chunk] if weight.shape[0] > 1 else weight
+        p = pattern[chunk] if pattern.shape[0] > 1 else pattern
+        # a convex combination of values in [0, 1] stays in [0, 1]: the clip only guards patterns out of range
+        torch.lerp(x[chunk], p, w, out=out[chunk]).clamp_(0.0, 1.0)
+    return out
 
 
 def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: torch.Tensor) -> torch.Tensor:
@@ -149,6 +166,11 @@ def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: to
     flat, _ = to_float_rgb(pattern.to(image.device))
     resized = torch.stack([resize_pattern(p, *x.shape[-2:]) for p in flat])
     return from_float_rgb(blend(x, alpha, resized), keep_alpha, image)
+
+
+def _offset(grey: torch.Tensor, alpha: float) -> torch.Tensor:
+    """``alpha * pattern * 255 + 0.5``: the pattern's share of a rounded uint8 blend."""
+    return torch.mul(grey, alpha).add_(0.5)
 
 
 def _parse_position(position: str | Sequence[float]) -> tuple[float, float] | None:
@@ -200,6 +222,8 @@ class LaserBlinding(CameraAttack):
         if model not in ("paper", "physical"):
             raise ValueError(f"unknown laser blinding model {model!r}; valid: 'paper', 'physical'")
         self.model = model
+        # the paper's blend returns a fresh tensor in [0, 1]: the base skips its final clamp
+        self._apply_in_unit_range = model == "paper"
         flat = dict(options)
         spot_given = spot is not None or any(f.name in flat for f in dataclasses.fields(LaserSpot))
         self.spot = _options(LaserSpot, spot, flat)
@@ -354,24 +378,38 @@ class LaserBlinding(CameraAttack):
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         """The paper's blend on uint8 ``(N, 3, H, W)`` without a batch-sized float copy.
 
-        One image at a time in a float32 scratch that stays in cache: ``lerp`` towards the pattern in grey levels,
-        then round. The float path rounds the same float32 blend, so the two agree up to rounding ties.
+        One image at a time in a float32 scratch that stays in cache, rounded by adding 0.5 and truncating through
+        int16 (the fast float -> uint8 route). At the level table's alphas with a fixed position the blend is
+        ``x * (1 - alpha) + q`` with ``q = alpha * pattern * 255 + 0.5`` cached; other alphas ``lerp``. The float
+        path rounds the same blend: equal up to rounding ties.
         """
         if self.model != "paper":
             return NotImplemented
         height, width = x.shape[-2:]
         pattern = self.patterns_for(params["position"], height, width, x.device)
-        if self._fixed_position is not None:
-            grey = self._cached(("grey", height, width, str(x.device)), lambda: pattern * 255.0)
-        else:
-            grey = pattern * 255.0
-        alpha = params["alpha"].to(torch.float64).reshape(-1).expand(x.shape[0]).tolist()
+        alphas = params["alpha"].to(torch.float64).reshape(-1).expand(x.shape[0]).tolist()
+        cacheable = self._fixed_position is not None
+        grey = (
+            self._cached(("grey", height, width, str(x.device)), lambda: pattern * 255.0)
+            if cacheable
+            else None
+        )
         out = torch.empty(x.shape, dtype=torch.uint8, device=x.device)
         scratch = torch.empty(x.shape[1:], dtype=torch.float32, device=x.device)
-        for i, weight in enumerate(alpha):
+        as_int16 = torch.empty(x.shape[1:], dtype=torch.int16, device=x.device)
+        for i, alpha in enumerate(alphas):
             scratch.copy_(x[i])
-            scratch.lerp_(grey[i if grey.shape[0] > 1 else 0], weight)
-            out[i].copy_(scratch.add_(0.5))  # values lie in [0, 255.5]: truncation after + 0.5 rounds
+            level = min(self.levels, key=lambda v: abs(v - alpha))
+            if cacheable and abs(level - alpha) < 1e-7:  # a paper level: at most 4 cached offsets per size
+                q = self._cached(
+                    ("offset", height, width, level, str(x.device)), partial(_offset, grey[0], alpha)
+                )
+                torch.add(q, scratch, alpha=1.0 - alpha, out=scratch)
+            else:
+                target = grey[0] if grey is not None else pattern[i if pattern.shape[0] > 1 else 0] * 255.0
+                scratch.lerp_(target, alpha).add_(0.5)
+            as_int16.copy_(scratch)  # values in [0.5, 255.5]: truncation rounds
+            out[i].copy_(as_int16)
         return out
 
     def _apply_physical(
