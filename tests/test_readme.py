@@ -8,8 +8,8 @@ How each fenced block of the README is treated, in order:
   ``configs/``, linked into the scratch directory), never by hand;
 * ``json`` blocks must parse (a fragment such as ``"image_transforms": {...}`` is read inside braces), and an
   ``image_transforms`` object must build through LeRobot's ``ImageTransforms`` after ``lerobot_phantom.register()``;
-* a shell block that runs ``scripts/setup.sh`` (system packages, ``pip install``) is never run by a test: it must
-  be skipped as covered by ``.ci/run``, which runs the setup itself;
+* a shell block that runs ``scripts/setup.sh`` (system packages, ``pip install``) or pytest (the suite would run
+  this test again) is never run by a test: it must be skipped as covered by ``.ci/run``, which runs both;
 * any other block, and any block the test cannot run verbatim within CI's budget, carries an annotation: an HTML
   comment (invisible on GitHub) on the line right before the opening fence. The forms:
 
@@ -151,10 +151,10 @@ def plan_block(block: Block, repo: Path = REPO) -> Plan:
     if block.language == "python":
         return Plan("run-python", text, replacements=replacements)
     if block.language in SHELL_LANGUAGES:
-        if "scripts/setup.sh" in text:
+        if "scripts/setup.sh" in text or re.search(r"\bpytest\b", text):
             raise ReadmeError(
-                f"{where}: runs scripts/setup.sh (system packages, pip install): never from a test; annotate it "
-                "'skip; REASON; covered by .ci/run' (CI runs setup.sh itself)"
+                f"{where}: runs scripts/setup.sh (system packages, pip install) or the test suite (which runs this "
+                "test): never from a test; annotate it 'skip; REASON; covered by .ci/run' (CI runs both itself)"
             )
         return Plan("run-shell", text, replacements=replacements)
     if block.language == "json":
@@ -333,9 +333,11 @@ def test_skip_needs_a_reason_and_an_existing_covering_test():
         _plan("<!-- readme-test: skip; covered by tests/test_readme.py -->\n```bash\nx\n```\n")
 
 
-def test_setup_is_never_run_by_the_harness():
+def test_setup_and_the_test_suite_are_never_run_by_the_harness():
     with pytest.raises(ReadmeError, match="never from a test"):
         _plan("```bash\nbash scripts/setup.sh && lerobot-phantom-demo --out outputs/demo\n```\n")
+    with pytest.raises(ReadmeError, match="never from a test"):
+        _plan("```bash\nHF_HUB_OFFLINE=1 python3 -m pytest -q\n```\n")
 
 
 def test_replace_must_match_the_block():
