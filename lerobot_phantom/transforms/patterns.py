@@ -2,8 +2,9 @@
 
 The paper blends *recorded* patterns (a photo of a laser hitting the camera, photos of projected images). This
 package ships no third-party images, so the patterns are generated here from a few physical parameters, and a
-user may pass the path of their own capture instead. Every size is relative to the image (the shorter side
-``L = min(H, W)``), so a 96x96 and a 480x640 camera see the same attack.
+user may pass the path of their own capture instead. Laser patterns are sized relative to the image (the glare to
+the frame, the spot to the shorter side ``L = min(H, W)``), so a 96x96 and a 480x640 camera see the same attack;
+projected shapes have a native pixel size (``NATIVE_SHAPE_HEIGHT``), as the authors' watermark has.
 
 Laser spot model (``laser_spot``): the lens spreads a laser beam into a point-spread function with a flat core and
 a power-law glare tail, ``E(r) = (1 + (r / r_core)^2)^(-k / 2)`` (``k`` = ``halo_exponent``; veiling glare falls
