@@ -68,10 +68,13 @@ def check_image(img: torch.Tensor) -> None:
     if img.dtype == torch.bool or img.is_complex():
         raise TypeError(f"unsupported image dtype {img.dtype}; use uint8 (0-255) or float (0-1)")
     if img.is_floating_point():
-        # min/max propagate NaN and expose +-inf, at a fraction of the cost of isfinite(img).all()
-        low, high = img.aminmax()
-        if not (torch.isfinite(low) and torch.isfinite(high)):
-            raise ValueError("image contains NaN or infinite values")
+        # A sum propagates NaN and +-inf at a quarter of the cost of aminmax (which costs as much as a clone);
+        # only a non-finite sum (which a huge but finite image can also give) needs the exact check.
+        total = img.sum(dtype=torch.float64 if img.dtype == torch.float64 else torch.float32)
+        if not torch.isfinite(total):
+            low, high = img.aminmax()
+            if not (torch.isfinite(low) and torch.isfinite(high)):
+                raise ValueError("image contains NaN or infinite values")
 
 
 def per_sample_values(
@@ -135,15 +138,23 @@ def _shares_storage(a: torch.Tensor, b: torch.Tensor) -> bool:
     return a.untyped_storage().data_ptr() == b.untyped_storage().data_ptr()
 
 
-def from_float_rgb(x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tensor) -> torch.Tensor:
-    """Inverse of ``to_float_rgb``: back to the dtype, channel count and shape of ``like``."""
+def from_float_rgb(
+    x: torch.Tensor, alpha: torch.Tensor | None, like: torch.Tensor, *, in_unit_range: bool = False
+) -> torch.Tensor:
+    """Inverse of ``to_float_rgb``: back to the dtype, channel count and shape of ``like``.
+
+    ``in_unit_range``: ``x`` is a fresh tensor (no view of ``like``) already in [0, 1], so the clamp (a full pass)
+    is skipped."""
     if like.shape[-3] == 1:
         x = x.mean(dim=1, keepdim=True)
     elif alpha is not None:
         x = torch.cat([x, alpha], dim=1)
     # In place when the kernel's result is its own tensor; a result that aliases the caller's float input
     # (an identity, a view) must not be modified, so it gets one copy.
-    x = x.clamp(0.0, 1.0) if _shares_storage(x, like) else x.clamp_(0.0, 1.0)
+    if _shares_storage(x, like):
+        x = x.clamp(0.0, 1.0)
+    elif not in_unit_range or alpha is not None:  # the caller's alpha channel is not the kernel's
+        x = x.clamp_(0.0, 1.0)
     x = x.mul_(255.0).round_().to(torch.uint8) if like.dtype == torch.uint8 else x.to(like.dtype)
     return x.reshape(like.shape)
 
@@ -266,6 +277,8 @@ class CameraAttack(SeededAttack, v2.Transform):
     # torchvision v2 semantics: images, videos and plain tensors are attacked; masks, boxes, keypoints and any other
     # tv_tensor (or non-tensor) pass through untouched.
     _transformed_types = IMAGE_TYPES
+    _apply_in_unit_range: ClassVar[bool] = False
+    """A subclass whose ``_apply`` always returns a fresh tensor in [0, 1] sets this: the final clamp is skipped."""
 
     def __init__(
         self,
@@ -316,7 +329,8 @@ class CameraAttack(SeededAttack, v2.Transform):
             if y is not NotImplemented:
                 return from_uint8_rgb(y, alpha, img)
         x, alpha = to_float_rgb(img)
-        return from_float_rgb(self._run_kernel(self._apply, x, params, img), alpha, img)
+        y = self._run_kernel(self._apply, x, params, img)
+        return from_float_rgb(y, alpha, img, in_unit_range=self._apply_in_unit_range)
 
     def _run_kernel(
         self, kernel: Callable[..., Any], x: torch.Tensor, params: dict[str, torch.Tensor], img: torch.Tensor

@@ -56,7 +56,7 @@ from lerobot_phantom.transforms.base import (
     from_float_rgb,
     to_float_rgb,
 )
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 
 MAX_SAMPLES = 100
 SNAP = 1e-6
@@ -237,6 +237,10 @@ class UltrasoundBlur(CameraAttack):
 
     name: ClassVar[str] = "ultrasound_blur"
     LEVEL_DISPLACEMENT_PX: ClassVar[tuple[float, float, float, float]] = LEVEL_DISPLACEMENT_PX
+    # the authors' adversarial training: displacement randint(5, 20) px (both ends included) at the reference size
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(
+        5, 20, integer=True, levels=LEVEL_DISPLACEMENT_PX
+    )
 
     def __init__(
         self,
@@ -278,7 +282,11 @@ class UltrasoundBlur(CameraAttack):
         """Linear displacement per axis, pixels at the 256x256 reference, at intensity ``s`` (per sample)."""
         if self.displacement_px is not None:
             return torch.full_like(s, self.displacement_px, dtype=torch.float32)
-        return interpolate_levels(s, self.LEVEL_DISPLACEMENT_PX)
+        d = interpolate_levels(s, self.LEVEL_DISPLACEMENT_PX)
+        # "random" draws whole pixels and reports s through the inverse level map; the float32 round trip comes
+        # back a few 1e-6 px short of the integer, which would drop a sample from the path: snap it
+        whole = d.round()
+        return torch.where((d - whole).abs() < 1e-4, whole, d)
 
     def _sample(self, s, height, width, generator, device):
         d = self.displacement_for(s).to(torch.float64)
