@@ -54,7 +54,9 @@ from lerobot_phantom.transforms.base import (
     CameraAttack,
     check_image,
     from_float_rgb,
+    from_uint8_rgb,
     to_float_rgb,
+    to_rgb,
 )
 from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 
@@ -108,6 +110,42 @@ def _axis_valid(
     return ((positions >= lo) & (positions < hi)).any(dim=1).to(torch.float32)
 
 
+def _shift_add(
+    a: torch.Tensor, b: torch.Tensor, k: int, step: tuple[int, int], out: torch.Tensor
+) -> torch.Tensor:
+    """``out = a + b`` shifted by ``k`` steps along ``step`` (``out[r, c] = a[r, c] + b[r + k sr, c + k sc]``, zero
+    where that leaves the image). ``out`` must not overlap ``a`` or ``b``."""
+    height, width = a.shape[-2:]
+    dr, dc = k * step[0], k * step[1]
+    r0, r1, c0, c1 = max(0, -dr), min(height, height - dr), max(0, -dc), min(width, width - dc)
+    if r0 >= r1 or c0 >= c1:
+        return out.copy_(a)
+    torch.add(a[..., r0:r1, c0:c1], b[..., r0 + dr : r1 + dr, c0 + dc : c1 + dc], out=out[..., r0:r1, c0:c1])
+    for rows, cols in ((slice(0, r0), slice(None)), (slice(r1, None), slice(None))):
+        out[..., rows, cols].copy_(a[..., rows, cols])
+    for cols in (slice(0, c0), slice(c1, None)):
+        out[..., r0:r1, cols].copy_(a[..., r0:r1, cols])
+    return out
+
+
+def _box_sum(x: torch.Tensor, step: tuple[int, int], length: int) -> torch.Tensor:
+    """``sum_{i < length} x[r + i sr, c + i sc]`` (zero outside) by doubling: ~2 log2(length) shifted adds instead of
+    ``length`` (5 instead of 17 at the paper's strong level on 224x224), summed as a tree (float error ~log2)."""
+    result, covered, power, size = None, 0, x, 1
+    while True:
+        if length & 1:
+            if result is None:
+                result, covered = power, size
+            else:
+                result = _shift_add(result, power, covered, step, torch.empty_like(x))
+                covered += size
+        length >>= 1
+        if not length:
+            return result
+        power = _shift_add(power, power, size, step, torch.empty_like(x))
+        size *= 2
+
+
 def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
     """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views."""
     batch, _, height, width = x.shape
@@ -120,6 +158,21 @@ def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
     row_valid = _axis_valid(height, [rows for rows, _ in spans], x.device)
     col_valid = _axis_valid(width, [cols for _, cols in spans], x.device)
     count = (row_valid.T @ col_valid).to(x.dtype)  # (H, W) in-bounds samples; sample 0 is the pixel itself
+    # The paper's diagonal (and any axis-aligned path): sample i sits exactly i steps of (0 or 1, 0 or 1) away,
+    # so the path is a box along one direction, summed by doubling.
+    shifts = [
+        (math.floor(i / num * d_row + SNAP), math.floor(i / num * d_col + SNAP)) for i in range(num + 1)
+    ]
+    step = shifts[1]
+    if step in ((1, 1), (1, 0), (0, 1)) and all(
+        s == (i * step[0], i * step[1]) for i, s in enumerate(shifts)
+    ):
+        out = torch.empty_like(x)
+        per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())  # a few images at a time stay in cache
+        for first in range(0, batch, per_chunk):
+            part = x[first : first + per_chunk]
+            torch.div(_box_sum(part, step, num + 1), count, out=out[first : first + per_chunk])
+        return out
     out = torch.empty_like(x)
     # a few images at a time keep the ~N read-modify-write passes in cache
     per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())
@@ -208,6 +261,12 @@ def ultrasound_blur_float(
     return out
 
 
+def _blur_uint8(x: torch.Tensor, dx, dy, theta_deg, scale) -> torch.Tensor:
+    """uint8 RGB: the blur on the 0-255 values themselves (float32 sums of integers are exact), rounded once; no
+    scaling to [0, 1] and back (the mean of in-range values needs no clamp)."""
+    return ultrasound_blur_float(x.to(torch.float32), dx, dy, theta_deg, scale).round_().to(torch.uint8)
+
+
 def ultrasound_blur(
     image: torch.Tensor,
     dx: float | torch.Tensor,
@@ -221,6 +280,9 @@ def ultrasound_blur(
     degrees; ``scale``: radial part. Each a float or one value per image. Returns the input's shape, dtype, device.
     """
     check_image(image)
+    if image.dtype == torch.uint8:
+        x, alpha = to_rgb(image)
+        return from_uint8_rgb(_blur_uint8(x, dx, dy, theta_deg, scale), alpha, image)
     x, alpha = to_float_rgb(image)
     return from_float_rgb(ultrasound_blur_float(x, dx, dy, theta_deg, scale), alpha, image)
 
@@ -315,6 +377,11 @@ class UltrasoundBlur(CameraAttack):
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
             return torch.where(still, x, blurred)
         return ultrasound_blur_float(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
+
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.path != "uniform" or self.gamma is not None:
+            return NotImplemented
+        return _blur_uint8(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
 
     def extra_repr(self) -> str:
         extra = [f"{k}={getattr(self, k)!r}" for k in ("displacement_px", "rotation_deg", "radial_scale")]
