@@ -74,25 +74,25 @@ def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Ten
     new tensor of the input's shape, dtype and device. See the module docstring for the algorithm and the fix.
     """
     check_image(image)
-    flat = image.reshape(-1, *image.shape[-3:])
-    batch, _, height, width = flat.shape
+    channels, height, width = image.shape[-3:]
+    batch = image.numel() // (channels * height * width)
     ratios = _ratios(ratio, batch)
     lost = {int(height * r) for r in ratios}  # int(h * r) as the paper (and truncation_row_index)
     if len(lost) == 1:  # one ratio for the whole batch: a cached row index, no per-call index arithmetic
-        index = _shared_row_index(batch * flat.shape[1], height, lost.pop(), str(flat.device))
+        index = _shared_row_index(batch * channels, height, lost.pop(), image.device)
     else:  # per-sample ratios: still one gather of whole rows over the flattened batch
         per_image = truncation_row_index(
-            height, torch.tensor(ratios, dtype=torch.float64, device=flat.device)
+            height, torch.tensor(ratios, dtype=torch.float64, device=image.device)
         )
-        index = per_image.repeat_interleave(flat.shape[1], dim=0) + height * torch.arange(
-            per_image.shape[0] * flat.shape[1], device=flat.device
+        index = per_image.repeat_interleave(channels, dim=0) + height * torch.arange(
+            batch * channels, device=image.device
         ).unsqueeze(1)
         index = index.reshape(-1)
-    return flat.reshape(-1, width).index_select(0, index).reshape(image.shape)
+    return image.reshape(-1, width).index_select(0, index).view(image.shape)
 
 
 @functools.lru_cache(maxsize=32)
-def _shared_row_index(planes: int, height: int, num: int, device: str) -> torch.Tensor:
+def _shared_row_index(planes: int, height: int, num: int, device: torch.device) -> torch.Tensor:
     """Source row of every row of ``planes`` stacked ``height``-row planes that all lose ``num`` rows."""
     rows = _rows_losing(height, torch.tensor([num]))[0]
     offsets = height * torch.arange(planes).unsqueeze(1)
