@@ -121,7 +121,7 @@ def registrations_before_and_after(route: str) -> tuple[dict, dict]:
 def test_importing_the_package_registers_nothing_and_lerobot_plugin_discovery_registers_everything():
     # what `lerobot-train --dataset.discover_packages_path=lerobot_phantom` runs before parsing its flags
     before, after = registrations_before_and_after(
-        "from lerobot.configs.parser import load_plugin; load_plugin('lerobot_phantom')"
+        "from lerobot_phantom import _lerobot_compat; _lerobot_compat.plugin_loader()('lerobot_phantom')"
     )
     assert before == NOTHING
     assert after == EVERYTHING
