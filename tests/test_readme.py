@@ -251,6 +251,7 @@ def test_every_block_is_run_or_annotated():
 RUNNABLE = [b for b in readme_blocks() if b.language in {"python", "json", *SHELL_LANGUAGES}]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("block", RUNNABLE, ids=[b.case_id for b in RUNNABLE])
 def test_readme_block(block, readme_results):
     try:
