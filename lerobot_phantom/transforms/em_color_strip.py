@@ -15,8 +15,9 @@ Deviations from the paper's code (and why):
 * **No uint8 overflow.** The released code adds R and B as ``np.uint8``, which wraps modulo 256, so a bright
   pixel (R + B > 255) gets a *dark* green channel. Here the sum is computed in float: the paper's formula as
   written.
-* **Continuous values.** Float images keep continuous values (``2.5 G`` instead of ``int(2.5 G)``); for uint8
-  images the result is rounded, so it is within one grey level of the paper's truncating ``int()``.
+* **Continuous values for float images** (``2.5 G`` instead of ``int(2.5 G)``). uint8 images are computed in
+  integers with the paper's truncating ``int()`` exactly (no float round trip), so the two paths are within one
+  grey level of each other.
 * **At least one row per band.** ``step = max(1, int(h / N))``: the released code crashes (``range`` step 0) on
   images with fewer rows than stripes.
 * **Continuous intensity** (the paper has only three levels). With ``s`` the intensity (weak = 1/3, medium = 2/3,
@@ -33,8 +34,12 @@ Deviations from the paper's code (and why):
   The three levels are the paper's patterns exactly. Between levels the distortion is monotone whenever the
   paper's own levels are ordered for the image; they cover about half of the frame each (for h = 256:
   128 / 126 / 128 rows), so for a given image the medium level can distort slightly less than the weak one.
-* **Vectorised per sample**: the band pattern is a per-row weight, so a batch whose samples have different
-  stripe counts is one elementwise op.
+* **Memory-bound**: the band pattern is a per-row weight. When every sample shares it (a level, a fixed
+  ``num_stripes``) the bands are corrupted in place through strided views of a copy of the batch (the periodic
+  bands are one view); per-sample patterns (``"random"``, intensity ranges) gather the corrupted rows of the whole
+  batch, corrupt them, and gather the output back (no per-sample loop; a row scatter is several times slower).
+* **"random"** draws the authors' adversarial-training stripe count ``N = randint(8, 16)`` and applies the paper's
+  pattern for that ``N`` (a per-sample intensity tensor, e.g. the mixer's, still means the continuous map above).
 """
 
 from __future__ import annotations

@@ -16,9 +16,10 @@ Deviations from the paper's code (and why):
   0.1/0.2/0.3), and for ``1/3 < r <= 0.5`` the band slides up so that it never overlaps the appended tail. The
   output always has height ``h``. Ratios above 0.5 are rejected: with at most ``h`` rows there is no way to lose
   more than half of them and still append as many.
-* **Vectorised per sample, exact in any dtype** (no float round trip). One ratio for the whole batch is three row
-  slices joined by one ``torch.cat`` (as fast as the paper's ``np.delete`` / ``np.append`` on one image);
-  per-sample ratios are one gather of whole rows over the flattened batch (``index_select``, about a clone's cost).
+* **Vectorised per sample, exact in any dtype** (no float round trip): one gather of whole rows over the flattened
+  batch (``index_select``); for one ratio shared by the batch the row index is cached, so one image costs about what
+  the paper's ``np.delete`` / ``np.append`` does.
+* **"random"** draws the authors' adversarial-training ratio ``r ~ U(0.1, 0.3)``.
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that

@@ -22,8 +22,9 @@ between (``interpolate_levels``). Colour fractions (R, G, B) default to the pape
 Nothing else is random: the band is fixed by the image size.
 
 Deviations from the paper's code: vectorised; the (H, W) profile is computed once per (H, W, device) and cached
-(the loops recompute it per pixel); uint8 output is rounded instead of truncated by ``astype(uint8)``
-(at most 1 grey level apart).
+(the loops recompute it per pixel), and at a fixed level the whole increment too; uint8 images stay uint8 (a
+saturating add of the rounded increment), so the output is rounded instead of truncated by ``astype(uint8)``
+(at most 1 grey level apart). ``"random"`` draws the authors' adversarial-training strength ``S ~ U(500, 2500)``.
 """
 
 from __future__ import annotations

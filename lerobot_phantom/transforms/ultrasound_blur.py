@@ -36,9 +36,13 @@ path is only a pixel or two long, ``int()`` quantises its direction, so a slight
 different (not a larger) set of neighbours.
 
 Fast path: with no rotation and no radial part (the paper's levels) the path offsets are the same for every pixel,
-so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds count map: ``~N`` strided adds per
-image. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical parameters,
-so per-sample parameters cost one pass per distinct parameter set.
+so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds count map. On the paper's diagonal
+(and any axis-aligned path) sample ``i`` sits exactly ``i`` pixels along the direction, so the sum is a box summed
+by doubling: ``~2 log2(N)`` shifted adds (5 instead of 17 at the strong level on 224x224); other directions take
+``~N`` strided adds. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical
+parameters (one pass per distinct displacement: at most 16 under ``"random"``, which draws the authors' whole-pixel
+``randint(5, 20)``). uint8 images are blurred on their 0-255 values (float32 sums of integers are exact) and
+rounded once, with no scaling to [0, 1] and back.
 """
 
 from __future__ import annotations
