@@ -6,6 +6,7 @@ workers continue their streams, so epochs still differ; a caller's generator is 
 """
 
 import os
+import pickle
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
@@ -108,6 +109,34 @@ def test_every_worker_and_epoch_draws_its_own_stream_after_a_preview(frame, pers
     every_output = torch.cat(list(images.values())).flatten(1)
     # 4 streams x 16 draws of a continuous alpha: no draw repeats within or across streams
     assert torch.unique(every_output, dim=0).shape[0] == every_output.shape[0] == NUM_FRAMES * EPOCHS
+
+
+class PickledTransforms(Dataset):
+    """``SameFrame`` whose transforms reach each worker as pickled bytes (what a "spawn" worker receives), unpickled
+    on the worker's first item. (This container's shared memory is too small for a real "spawn" DataLoader.)"""
+
+    def __init__(self, frame, transforms):
+        self.frame = frame
+        self.pickled = pickle.dumps(transforms)
+        self.transforms = None
+
+    def __len__(self):
+        return NUM_FRAMES
+
+    def __getitem__(self, index):
+        if self.transforms is None:
+            self.transforms = pickle.loads(self.pickled)
+        return SameFrame(self.frame, self.transforms)[index]
+
+
+def test_pickled_after_a_preview_every_worker_and_epoch_still_differs(frame):
+    transforms = image_transforms("LaserBlinding", intensity="random", seed=0)
+    preview(transforms, frame)
+    pickled = stream_images(run_epochs(PickledTransforms(frame, transforms), seed=1))
+    every_output = torch.cat(list(pickled.values())).flatten(1)
+    assert torch.unique(every_output, dim=0).shape[0] == NUM_FRAMES * EPOCHS
+    forked = stream_images(run_epochs(SameFrame(frame, transforms), seed=1))
+    assert all(torch.equal(pickled[key], forked[key]) for key in forked)  # the same streams either way
 
 
 def test_a_fixed_seed_reproduces_the_run_whatever_the_preview(frame):
