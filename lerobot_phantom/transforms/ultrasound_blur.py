@@ -150,12 +150,14 @@ def _box_sum(x: torch.Tensor, step: tuple[int, int], length: int) -> torch.Tenso
         size *= 2
 
 
-def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
-    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views."""
+def _linear_blur(x: torch.Tensor, d_row: float, d_col: float, upper: float | None = None) -> torch.Tensor:
+    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views.
+
+    ``upper``: clamp the result to [0, upper], chunk by chunk while it is in cache (a fresh tensor then)."""
     batch, _, height, width = x.shape
     num = min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES)
     if num <= 0:
-        return x
+        return x if upper is None else x.clamp(0.0, upper)
     spans = [
         (_axis_spans(height, i / num * d_row), _axis_spans(width, i / num * d_col)) for i in range(num + 1)
     ]
@@ -176,6 +178,8 @@ def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
         for first in range(0, batch, per_chunk):
             part = x[first : first + per_chunk]
             torch.div(_box_sum(part, step, num + 1), count, out=out[first : first + per_chunk])
+            if upper is not None:
+                out[first : first + per_chunk].clamp_(0.0, upper)
         return out
     out = torch.empty_like(x)
     # a few images at a time keep the ~N read-modify-write passes in cache
@@ -188,11 +192,13 @@ def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
                 for c0, c1, cs in col_spans:
                     total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
         torch.div(total, count, out=out[first : first + per_chunk])
+        if upper is not None:
+            out[first : first + per_chunk].clamp_(0.0, upper)
     return out
 
 
 def _general_blur(
-    x: torch.Tensor, d_row: float, d_col: float, theta_deg: float, scale: float
+    x: torch.Tensor, d_row: float, d_col: float, theta_deg: float, scale: float, upper: float | None = None
 ) -> torch.Tensor:
     """General path (rotation and/or radial part): gather the samples of every pixel, float64 coordinates."""
     batch, channels, height, width = x.shape
@@ -233,7 +239,8 @@ def _general_blur(
         count += weight
     keep = count == 0
     out = torch.where(keep, flat, total / torch.where(keep, torch.ones_like(count), count))
-    return out.reshape(batch, channels, height, width)
+    out = out.reshape(batch, channels, height, width)
+    return out if upper is None else out.clamp_(0.0, upper)
 
 
 def ultrasound_blur_float(
@@ -242,8 +249,10 @@ def ultrasound_blur_float(
     dy: float | torch.Tensor,
     theta_deg: float | torch.Tensor = 0.0,
     scale: float | torch.Tensor = 0.0,
+    upper: float | None = None,
 ) -> torch.Tensor:
-    """``ultrasound_blur`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op)."""
+    """``ultrasound_blur`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op). ``upper``: also clamp
+    the result to [0, upper] while it is in cache (a fresh tensor then; the mean of in-range values is in range)."""
     batch = x.shape[0]
     columns = _per_sample(dx, batch, "dx")
     rows = _per_sample(dy, batch, "dy")
@@ -256,9 +265,9 @@ def ultrasound_blur_float(
     for (d_row, d_col, angle, radial), members in groups.items():
         part = x if out is None else x[members]
         if angle == 0.0 and radial == 0.0:
-            blurred = _linear_blur(part, d_row, d_col)
+            blurred = _linear_blur(part, d_row, d_col, upper)
         else:
-            blurred = _general_blur(part, d_row, d_col, angle, radial)
+            blurred = _general_blur(part, d_row, d_col, angle, radial, upper)
         if out is None:
             return blurred
         out[members] = blurred
@@ -302,6 +311,7 @@ class UltrasoundBlur(CameraAttack):
     """
 
     name: ClassVar[str] = "ultrasound_blur"
+    _apply_in_unit_range: ClassVar[bool] = True  # _apply clamps chunk by chunk, in cache
     LEVEL_DISPLACEMENT_PX: ClassVar[tuple[float, float, float, float]] = LEVEL_DISPLACEMENT_PX
     # the authors' adversarial training: displacement randint(5, 20) px (both ends included) at the reference size
     random_parameter: ClassVar[RandomParameter] = RandomParameter(
@@ -379,8 +389,10 @@ class UltrasoundBlur(CameraAttack):
             gamma = 1.0 if self.gamma is None else self.gamma
             blurred = physics.encode(physics.line_blur(physics.decode(x, gamma), dx, dy, offsets), gamma)
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
-            return torch.where(still, x, blurred)
-        return ultrasound_blur_float(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
+            return torch.where(still, x, blurred).clamp_(0.0, 1.0)
+        return ultrasound_blur_float(
+            x, params["dx"], params["dy"], params["theta_deg"], params["scale"], upper=1.0
+        )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         if self.path != "uniform" or self.gamma is not None:
