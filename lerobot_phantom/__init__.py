@@ -1,9 +1,16 @@
 """lerobot-phantom: physical sensor attacks for LeRobot policies (Phantom Menace, AAAI-26).
 
-Importing the package calls ``register()``, which makes LeRobot accept the camera attacks in image-transform
-configs (``ImageTransformConfig(type="LaserBlinding", ...)``), registers the ``phantom_table`` env type and its
-gymnasium ids (so ``--env.discover_packages_path=lerobot_phantom`` works with stock ``lerobot-eval``) and the
-``phantom_servo`` reference policy type.
+Importing the package (or ``lerobot_phantom.transforms``) imports neither LeRobot nor gymnasium: the attacks need
+torch, torchvision and Pillow only. ``register()`` plugs the package into LeRobot: camera attacks and the
+``PhantomMix`` mixing transform become valid image-transform types (``ImageTransformConfig(type="LaserBlinding",
+...)``), and the ``phantom_table`` env type with its gymnasium ids and the ``phantom_servo`` reference policy type
+are registered. It runs by itself on each of the three routes a LeRobot user takes:
+
+* LeRobot's plugin discovery, ``--<anything>.discover_packages_path=lerobot_phantom`` on any stock ``lerobot-*``
+  script (LeRobot imports the package and each of its top-level modules; ``lerobot_phantom.lerobot_plugin``
+  registers on import);
+* every ``lerobot-phantom-*`` console script;
+* an explicit ``lerobot_phantom.register()`` in your own code.
 """
 
 __version__ = "0.1.0"
@@ -18,6 +25,3 @@ def register() -> None:
 
     register_image_transforms()
     register_gym_envs()
-
-
-register()

@@ -87,18 +87,6 @@ def config_parser_wrap():
     return parser.wrap
 
 
-def make_accelerator(cfg) -> Any:
-    """An ``Accelerator`` built the way ``lerobot_train.train`` builds its own when none is passed."""
-    from accelerate import Accelerator
-    from accelerate.utils import DistributedDataParallelKwargs
-
-    return Accelerator(
-        step_scheduler_with_optimizer=False,
-        kwargs_handlers=[DistributedDataParallelKwargs(find_unused_parameters=True)],
-        cpu=cfg.policy.device == "cpu",
-    )
-
-
 def load_checkpoint_step(checkpoint_dir) -> int:
     """The training step stored in ``checkpoint_dir/training_state``."""
     from pathlib import Path
@@ -200,6 +188,22 @@ def eval_seed_everything(seed: int) -> None:
     from lerobot.utils.random_utils import set_seed
 
     set_seed(seed)
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# plugin discovery (lerobot_phantom.lerobot_plugin; checked by tests/test_standalone_import.py and
+# tests/train/test_stock_lerobot_train.py)
+#
+# Any ``--<field>.discover_packages_path=lerobot_phantom`` makes LeRobot 0.4.4's ``parser.wrap`` call
+# ``lerobot.configs.parser.load_plugin("lerobot_phantom")`` before parsing: it imports the package, then every module
+# and subpackage directly under it (``pkgutil.iter_modules``, not recursive), and drops the flag. The package
+# itself registers nothing on import; its ``lerobot_plugin`` module calls ``register()``.
+# ---------------------------------------------------------------------------------------------------------------
+def plugin_loader():
+    """``lerobot.configs.parser.load_plugin``: what ``--*.discover_packages_path=PACKAGE`` runs."""
+    from lerobot.configs.parser import load_plugin
+
+    return load_plugin
 
 
 # ---------------------------------------------------------------------------------------------------------------

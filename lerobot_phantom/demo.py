@@ -260,6 +260,9 @@ def _print_summary(report_dir: Path) -> None:
 
 
 def main() -> None:
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
 
     cfg = draccus.parse(config_class=DemoConfig)

@@ -184,6 +184,9 @@ def viz(cfg: VizConfig) -> Path:
 
 
 def main() -> None:
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
 
     logging.basicConfig(level=logging.INFO, format="%(message)s")

@@ -161,6 +161,9 @@ def normalize_argv(argv: list[str]) -> list[str]:
 
 
 def main(argv: list[str] | None = None) -> None:
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
 
     cfg = draccus.parse(CalibrateConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))

@@ -486,6 +486,9 @@ def normalize_argv(argv: list[str]) -> list[str]:
 
 def main(argv: list[str] | None = None) -> None:
     """Entry point; bad flags, bad settings and refused outputs end with a one-line error (exit status 1)."""
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
     from datasets.utils.logging import disable_progress_bar
 

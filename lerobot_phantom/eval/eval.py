@@ -275,6 +275,9 @@ def eval_cli(cfg: PhantomEvalConfig) -> dict[str, Any]:
 
 
 def main() -> None:
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     from lerobot.configs import parser
     from lerobot.utils.import_utils import register_third_party_plugins
     from lerobot.utils.utils import init_logging

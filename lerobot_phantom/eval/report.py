@@ -609,6 +609,9 @@ def report_cli(cfg: ReportConfig) -> dict[str, Path]:
 
 
 def main() -> None:
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
 
     draccus.wrap()(report_cli)()

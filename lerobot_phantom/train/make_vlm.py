@@ -373,6 +373,9 @@ class MakeVLMConfig:
 
 def main(args: Sequence[str] | None = None) -> None:
     # Returns None: console scripts pass main()'s return value to sys.exit.
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     cfg = draccus.parse(MakeVLMConfig, args=args)
     if not cfg.out:
         raise ValueError(

@@ -213,6 +213,9 @@ def _run_from_cli(cfg: PhantomTrainPipelineConfig) -> None:
 
 def main(args: Sequence[str] | None = None) -> None:
     """``lerobot-phantom-train [lerobot-train flags] [--phantom.* flags]``; ``args`` defaults to ``sys.argv[1:]``."""
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     compat.register_lerobot_plugins()
     # Importing LeRobot's training script registers every policy/env/optimizer config type for draccus.
     compat.train_script_module()

@@ -15,8 +15,9 @@ Deviations from the paper's code (and why):
 * **No uint8 overflow.** The released code adds R and B as ``np.uint8``, which wraps modulo 256, so a bright
   pixel (R + B > 255) gets a *dark* green channel. Here the sum is computed in float: the paper's formula as
   written.
-* **Continuous values.** Float images keep continuous values (``2.5 G`` instead of ``int(2.5 G)``); for uint8
-  images the result is rounded, so it is within one grey level of the paper's truncating ``int()``.
+* **Continuous values for float images** (``2.5 G`` instead of ``int(2.5 G)``). uint8 images are computed in
+  integers with the paper's truncating ``int()`` exactly (no float round trip), so the two paths are within one
+  grey level of each other.
 * **At least one row per band.** ``step = max(1, int(h / N))``: the released code crashes (``range`` step 0) on
   images with fewer rows than stripes.
 * **Continuous intensity** (the paper has only three levels). With ``s`` the intensity (weak = 1/3, medium = 2/3,
@@ -33,8 +34,12 @@ Deviations from the paper's code (and why):
   The three levels are the paper's patterns exactly. Between levels the distortion is monotone whenever the
   paper's own levels are ordered for the image; they cover about half of the frame each (for h = 256:
   128 / 126 / 128 rows), so for a given image the medium level can distort slightly less than the weak one.
-* **Vectorised per sample**: the band pattern is a per-row weight, so a batch whose samples have different
-  stripe counts is one elementwise op.
+* **Memory-bound**: the band pattern is a per-row weight. When every sample shares it (a level, a fixed
+  ``num_stripes``) the bands are corrupted in place through strided views of a copy of the batch (the periodic
+  bands are one view); per-sample patterns (``"random"``, intensity ranges) gather the corrupted rows of the whole
+  batch, corrupt them, and gather the output back (no per-sample loop; a row scatter is several times slower).
+* **"random"** draws the authors' adversarial-training stripe count ``N = randint(8, 16)`` and applies the paper's
+  pattern for that ``N`` (a per-sample intensity tensor, e.g. the mixer's, still means the continuous map above).
 """
 
 from __future__ import annotations
@@ -48,12 +53,21 @@ from lerobot_phantom.transforms.base import (
     CameraAttack,
     check_image,
     from_float_rgb,
+    from_uint8_rgb,
     per_sample_values,
     to_float_rgb,
+    to_rgb,
 )
-from lerobot_phantom.transforms.intensity import IntensitySpec
+from lerobot_phantom.transforms.intensity import (
+    IntensitySpec,
+    RandomParameter,
+    interpolate_levels,
+    is_random,
+)
 
 LEVEL_STRIPES: tuple[float, float, float] = (8.0, 12.0, 16.0)
+STRIPE_LEVEL_MAP: tuple[float, float, float, float] = (LEVEL_STRIPES[0], *LEVEL_STRIPES)
+"""Stripes at s = 0, weak, medium, strong for ``"random"``'s inverse map (below weak the bands thin instead)."""
 GREEN_GAIN = 2.5
 GREEN_OFFSET = 50.0 / 255.0
 
@@ -71,18 +85,155 @@ def stripe_row_weights(height: int, num_stripes: torch.Tensor, band_fraction: to
 
 def em_color_error(x: torch.Tensor) -> torch.Tensor:
     """The colour-decoding error on float RGB ``(B, 3, H, W)`` in [0, 1] (every pixel, from the original values)."""
-    # written channel by channel into one output: torch.stack of the planes was the kernel's slowest op
-    out = torch.empty_like(x)
-    red, green, blue = x.unbind(dim=1)
-    new_red = torch.mul(green, GREEN_GAIN, out=out[:, 0]).clamp_(0.0, 1.0)
-    torch.add(red, blue, out=out[:, 1]).mul_(0.5).sub_(GREEN_OFFSET).clamp_(0.0, 1.0)
-    out[:, 2].copy_(new_red)
+    out = x.clone()
+    _corrupt_(out[:, 0], out[:, 1], out[:, 2])
     return out
+
+
+def _corrupt_(red: torch.Tensor, green: torch.Tensor, blue: torch.Tensor) -> None:
+    """Overwrite the three planes (views of the same rows) with the colour error, in place.
+
+    uint8 computes the paper's integer formula exactly: ``int(2.5 G)`` = ``2 G + G // 2`` (255 from G = 102 on) and
+    ``int((R + B) / 2)`` = ``(R & B) + ((R ^ B) >> 1)`` (no uint8 wrap-around), minus 50 saturating at 0. Float keeps
+    continuous values. Both are within one grey level of each other.
+    """
+    if red.dtype == torch.uint8:
+        new_green = torch.bitwise_and(red, blue)
+        new_green.add_(torch.bitwise_xor(red, blue).bitwise_right_shift_(1)).clamp_(min=50).sub_(50)
+        capped = green.clamp(max=102)
+        torch.add(capped.bitwise_right_shift(1), capped, alpha=2, out=red)
+    else:
+        new_green = torch.lerp(red, blue, 0.5).sub_(GREEN_OFFSET).clamp_(0.0, 1.0)
+        torch.mul(green, GREEN_GAIN, out=red).clamp_(0.0, 1.0)
+    blue.copy_(red)
+    green.copy_(new_green)
 
 
 def _check_stripes(num_stripes: torch.Tensor) -> None:
     if not torch.isfinite(num_stripes).all() or (num_stripes < 1).any():
         raise ValueError(f"num_stripes must be >= 1, got {num_stripes.tolist()}")
+
+
+def _row_weights(
+    height: int,
+    batch: int,
+    device: torch.device,
+    num_stripes: float | torch.Tensor,
+    band_fraction: float | torch.Tensor,
+    next_num_stripes: float | torch.Tensor | None,
+    mix: float | torch.Tensor,
+) -> torch.Tensor:
+    """Validated parameters -> per-row corruption weights ``(batch, height)`` float64."""
+    stripes = per_sample_values(num_stripes, batch, device, "num_stripes")
+    fraction = per_sample_values(band_fraction, batch, device, "band_fraction")
+    _check_stripes(stripes)
+    if not ((fraction >= 0) & (fraction <= 1)).all():
+        raise ValueError(f"band_fraction must lie in [0, 1], got {fraction.tolist()}")
+    weights = stripe_row_weights(height, stripes, fraction)
+    if next_num_stripes is not None:
+        following = per_sample_values(next_num_stripes, batch, device, "next_num_stripes")
+        _check_stripes(following)
+        weight_of_next = per_sample_values(mix, batch, device, "mix")
+        if not ((weight_of_next >= 0) & (weight_of_next <= 1)).all():
+            raise ValueError(f"mix must lie in [0, 1], got {weight_of_next.tolist()}")
+        if bool((weight_of_next > 0).any()):
+            weight_of_next = weight_of_next.unsqueeze(1)
+            weights = (1 - weight_of_next) * weights + weight_of_next * stripe_row_weights(
+                height, following, fraction
+            )
+    return weights
+
+
+def _runs(row_weights: list[float]) -> list[tuple[int, int]]:
+    """``[start, stop)`` runs of fully corrupted rows."""
+    runs, start = [], None
+    for row, weight in enumerate([*row_weights, 0.0]):
+        if weight == 1.0 and start is None:
+            start = row
+        elif weight != 1.0 and start is not None:
+            runs.append((start, row))
+            start = None
+    return runs
+
+
+def _corrupt_bands_(out: torch.Tensor, runs: list[tuple[int, int]]) -> None:
+    """Corrupt the same rows of every image of ``out`` in place, through views (no gather, no scatter).
+
+    The paper's bands are periodic (``step`` rows every ``2 step``), so all of them but possibly the last are one
+    strided view: a handful of ops whatever the stripe count.
+    """
+    height = out.shape[-2]
+    periodic = len(runs) >= 2 and all(
+        b - a == runs[0][1] - runs[0][0] and a == runs[0][0] + k * (runs[1][0] - runs[0][0])
+        for k, (a, b) in enumerate(runs)
+    )
+    views = []
+    if periodic:
+        first, period, length = runs[0][0], runs[1][0] - runs[0][0], runs[0][1] - runs[0][0]
+        whole = min(len(runs), (height - first) // period)  # periods that fit below the first band
+        block = out[:, :, first : first + whole * period].unflatten(2, (whole, period))[:, :, :, :length]
+        views.append(block)
+        views += [out[:, :, a:b] for a, b in runs[whole:]]
+    else:
+        views = [out[:, :, a:b] for a, b in runs]
+    for view in views:
+        _corrupt_(view[:, 0], view[:, 1], view[:, 2])
+
+
+def _corrupt_rows_gathered(out: torch.Tensor, weights: torch.Tensor) -> torch.Tensor:
+    """Per-sample patterns and partial rows: gather the corrupted rows, corrupt them, gather the output back.
+
+    Scatters (``index_copy_``, ``index_put_``) are several times slower than a row gather on the CPU, so the output
+    is one gather from [image rows; corrupted rows].
+    """
+    batch, _, height, width = out.shape
+    sample, row = (weights > 0).nonzero().unbind(1)
+    first = sample * (3 * height) + row
+    index = torch.cat([first, first + height, first + 2 * height])  # the R, G, B rows of every corrupted row
+    count = out.numel() // width
+    rows = out.view(count, width)
+    source = torch.empty((count + index.numel(), width), dtype=out.dtype, device=out.device)
+    source[:count].copy_(rows)
+    corrupted = source[count:].view(3, -1, width)
+    torch.index_select(rows, 0, index, out=source[count:])
+    weight = weights[sample, row]
+    partial = (weight < 1).nonzero().squeeze(1)
+    original = corrupted.index_select(1, partial) if partial.numel() else None
+    _corrupt_(corrupted[0], corrupted[1], corrupted[2])
+    if original is not None:
+        w = weight.index_select(0, partial).to(torch.float32)[None, :, None]
+        if out.dtype == torch.uint8:  # the partial rows' blend in float, on those rows only
+            clean = original.to(torch.float32).div_(255.0)
+            blended = torch.lerp(clean, em_color_error(clean[None])[0], w).mul_(255.0).round_()
+            corrupted[:, partial] = blended.to(torch.uint8)
+        else:
+            corrupted[:, partial] = torch.lerp(original, corrupted.index_select(1, partial), w.to(out.dtype))
+    source_of = torch.arange(count, device=out.device)
+    source_of[index] = torch.arange(count, count + index.numel(), device=out.device)
+    return source.index_select(0, source_of).view(batch, 3, height, width)
+
+
+def em_color_strip_rgb(
+    x: torch.Tensor,
+    num_stripes: float | torch.Tensor,
+    band_fraction: float | torch.Tensor = 1.0,
+    next_num_stripes: float | torch.Tensor | None = None,
+    mix: float | torch.Tensor = 0.0,
+) -> torch.Tensor:
+    """``em_color_strip`` on RGB ``(B, 3, H, W)``, uint8 or float (the transform's inner op).
+
+    Returns a fresh tensor; float values are clamped to [0, 1] (the input first, so every output row is too).
+    """
+    batch, _, height, _ = x.shape
+    weights = _row_weights(height, batch, x.device, num_stripes, band_fraction, next_num_stripes, mix)
+    out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
+    uniform = bool((weights == weights[:1]).all())
+    if uniform and bool(((weights == 0) | (weights == 1)).all()):
+        _corrupt_bands_(out, _runs(weights[0].tolist()))
+        return out
+    if not bool((weights > 0).any()):
+        return out
+    return _corrupt_rows_gathered(out, weights)
 
 
 def em_color_strip_float(
@@ -92,27 +243,8 @@ def em_color_strip_float(
     next_num_stripes: float | torch.Tensor | None = None,
     mix: float | torch.Tensor = 0.0,
 ) -> torch.Tensor:
-    """``em_color_strip`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op)."""
-    batch, _, height, _ = x.shape
-    stripes = per_sample_values(num_stripes, batch, x.device, "num_stripes")
-    fraction = per_sample_values(band_fraction, batch, x.device, "band_fraction")
-    _check_stripes(stripes)
-    if not ((fraction >= 0) & (fraction <= 1)).all():
-        raise ValueError(f"band_fraction must lie in [0, 1], got {fraction.tolist()}")
-    weights = stripe_row_weights(height, stripes, fraction)
-    if next_num_stripes is not None:
-        following = per_sample_values(next_num_stripes, batch, x.device, "next_num_stripes")
-        _check_stripes(following)
-        weight_of_next = per_sample_values(mix, batch, x.device, "mix")
-        if not ((weight_of_next >= 0) & (weight_of_next <= 1)).all():
-            raise ValueError(f"mix must lie in [0, 1], got {weight_of_next.tolist()}")
-        weight_of_next = weight_of_next.unsqueeze(1)
-        weights = (1 - weight_of_next) * weights + weight_of_next * stripe_row_weights(
-            height, following, fraction
-        )
-    # an expanded weight keeps lerp on its fast same-shape path (a (B, 1, H, 1) broadcast is several times slower)
-    weights = weights.to(x.dtype)[:, None, :, None].expand_as(x)
-    return torch.lerp(x, em_color_error(x), weights)
+    """``em_color_strip`` on float RGB ``(B, 3, H, W)`` in [0, 1] (kept for callers of the float kernel)."""
+    return em_color_strip_rgb(x, num_stripes, band_fraction, next_num_stripes, mix)
 
 
 def em_color_strip(
@@ -126,12 +258,18 @@ def em_color_strip(
 
     ``num_stripes`` (N >= 1) is the paper's parameter; ``band_fraction`` in [0, 1] thins every corrupted band;
     ``next_num_stripes`` with ``mix`` in [0, 1] cross-fades to a second pattern (used between the paper's levels).
-    Each may be a float or one value per image. Returns the input's shape, dtype and device.
+    Each may be a float or one value per image. Returns the input's shape, dtype and device. uint8 images are
+    computed in integers (the paper's ``int()`` formula), float images in float.
     """
     check_image(image)
+    if image.dtype == torch.uint8:
+        x, alpha = to_rgb(image)
+        return from_uint8_rgb(
+            em_color_strip_rgb(x, num_stripes, band_fraction, next_num_stripes, mix), alpha, image
+        )
     x, alpha = to_float_rgb(image)
-    y = em_color_strip_float(x, num_stripes, band_fraction, next_num_stripes, mix)
-    return from_float_rgb(y, alpha, image)
+    y = em_color_strip_rgb(x, num_stripes, band_fraction, next_num_stripes, mix)
+    return from_float_rgb(y, alpha, image, in_unit_range=True)
 
 
 def stripe_params_for(s: torch.Tensor) -> dict[str, torch.Tensor]:
@@ -159,7 +297,12 @@ class EMColorStrip(CameraAttack):
     """
 
     name: ClassVar[str] = "em_color_strip"
+    _apply_in_unit_range: ClassVar[bool] = True
     LEVEL_STRIPES: ClassVar[tuple[float, float, float]] = LEVEL_STRIPES
+    # the authors' adversarial training: N = randint(8, 16) stripes (both ends included)
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(
+        8, 16, integer=True, levels=STRIPE_LEVEL_MAP
+    )
 
     def __init__(
         self,
@@ -186,6 +329,28 @@ class EMColorStrip(CameraAttack):
             raise ValueError(f"num_stripes must be >= 1, got {num_stripes!r}")
         self.num_stripes = None if num_stripes is None else int(num_stripes)
 
+    def sample_params(
+        self,
+        batch_size: int,
+        height: int,
+        width: int,
+        *,
+        intensity: IntensitySpec | torch.Tensor | None = None,
+        generator: torch.Generator | None = None,
+        device: torch.device | str | None = None,
+    ) -> dict[str, torch.Tensor]:
+        """As ``CameraAttack.sample_params``; ``"random"`` gives the paper's pattern for the drawn integer N (the
+        authors' training), not the cross-fade of the neighbouring levels that the same ``s`` means elsewhere."""
+        params = super().sample_params(
+            batch_size, height, width, intensity=intensity, generator=generator, device=device
+        )
+        drawn = is_random(self.intensity if intensity is None else intensity)
+        if drawn and self.model == "paper" and self.num_stripes is None:
+            stripes = interpolate_levels(params["intensity"], STRIPE_LEVEL_MAP).round()
+            ones = torch.ones_like(stripes)
+            params.update(num_stripes=stripes, next_num_stripes=stripes, mix=0 * ones, band_fraction=ones)
+        return params
+
     def _sample(self, s, height, width, generator, device):
         if self.model == "bayer_phase_flip":
             return {"start_fraction": (1.0 - self.bayer["max_fraction"] * s.to(torch.float32)).to(device)}
@@ -202,8 +367,16 @@ class EMColorStrip(CameraAttack):
                 height, params["start_fraction"].to(x.device) * height, device=x.device
             )
             wrong = physics.em_color_map(x, self.bayer["gain"], self.bayer["offset"])
-            return torch.lerp(x, wrong, mask.to(x.dtype))
-        return em_color_strip_float(
+            return torch.lerp(x, wrong, mask.to(x.dtype)).clamp_(0.0, 1.0)
+        return self._apply_paper(x, params)
+
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.model == "bayer_phase_flip":
+            return NotImplemented
+        return self._apply_paper(x, params)
+
+    def _apply_paper(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        return em_color_strip_rgb(
             x, params["num_stripes"], params["band_fraction"], params["next_num_stripes"], params["mix"]
         )
 

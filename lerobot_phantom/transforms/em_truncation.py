@@ -16,9 +16,10 @@ Deviations from the paper's code (and why):
   0.1/0.2/0.3), and for ``1/3 < r <= 0.5`` the band slides up so that it never overlaps the appended tail. The
   output always has height ``h``. Ratios above 0.5 are rejected: with at most ``h`` rows there is no way to lose
   more than half of them and still append as many.
-* **Vectorised per sample.** The operation is a row-index gather: one row copy per distinct ratio in the batch
-  (measured twice as fast as a single element-wise ``torch.gather``),
-  exact for any dtype (no float round trip).
+* **Vectorised per sample, exact in any dtype** (no float round trip): one gather of whole rows over the flattened
+  batch (``index_select``); for one ratio shared by the batch the row index is cached, so one image costs about what
+  the paper's ``np.delete`` / ``np.append`` does.
+* **"random"** draws the authors' adversarial-training ratio ``r ~ U(0.1, 0.3)``.
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
@@ -28,47 +29,75 @@ in fewer pixels than its weak level does.
 
 from __future__ import annotations
 
+import functools
 from typing import ClassVar
 
 import torch
 
-from lerobot_phantom.transforms.base import CameraAttack, check_image, per_sample_values
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.base import CameraAttack, check_image
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 
 MAX_RATIO = 0.5
 
 
 def truncation_row_index(height: int, ratio: torch.Tensor) -> torch.Tensor:
     """Source row of every output row, ``(B, height)`` long, for per-sample ratios ``(B,)`` in [0, 0.5]."""
-    num = torch.floor(height * ratio).long()  # (B,)
+    return _rows_losing(height, torch.floor(height * ratio).long())
+
+
+def _rows_losing(height: int, num: torch.Tensor) -> torch.Tensor:
+    """``truncation_row_index`` from the number of lost rows per sample ``num`` (long ``(B,)``)."""
     start = torch.clamp(torch.minimum(num, height - 2 * num), min=0)
-    rows = torch.arange(height, device=ratio.device).unsqueeze(0)  # (1, H)
+    rows = torch.arange(height, device=num.device).unsqueeze(0)  # (1, H)
     num, start = num.unsqueeze(1), start.unsqueeze(1)
     shifted = (rows >= start) & (rows < height - num)
     return torch.where(shifted, rows + num, rows)
+
+
+def _ratios(ratio: float | torch.Tensor, batch: int) -> list[float]:
+    """Validated per-sample ratios as Python floats (one host sync for a tensor, none for a float)."""
+    values = ratio.detach().reshape(-1).tolist() if isinstance(ratio, torch.Tensor) else [float(ratio)]
+    if len(values) == 1:
+        values = values * batch
+    elif len(values) != batch:
+        raise ValueError(
+            f"ratio must be a scalar or have one value per sample ({batch}), got {len(values)} values"
+        )
+    if not all(0.0 <= r <= MAX_RATIO for r in values):  # also rejects NaN
+        raise ValueError(f"EM truncation ratio must lie in [0, {MAX_RATIO}], got {values}")
+    return values
 
 
 def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Tensor:
     """EM truncation of ``image`` (``(..., C, H, W)``, any dtype) with truncation ratio ``ratio`` in [0, 0.5].
 
     ``ratio`` is a float or a tensor with one value per image of the batch (leading dims flattened). Returns a
-    tensor of the input's shape, dtype and device. See the module docstring for the algorithm and the fix.
+    new tensor of the input's shape, dtype and device. See the module docstring for the algorithm and the fix.
     """
     check_image(image)
-    flat = image.reshape(-1, *image.shape[-3:])
-    batch, _, height, _ = flat.shape
-    r = per_sample_values(ratio, batch, flat.device, "ratio")
-    if not torch.isfinite(r).all() or (r < 0).any() or (r > MAX_RATIO).any():
-        raise ValueError(f"EM truncation ratio must lie in [0, {MAX_RATIO}], got {r.tolist()}")
-    index = truncation_row_index(height, r)  # (B, H)
-    patterns, group = torch.unique(index, dim=0, return_inverse=True)
-    if patterns.shape[0] == 1:  # one ratio for the whole batch: a plain row copy
-        return flat.index_select(2, patterns[0]).reshape(image.shape)
-    out = torch.empty_like(flat)
-    for g in range(patterns.shape[0]):
-        members = (group == g).nonzero().squeeze(1)
-        out[members] = flat[members].index_select(2, patterns[g])
-    return out.reshape(image.shape)
+    channels, height, width = image.shape[-3:]
+    batch = image.numel() // (channels * height * width)
+    ratios = _ratios(ratio, batch)
+    lost = {int(height * r) for r in ratios}  # int(h * r) as the paper (and truncation_row_index)
+    if len(lost) == 1:  # one ratio for the whole batch: a cached row index, no per-call index arithmetic
+        index = _shared_row_index(batch * channels, height, lost.pop(), image.device)
+    else:  # per-sample ratios: still one gather of whole rows over the flattened batch
+        per_image = truncation_row_index(
+            height, torch.tensor(ratios, dtype=torch.float64, device=image.device)
+        )
+        index = per_image.repeat_interleave(channels, dim=0) + height * torch.arange(
+            batch * channels, device=image.device
+        ).unsqueeze(1)
+        index = index.reshape(-1)
+    return image.reshape(-1, width).index_select(0, index).view(image.shape)
+
+
+@functools.lru_cache(maxsize=32)
+def _shared_row_index(planes: int, height: int, num: int, device: torch.device) -> torch.Tensor:
+    """Source row of every row of ``planes`` stacked ``height``-row planes that all lose ``num`` rows."""
+    rows = _rows_losing(height, torch.tensor([num]))[0]
+    offsets = height * torch.arange(planes).unsqueeze(1)
+    return (rows.unsqueeze(0) + offsets).reshape(-1).to(device)
 
 
 class EMTruncation(CameraAttack):
@@ -80,6 +109,8 @@ class EMTruncation(CameraAttack):
 
     name: ClassVar[str] = "em_truncation"
     LEVEL_RATIOS: ClassVar[tuple[float, float, float, float]] = (0.0, 0.1, 0.2, 0.3)
+    # the authors' adversarial training: ratio uniform in [0.1, 0.3]
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(0.1, 0.3, levels=LEVEL_RATIOS)
 
     def __init__(
         self,
@@ -101,6 +132,12 @@ class EMTruncation(CameraAttack):
         return interpolate_levels(s, self.LEVEL_RATIOS)
 
     def _sample(self, s, height, width, generator, device):
+        values = s.tolist()
+        if (
+            len(set(values)) == 1
+        ):  # a fixed intensity: the level map once per value, not a dozen tiny ops per call
+            ratio = self._cached(("ratio", values[0]), lambda: float(self.ratio_for(s[:1])[0]))
+            return {"ratio": torch.full((len(values),), ratio, dtype=torch.float32, device=device)}
         return {"ratio": self.ratio_for(s).to(device)}
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:

@@ -17,7 +17,10 @@ EM truncation         ``em_truncation(image, ratio)``                           
 ultrasound blur       ``ultrasound_blur(image, dx, dy, theta_deg=0, scale=0)``              dx = dy 5 / 10 / 20
 ===================== ===================================================================== =====================
 
-``laser_spot`` and ``projection_shape`` build the procedural patterns the first two take. ``apply_attack`` is the
+``laser_glare`` (the default red laser glare, statistics of the authors' ``red.png``), ``laser_spot`` (a small spot)
+and ``projection_shape`` (the default ``"can"``, 50x42 like the authors' ``can.png``, and other shapes) build the
+procedural patterns the first two take; ``laser_blinding`` resizes a pattern to the image with PIL's LANCZOS filter
+as the authors do, ``light_projection`` pastes it at its own size. ``apply_attack`` is the
 one-call version of a transform (registry name, intensity, seed), and ``voice_dos`` / ``voice_spoofing`` apply the
 instruction attacks to a task string or a list of them.
 """
@@ -35,7 +38,7 @@ from lerobot_phantom.transforms.intensity import IntensitySpec
 from lerobot_phantom.transforms.laser_blinding import laser_blinding
 from lerobot_phantom.transforms.laser_color_strip import laser_color_strip
 from lerobot_phantom.transforms.light_projection import light_projection
-from lerobot_phantom.transforms.patterns import laser_spot, projection_shape
+from lerobot_phantom.transforms.patterns import laser_glare, laser_spot, projection_shape
 from lerobot_phantom.transforms.registry import is_camera_attack, make_attack
 from lerobot_phantom.transforms.ultrasound_blur import ultrasound_blur
 
@@ -45,6 +48,7 @@ __all__ = [
     "em_truncation",
     "laser_blinding",
     "laser_color_strip",
+    "laser_glare",
     "laser_spot",
     "light_projection",
     "projection_shape",

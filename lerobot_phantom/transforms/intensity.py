@@ -9,13 +9,23 @@ Each attack maps ``s`` to its physical parameter piecewise-linearly through
 ``(0, identity), (1/3, weak), (2/3, medium), (1, strong)`` (see ``interpolate_levels``), so that "random between
 weak and strong" means ``s ~ U(1/3, 1)`` for every attack.
 
-Accepted ``intensity`` values: a level name, ``"random"`` (= ``(1/3, 1)``), a float in [0, 1], a ``(low, high)``
-pair sampled uniformly per sample, or a string ``"0.2"`` / ``"0.2:0.8"`` (the CLI form).
+Accepted ``intensity`` values: a level name, ``"random"``, a float in [0, 1], a ``(low, high)`` pair (``s``
+uniform in it, per sample), or a string ``"0.2"`` / ``"0.2:0.8"`` (the CLI form).
+
+``"random"`` draws the authors' adversarial-training distribution of the attack's *physical* parameter when the
+attack declares one (class attribute ``random_parameter``, a ``RandomParameter``), e.g. ultrasound blur
+displacement ``randint(5, 20)`` px, laser blinding alpha ``U[0.1, 0.9]``; the reported per-sample ``s`` is that
+value pushed back through the attack's level map (``intensity_for``), so labels stay in [0, 1] and
+``interpolate_levels(s, levels)`` gives the drawn value back. Attacks without a declaration (the instruction
+attacks) draw ``s ~ U(1/3, 1)`` (``RANDOM_RANGE``), as does an explicit ``(1/3, 1)`` for every attack.
 """
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import torch
 
@@ -94,3 +104,95 @@ def interpolate_levels(s: torch.Tensor, points: Sequence[float]) -> torch.Tensor
     idx = pos.floor().clamp(max=2).long()
     frac = pos - idx.to(torch.float32)
     return knots[idx] + (knots[idx + 1] - knots[idx]) * frac
+
+
+def is_random(intensity: IntensitySpec | torch.Tensor | None) -> bool:
+    """Whether a spec is the word ``"random"`` (the authors' training distribution), not an explicit range."""
+    return isinstance(intensity, str) and intensity.strip().lower() == "random"
+
+
+def intensity_for(values: torch.Tensor, points: Sequence[float]) -> torch.Tensor:
+    """Inverse of ``interpolate_levels``: the intensity ``s`` at which the level map reaches ``values``.
+
+    ``points`` (values at s = 0, 1/3, 2/3, 1) must be non-decreasing; where the map is flat the largest such ``s``
+    is returned (so a weak value maps to 1/3 even when the map is flat below weak). Values outside
+    ``[points[0], points[3]]`` clamp to s = 0 / 1.
+    """
+    if len(points) != 4 or any(b < a for a, b in itertools.pairwise(points)):
+        raise ValueError(
+            f"need 4 non-decreasing level points (identity, weak, medium, strong), got {points!r}"
+        )
+    v = values.to(torch.float32)
+    s = torch.zeros_like(v)
+    for k in range(3):
+        low, high = float(points[k]), float(points[k + 1])
+        frac = torch.ones_like(v) if high == low else ((v - low) / (high - low)).clamp(0.0, 1.0)
+        s = torch.where(v >= low, torch.maximum(s, (k + frac) / 3.0), s)
+    return s
+
+
+@dataclass(frozen=True)
+class RandomParameter:
+    """The distribution ``"random"`` draws an attack's physical parameter from (the authors' adversarial training).
+
+    ``uniform(low, high)`` when ``integer`` is false; ``randint(low, high)`` with both ends included (Python's
+    ``random.randint``, which the authors' code uses) when it is true. ``levels``: the attack's level table
+    (values at s = 0, weak, medium, strong) used to report ``s``; ``None`` reads the instance's ``levels``
+    attribute (attacks whose table is a constructor option).
+
+    Declare on the attack class::
+
+        class UltrasoundBlur(CameraAttack):
+            random_parameter: ClassVar[RandomParameter] = RandomParameter(5, 20, integer=True,
+                                                                          levels=LEVEL_DISPLACEMENT_PX)
+    """
+
+    low: float
+    high: float
+    integer: bool = False
+    levels: tuple[float, float, float, float] | None = None
+
+    def __post_init__(self) -> None:
+        if not (self.low <= self.high):
+            raise ValueError(f"RandomParameter needs low <= high, got ({self.low}, {self.high})")
+        if self.integer and (self.low != int(self.low) or self.high != int(self.high)):
+            raise ValueError(f"an integer RandomParameter needs integer ends, got ({self.low}, {self.high})")
+
+    def quantile(self, u: torch.Tensor) -> torch.Tensor:
+        """The parameter value at uniform draw(s) ``u`` in [0, 1) (stratified schedules pass their own ``u``)."""
+        u = u.to(torch.float32)
+        if self.integer:
+            count = self.high - self.low + 1.0
+            return (self.low + torch.floor(u * count)).clamp(max=self.high)
+        return self.low + (self.high - self.low) * u
+
+    def intensity(self, u: torch.Tensor, points: Sequence[float]) -> torch.Tensor:
+        """Per-sample ``s`` for uniform draws ``u``: the quantile's value through the inverse level map."""
+        return intensity_for(self.quantile(u), points)
+
+
+def random_intensities(attack: Any, u: torch.Tensor) -> torch.Tensor:
+    """``s`` for uniform draws ``u`` under ``"random"``: the attack's ``RandomParameter`` or ``U(1/3, 1)``."""
+    parameter: RandomParameter | None = getattr(attack, "random_parameter", None)
+    if parameter is None:
+        low, high = RANDOM_RANGE
+        return low + (high - low) * u.to(torch.float32)
+    points = parameter.levels if parameter.levels is not None else getattr(attack, "levels", None)
+    if points is None:
+        raise TypeError(
+            f"{type(attack).__name__}.random_parameter has no levels and the attack has no 'levels' attribute"
+        )
+    return parameter.intensity(u, points)
+
+
+def sample_random_intensity(
+    attack: Any,
+    batch_size: int,
+    generator: torch.Generator | None,
+    device: torch.device | str | None = None,
+) -> torch.Tensor:
+    """Per-sample ``s`` ``(batch_size,)`` for ``intensity="random"``: one uniform draw per sample from ``generator``."""
+    if generator is None:
+        raise ValueError("a random intensity needs a torch.Generator (pass generator= or seed=)")
+    u = torch.rand(batch_size, generator=generator, dtype=torch.float32, device=generator.device)
+    return random_intensities(attack, u).to(device)

@@ -2,19 +2,30 @@
 Appendix A, Algorithm "Laser Blinding Attack").
 
 Physics: the beam is spread by the lens into a saturated white core, a ring clipped in the laser's colour and a
-glare halo; the camera's exposure drops, darkening the rest of the scene. The paper blends a recorded pattern in
-linearly: ``out = clip(img * (1 - alpha) + pattern * alpha)``.
+glare that floods the frame. The paper blends a recorded pattern in linearly:
+``out = clip(img * (1 - alpha) + pattern * alpha)``.
 
 Levels (Table 2, "weight of pattern"): alpha = 0 / 0.1 / 0.5 / 0.9 at s = 0 / weak / medium / strong, linear in
-between (``interpolate_levels``).
+between (``interpolate_levels``); ``"random"`` draws alpha uniform in [0.1, 0.9] (the authors' adversarial training).
 
-Pattern: procedural by default (``patterns.laser_spot``: core radius, power-law halo exponent, laser colour
-red/green/blue/violet/white or an RGB triple, colour crosstalk, flare streaks; sizes relative to the shorter image
-side), or ``pattern=PATH`` for a user image such as a real laser capture (resized to the image, antialiased
-bicubic; the paper's code used LANCZOS). ``position`` places the spot centre at (x, y) fractions of the width and
-height (default the centre; the image pattern is shifted, black filling the uncovered part); ``"random"`` draws
-it per sample, uniformly in ``position_range`` on both axes, rounded to whole pixels. Only alpha (via the
-intensity) and, when asked, the position are random; the spot shape is fixed per instance.
+Pattern (``pattern=``):
+
+* ``"red"`` (default): a procedural red laser glare with the statistics of the authors' capture ``red.png``
+  (``patterns.laser_glare``: white core over a third of the frame, pink ring, red field to the corners; mean colour
+  (245, 79, 132) like the capture's, values >= 250 27.3% vs 27.0%), stretched with the frame as the authors'
+  resized capture is.
+* ``"spot"``: a small procedural spot on a dark frame (``patterns.laser_spot``; its shape is a ``LaserSpot``:
+  colour, core radius, power-law halo, crosstalk, flare streaks; sizes relative to the shorter image side).
+* a PATH: a user image such as a real capture, resized to the frame with PIL's LANCZOS filter as the authors do.
+
+``position`` places the pattern centre at (x, y) fractions of the width and height (default the centre; an image
+pattern is shifted, black filling the uncovered part); ``"random"`` draws it per sample, uniformly in
+``position_range`` on both axes, rounded to whole pixels. Only alpha (via the intensity) and, when asked, the
+position are random; the pattern is fixed per instance.
+
+``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of
+blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"`` (what it
+was calibrated with).
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
@@ -23,7 +34,10 @@ global RNG; uint8 output is rounded, not truncated (at most 1 grey level apart).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import dataclasses
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -31,9 +45,11 @@ import torch
 
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
+    LASER_COLORS,
     check_levels,
+    laser_glare,
     laser_spot,
     load_pattern_image,
     parse_color,
@@ -41,6 +57,66 @@ from lerobot_phantom.transforms.patterns import (
 )
 
 ALPHA_LEVELS: tuple[float, float, float, float] = (0.0, 0.1, 0.5, 0.9)
+PROCEDURAL_PATTERNS: tuple[str, ...] = ("red", "spot")
+
+
+@dataclass(frozen=True)
+class LaserSpot:
+    """Shape of the ``"spot"`` pattern (``patterns.laser_spot``); radii and widths are fractions of the shorter side."""
+
+    color: str | Sequence[float] = "green"
+    core_radius: float = 0.08
+    halo_exponent: float = 2.0
+    crosstalk: float = 0.25
+    streaks: int = 4
+    streak_strength: float = 0.3
+    streak_width: float = 0.01
+    streak_angle: float = 15.0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "color", parse_color(self.color))
+        if self.streaks < 0:
+            raise ValueError(f"streaks must be >= 0, got {self.streaks}")
+        laser_spot(1, 1, center=(0.0, 0.0), **self.spot_kwargs())  # validates the shape parameters
+
+    def spot_kwargs(self) -> dict[str, Any]:
+        return dataclasses.asdict(self)
+
+
+@dataclass(frozen=True)
+class LaserPhysics:
+    """Options of ``model="physical"`` (``physics.laser_injection``), as ``lerobot-phantom-calibrate`` fits them."""
+
+    gain: float = 1.0
+    glare_amplitude: float = 0.0
+    glare_exponent: float = 2.0
+    glare_scale_ref_px: float = 8.0
+    auto_exposure: float = 0.0
+    gamma: float | None = None
+
+    def __post_init__(self) -> None:
+        if (
+            self.gain < 0
+            or self.glare_amplitude < 0
+            or self.auto_exposure < 0
+            or self.glare_scale_ref_px <= 0
+        ):
+            raise ValueError(
+                "gain, glare_amplitude and auto_exposure must be >= 0 and glare_scale_ref_px > 0"
+            )
+
+
+def _options(kind: type, given: Any, flat: dict[str, Any]) -> Any:
+    """A ``LaserSpot``/``LaserPhysics`` from an instance, a mapping or None, updated by flat keyword options."""
+    names = {f.name for f in dataclasses.fields(kind)}
+    mine = {k: flat.pop(k) for k in list(flat) if k in names}
+    if given is None:
+        return kind(**mine)
+    if isinstance(given, Mapping):
+        return kind(**{**given, **mine})
+    if isinstance(given, kind):
+        return dataclasses.replace(given, **mine) if mine else given
+    raise TypeError(f"expected a {kind.__name__}, a mapping or None, got {type(given).__name__}")
 
 
 def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.device) -> torch.Tensor:
@@ -51,18 +127,35 @@ def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.devi
     return values.reshape(-1, 1, 1, 1)
 
 
+CHUNK_BYTES = 1 << 20
+"""Images are blended in chunks of about this many bytes, so each pass runs in cache: a batch costs no more per
+image than a single image."""
+
+
 def blend(x: torch.Tensor, alpha: torch.Tensor | float, pattern: torch.Tensor) -> torch.Tensor:
-    """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding)."""
+    """``clip(x * (1 - alpha) + pattern * alpha)`` on float images in [0, 1] (Appendix A, Laser Blinding).
+
+    ``pattern``: ``(1 or B, 3, H, W)``. Returns a new tensor in [0, 1].
+    """
     weight = _as_batch_values(alpha, x.shape[0], x.device)
-    # a convex combination of values in [0, 1] stays in [0, 1]: the clip only guards patterns out of range
-    return torch.lerp(x, pattern.to(x.dtype), weight).clamp_(0.0, 1.0)
+    pattern = pattern.to(x.dtype)
+    out = torch.empty_like(x, memory_format=torch.contiguous_format)
+    step = max(1, CHUNK_BYTES // max(1, x[:1].numel() * x.element_size()))
+    for start in range(0, x.shape[0], step):
+        chunk = slice(start, start + step)
+        w = weight[chunk] if weight.shape[0] > 1 else weight
+        p = pattern[chunk] if pattern.shape[0] > 1 else pattern
+        # a convex combination of values in [0, 1] stays in [0, 1]: the clip only guards patterns out of range
+        torch.lerp(x[chunk], p, w, out=out[chunk]).clamp_(0.0, 1.0)
+    return out
 
 
 def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: torch.Tensor) -> torch.Tensor:
     """Blend ``pattern`` into ``image`` with weight ``alpha`` (a float or one value per sample).
 
     ``image``: uint8 or float [0, 1], ``(C, H, W)`` or ``(B, C, H, W)``. ``pattern``: ``(3, h, w)`` or
-    ``(B, 3, h, w)`` (1 or 4 channels accepted; alpha ignored), uint8 or float, resized to the image if needed.
+    ``(B, 3, h, w)`` (1 or 4 channels accepted; alpha ignored), uint8 or float, resized to the image if needed
+    with PIL's LANCZOS filter (bit-exact with the authors' ``Image.resize`` for 8-bit patterns).
     Returns the image's dtype, shape and device.
     """
     check_image(image)
@@ -73,6 +166,11 @@ def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: to
     flat, _ = to_float_rgb(pattern.to(image.device))
     resized = torch.stack([resize_pattern(p, *x.shape[-2:]) for p in flat])
     return from_float_rgb(blend(x, alpha, resized), keep_alpha, image)
+
+
+def _offset(grey: torch.Tensor, alpha: float) -> torch.Tensor:
+    """``alpha * pattern * 255 + 0.5``: the pattern's share of a rounded uint8 blend."""
+    return torch.mul(grey, alpha).add_(0.5)
 
 
 def _parse_position(position: str | Sequence[float]) -> tuple[float, float] | None:
@@ -92,57 +190,67 @@ def _parse_position(position: str | Sequence[float]) -> tuple[float, float] | No
 
 
 class LaserBlinding(CameraAttack):
-    """Laser blinding; see the module docstring. ``levels`` overrides the alpha table (identity, weak, medium, strong)."""
+    """Laser blinding; see the module docstring. ``levels`` overrides the alpha table (identity, weak, medium, strong).
+
+    ``spot`` (a ``LaserSpot``) shapes the ``"spot"`` pattern and ``physics`` (a ``LaserPhysics``) the physical
+    model; either may be a mapping, and their fields are also accepted as flat keyword options (``color="red"``,
+    ``core_radius=0.05``, ``gain=1.5``: the form ``calibrated.json`` files store). Without ``pattern``, spot
+    options or ``model="physical"`` select the ``"spot"`` pattern, otherwise the ``"red"`` glare.
+    """
 
     name: ClassVar[str] = "laser_blinding"
+    # the authors' adversarial training: weight uniform in [0.1, 0.9] per attacked sample
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(0.1, 0.9)
 
     def __init__(
         self,
         intensity: IntensitySpec = "medium",
         *,
         pattern: str | Path | None = None,
-        color: str | Sequence[float] = "green",
         position: str | Sequence[float] = "center",
         position_range: Sequence[float] = (0.15, 0.85),
-        core_radius: float = 0.08,
-        halo_exponent: float = 2.0,
-        crosstalk: float = 0.25,
-        streaks: int = 4,
-        streak_strength: float = 0.3,
-        streak_width: float = 0.01,
-        streak_angle: float = 15.0,
         levels: Sequence[float] = ALPHA_LEVELS,
         model: str = "paper",
-        gain: float = 1.0,
-        glare_amplitude: float = 0.0,
-        glare_exponent: float = 2.0,
-        glare_scale_ref_px: float = 8.0,
-        auto_exposure: float = 0.0,
-        gamma: float | None = None,
+        spot: LaserSpot | Mapping[str, Any] | None = None,
+        physics: LaserPhysics | Mapping[str, Any] | None = None,
         seed: int | None = None,
         generator: torch.Generator | None = None,
+        **options: Any,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "laser blinding alpha", upper=1.0)
-        # model="physical" (lerobot-phantom-calibrate): the pattern is linear light x intensity x gain added to
-        # the scene, with optional power-law glare, auto-exposure and tone curve (physics.laser_injection)
         if model not in ("paper", "physical"):
             raise ValueError(f"unknown laser blinding model {model!r}; valid: 'paper', 'physical'")
-        if gain < 0 or glare_amplitude < 0 or auto_exposure < 0 or glare_scale_ref_px <= 0:
-            raise ValueError(
-                "gain, glare_amplitude and auto_exposure must be >= 0 and glare_scale_ref_px > 0"
-            )
         self.model = model
-        self.physical = {
-            "gain": float(gain),
-            "glare_amplitude": float(glare_amplitude),
-            "glare_exponent": float(glare_exponent),
-            "glare_scale_ref_px": float(glare_scale_ref_px),
-            "auto_exposure": float(auto_exposure),
-            "gamma": None if gamma is None else float(gamma),
-        }
-        self.pattern_path = None if pattern is None else str(pattern)
-        self.color = parse_color(color)
+        # the paper's blend returns a fresh tensor in [0, 1]: the base skips its final clamp
+        self._apply_in_unit_range = model == "paper"
+        flat = dict(options)
+        spot_given = spot is not None or any(f.name in flat for f in dataclasses.fields(LaserSpot))
+        self.spot = _options(LaserSpot, spot, flat)
+        self.physics = _options(LaserPhysics, physics, flat)
+        if flat:
+            valid = [f.name for kind in (LaserSpot, LaserPhysics) for f in dataclasses.fields(kind)]
+            raise TypeError(f"LaserBlinding got unknown options {sorted(flat)}; valid: {', '.join(valid)}")
+        if pattern is None:  # spot options ask for the spot; the physical model was calibrated with it
+            pattern = "spot" if model == "physical" or spot_given else "red"
+        text = str(pattern)
+        if text == "red" and spot_given:
+            raise ValueError(
+                "spot options (color, core_radius, ...) shape pattern='spot', not the 'red' glare"
+            )
+        if text in PROCEDURAL_PATTERNS:
+            self.pattern = text
+            self._user_pattern = None
+        elif isinstance(pattern, Path) or Path(text).suffix:
+            self.pattern = text
+            # Loaded once here (not on every call, the paper code's defect); travels with the pickle.
+            self._user_pattern = load_pattern_image(text, keep_alpha=False)
+        else:
+            raise ValueError(
+                f"unknown laser pattern {pattern!r}; valid: {', '.join(PROCEDURAL_PATTERNS)} or an image path"
+            )
+        # the laser colour of the physical model's glare halo
+        self.color = LASER_COLORS["red"] if self.pattern == "red" else self.spot.color
         self.position = position
         self._fixed_position = _parse_position(position)
         low, high = (float(v) for v in position_range)
@@ -151,21 +259,6 @@ class LaserBlinding(CameraAttack):
                 f"position_range must be (low, high) with 0 <= low <= high <= 1, got {position_range!r}"
             )
         self.position_range = (low, high)
-        if streaks < 0:
-            raise ValueError(f"streaks must be >= 0, got {streaks}")
-        self.spot_kwargs: dict[str, Any] = {
-            "core_radius": float(core_radius),
-            "halo_exponent": float(halo_exponent),
-            "color": self.color,
-            "crosstalk": float(crosstalk),
-            "streaks": int(streaks),
-            "streak_strength": float(streak_strength),
-            "streak_width": float(streak_width),
-            "streak_angle": float(streak_angle),
-        }
-        laser_spot(1, 1, center=(0.0, 0.0), **self.spot_kwargs)  # validate the shape parameters now
-        # Loaded once here (not on every call, the paper code's defect); travels with the pickle.
-        self._user_pattern = None if pattern is None else load_pattern_image(pattern, keep_alpha=False)
 
     # -- parameters ---------------------------------------------------------------------------------------------
     def _sample(
@@ -192,7 +285,7 @@ class LaserBlinding(CameraAttack):
         assert self._user_pattern is not None
         return self._cached(
             ("user", height, width, str(device)),
-            lambda: resize_pattern(self._user_pattern.to(device), height, width),
+            lambda: resize_pattern(self._user_pattern, height, width).to(device),
         )
 
     def spot_pixel(self, position: torch.Tensor, height: int, width: int) -> torch.Tensor:
@@ -201,19 +294,31 @@ class LaserBlinding(CameraAttack):
         cols = torch.round(position[:, 0] * (width - 1))
         return torch.stack([rows, cols], dim=1).long()
 
+    def _procedural(
+        self,
+        height: int,
+        width: int,
+        center: tuple[float, float],
+        frame: tuple[int, int],
+        device: torch.device | str | None,
+    ) -> torch.Tensor:
+        if self.pattern == "red":
+            return laser_glare(height, width, center=center, frame=frame, device=device)
+        return laser_spot(
+            height, width, center=center, unit=min(frame), device=device, **self.spot.spot_kwargs()
+        )
+
     def render_pattern(
-        self, height: int, width: int, row: int, col: int, device: torch.device
+        self, height: int, width: int, row: float, col: float, device: torch.device
     ) -> torch.Tensor:
         """The pattern ``(3, height, width)`` with its centre at pixel (row, col); cached."""
 
         def make() -> torch.Tensor:
             if self._user_pattern is None:
-                return laser_spot(
-                    height, width, center=(float(row), float(col)), device=device, **self.spot_kwargs
-                )
+                return self._procedural(height, width, (float(row), float(col)), (height, width), device)
             base = self._resized_user_pattern(height, width, device)
             shifted = torch.zeros_like(base)
-            dy, dx = row - round(0.5 * (height - 1)), col - round(0.5 * (width - 1))
+            dy, dx = round(row) - round(0.5 * (height - 1)), round(col) - round(0.5 * (width - 1))
             src_r, dst_r = (
                 slice(max(0, -dy), min(height, height - dy)),
                 slice(max(0, dy), min(height, height + dy)),
@@ -232,13 +337,8 @@ class LaserBlinding(CameraAttack):
 
         def make() -> torch.Tensor:
             if self._user_pattern is None:
-                return laser_spot(
-                    2 * height - 1,
-                    2 * width - 1,
-                    center=(height - 1.0, width - 1.0),
-                    unit=min(height, width),
-                    device=device,
-                    **self.spot_kwargs,
+                return self._procedural(
+                    2 * height - 1, 2 * width - 1, (height - 1.0, width - 1.0), (height, width), device
                 )
             canvas = torch.zeros(3, 2 * height - 1, 2 * width - 1, device=device)
             top, left = height - 1 - round(0.5 * (height - 1)), width - 1 - round(0.5 * (width - 1))
@@ -253,14 +353,14 @@ class LaserBlinding(CameraAttack):
         self, position: torch.Tensor, height: int, width: int, device: torch.device
     ) -> torch.Tensor:
         """Patterns ``(B or 1, 3, H, W)`` for per-sample positions ``(B, 2)``."""
+        if self._fixed_position is not None:
+            # a fixed position is exact (the glare centred between pixels on an even frame, as the resized capture)
+            px, py = self._fixed_position
+            return self.render_pattern(height, width, py * (height - 1), px * (width - 1), device)[None]
         pixels = self.spot_pixel(position.to(device), height, width)
-        same_everywhere = bool((pixels == pixels[:1]).all())
-        if same_everywhere and self._fixed_position is not None:
-            row, col = (int(v) for v in pixels[0].tolist())
-            return self.render_pattern(height, width, row, col, device)[None]
         # random positions: crop the cached canvas (a view when one position serves the whole batch)
         canvas = self._canvas(height, width, device)
-        if same_everywhere:
+        if bool((pixels == pixels[:1]).all()):
             top, left = height - 1 - int(pixels[0, 0]), width - 1 - int(pixels[0, 1])
             return canvas[None, :, top : top + height, left : left + width]
         rows = (height - 1 - pixels[:, :1]) + torch.arange(height, device=device)
@@ -275,25 +375,61 @@ class LaserBlinding(CameraAttack):
             return self._apply_physical(x, params, pattern)
         return blend(x, params["alpha"], pattern)
 
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The paper's blend on uint8 ``(N, 3, H, W)`` without a batch-sized float copy.
+
+        One image at a time in a float32 scratch that stays in cache, rounded by adding 0.5 and truncating through
+        int16 (the fast float -> uint8 route). At the level table's alphas with a fixed position the blend is
+        ``x * (1 - alpha) + q`` with ``q = alpha * pattern * 255 + 0.5`` cached; other alphas ``lerp``. The float
+        path rounds the same blend: equal up to rounding ties.
+        """
+        if self.model != "paper":
+            return NotImplemented
+        height, width = x.shape[-2:]
+        pattern = self.patterns_for(params["position"], height, width, x.device)
+        alphas = params["alpha"].to(torch.float64).reshape(-1).expand(x.shape[0]).tolist()
+        cacheable = self._fixed_position is not None
+        grey = (
+            self._cached(("grey", height, width, str(x.device)), lambda: pattern * 255.0)
+            if cacheable
+            else None
+        )
+        out = torch.empty(x.shape, dtype=torch.uint8, device=x.device)
+        scratch = torch.empty(x.shape[1:], dtype=torch.float32, device=x.device)
+        as_int16 = torch.empty(x.shape[1:], dtype=torch.int16, device=x.device)
+        for i, alpha in enumerate(alphas):
+            scratch.copy_(x[i])
+            level = min(self.levels, key=lambda v: abs(v - alpha))
+            if cacheable and abs(level - alpha) < 1e-7:  # a paper level: at most 4 cached offsets per size
+                q = self._cached(
+                    ("offset", height, width, level, str(x.device)), partial(_offset, grey[0], alpha)
+                )
+                torch.add(q, scratch, alpha=1.0 - alpha, out=scratch)
+            else:
+                target = grey[0] if grey is not None else pattern[i if pattern.shape[0] > 1 else 0] * 255.0
+                scratch.lerp_(target, alpha).add_(0.5)
+            as_int16.copy_(scratch)  # values in [0.5, 255.5]: truncation rounds
+            out[i].copy_(as_int16)
+        return out
+
     def _apply_physical(
         self, x: torch.Tensor, params: dict[str, torch.Tensor], pattern: torch.Tensor
     ) -> torch.Tensor:
         height, width = x.shape[-2:]
-        p = self.physical
+        p = self.physics
         pixels = self.spot_pixel(params["position"].to(x.device), height, width)
         return physics.laser_injection(
             x,
             pattern,
-            params["intensity"].to(x.device) * p["gain"],
+            params["intensity"].to(x.device) * p.gain,
             centre=pixels.flip(1).to(x.dtype),
             color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
-            halo_amplitude=p["glare_amplitude"],
-            halo_exponent=p["glare_exponent"],
-            halo_scale_px=p["glare_scale_ref_px"] * max(height, width) / 256.0,
-            auto_exposure=p["auto_exposure"],
-            gamma=p["gamma"],
+            halo_amplitude=p.glare_amplitude,
+            halo_exponent=p.glare_exponent,
+            halo_scale_px=p.glare_scale_ref_px * max(height, width) / 256.0,
+            auto_exposure=p.auto_exposure,
+            gamma=p.gamma,
         )
 
     def extra_repr(self) -> str:
-        source = self.pattern_path or f"procedural color={self.color}"
-        return f"{super().extra_repr()}, pattern={source!r}, position={self.position!r}"
+        return f"{super().extra_repr()}, pattern={self.pattern!r}, position={self.position!r}, model={self.model!r}"

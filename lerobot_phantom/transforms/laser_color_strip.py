@@ -22,8 +22,9 @@ between (``interpolate_levels``). Colour fractions (R, G, B) default to the pape
 Nothing else is random: the band is fixed by the image size.
 
 Deviations from the paper's code: vectorised; the (H, W) profile is computed once per (H, W, device) and cached
-(the loops recompute it per pixel); uint8 output is rounded instead of truncated by ``astype(uint8)``
-(at most 1 grey level apart).
+(the loops recompute it per pixel), and at a fixed level the whole increment too; uint8 images stay uint8 (a
+saturating add of the rounded increment), so the output is rounded instead of truncated by ``astype(uint8)``
+(at most 1 grey level apart). ``"random"`` draws the authors' adversarial-training strength ``S ~ U(500, 2500)``.
 """
 
 from __future__ import annotations
@@ -35,8 +36,15 @@ from typing import ClassVar
 import torch
 
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.base import (
+    CameraAttack,
+    check_image,
+    from_float_rgb,
+    from_uint8_rgb,
+    to_float_rgb,
+    to_rgb,
+)
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import check_levels
 
 STRENGTH_LEVELS: tuple[float, float, float, float] = (0.0, 500.0, 1500.0, 2500.0)
@@ -63,16 +71,45 @@ def strip_profile(height: int, width: int, device: torch.device | str | None = N
     return profile.to(device=device, dtype=torch.float32)
 
 
+def _band_gain(strength: torch.Tensor, color_fractions: torch.Tensor, device: torch.device) -> torch.Tensor:
+    """Per-sample, per-channel strength ``S * fraction`` (grey levels), ``(B, 3)``, or ``(1, 3)`` when shared."""
+    gain = strength.reshape(-1, 1).to(device, torch.float32) * color_fractions.reshape(-1, 3).to(device)
+    return gain[:1] if bool((gain == gain[:1]).all()) else gain
+
+
+def strip_increment(gain: torch.Tensor, profile: torch.Tensor, dtype: torch.dtype) -> torch.Tensor:
+    """What the band gains, ``(B or 1, 3, rows, W)``: float ``gain * profile / 255`` or uint8 ``round(gain * profile)``
+    (capped at 255; the sum is saturated where it is added, so adding it equals rounding the float sum)."""
+    increment = gain[:, :, None, None] * profile
+    if dtype == torch.uint8:
+        return increment.round_().clamp_(max=255.0).to(torch.uint8)
+    return increment.div_(255.0).to(dtype)
+
+
 def add_strip(
-    x: torch.Tensor, strength: torch.Tensor, color_fractions: torch.Tensor, profile: torch.Tensor
+    x: torch.Tensor,
+    strength: torch.Tensor,
+    color_fractions: torch.Tensor,
+    profile: torch.Tensor,
+    increment: torch.Tensor | None = None,
 ) -> torch.Tensor:
-    """Add ``strength * fraction * profile / 255`` to the band of float ``x`` ``(B, 3, H, W)``, clipped to [0, 1]."""
+    """Add ``strength * fraction * profile`` (grey levels) to the band of RGB ``x`` ``(B, 3, H, W)``, clipped.
+
+    uint8 ``x`` stays uint8 (a saturating add: ``x + min(increment, 255 - x)``); float ``x`` gets ``/ 255`` and
+    [0, 1] (the whole output is clamped, so the result is always in range). ``increment`` (from
+    ``strip_increment``) may be passed in by a caller that caches it.
+    """
     start, end = band_rows(x.shape[-2])
-    gain = strength.reshape(-1, 1).to(x.device, torch.float32) * color_fractions.reshape(-1, 3).to(x.device)
-    out = x.clone()
-    if end > start:
-        band = out[:, :, start:end]
-        band.add_(gain[:, :, None, None] * (profile / 255.0)).clamp_(0.0, 1.0)
+    out = x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)
+    if end <= start:
+        return out
+    if increment is None:
+        increment = strip_increment(_band_gain(strength, color_fractions, x.device), profile, x.dtype)
+    band = out[:, :, start:end]
+    if x.dtype == torch.uint8:
+        band.add_(torch.minimum(band.bitwise_not(), increment))  # bitwise_not of uint8 is 255 - value
+    else:
+        band.add_(increment).clamp_(max=1.0)
     return out
 
 
@@ -82,7 +119,8 @@ def laser_color_strip(
     color_fractions: Sequence[float] | torch.Tensor = PAPER_COLOR_FRACTIONS,
 ) -> torch.Tensor:
     """Appendix A's laser color strip with strength ``S`` (grey-level units; float or one per sample) and colour
-    fractions (R, G, B) (``(3,)`` or one triple per sample). Returns the image's dtype, shape and device."""
+    fractions (R, G, B) (``(3,)`` or one triple per sample). Returns the image's dtype, shape and device; uint8
+    images are computed in uint8 (within one grey level of the float path: the increment is rounded once)."""
     check_image(image)
     s = torch.as_tensor(strength, dtype=torch.float32).reshape(-1)
     fractions = torch.as_tensor(color_fractions, dtype=torch.float32)
@@ -90,15 +128,22 @@ def laser_color_strip(
         raise ValueError(f"strength must be finite and >= 0, got {strength!r}")
     if fractions.shape[-1] != 3 or not bool((fractions >= 0).all()):
         raise ValueError(f"color_fractions must be non-negative (R, G, B) triples, got {color_fractions!r}")
+    if image.dtype == torch.uint8:
+        x, keep_alpha = to_rgb(image)
+        profile = strip_profile(*x.shape[-2:], device=x.device)
+        return from_uint8_rgb(add_strip(x, s, fractions, profile), keep_alpha, image)
     x, keep_alpha = to_float_rgb(image)
     profile = strip_profile(*x.shape[-2:], device=x.device)
-    return from_float_rgb(add_strip(x, s, fractions, profile), keep_alpha, image)
+    return from_float_rgb(add_strip(x, s, fractions, profile), keep_alpha, image, in_unit_range=True)
 
 
 class LaserColorStrip(CameraAttack):
     """Laser color strip; see the module docstring. ``levels`` overrides the strength table (grey-level units)."""
 
     name: ClassVar[str] = "laser_color_strip"
+    _apply_in_unit_range: ClassVar[bool] = True
+    # the authors' adversarial training: strength uniform in [500, 2500] (levels=None: the instance's ``levels``)
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(500.0, 2500.0)
 
     def __init__(
         self,
@@ -181,8 +226,22 @@ class LaserColorStrip(CameraAttack):
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         if self.model == "rolling_shutter":
             return self._apply_rolling_shutter(x, params)
-        profile = self.profile(*x.shape[-2:], device=x.device)
-        return add_strip(x, params["strength"], params["color_fractions"], profile)
+        return self._apply_paper(x, params)
+
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.model == "rolling_shutter":
+            return NotImplemented
+        return self._apply_paper(x, params)
+
+    def _apply_paper(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        height, width = x.shape[-2:]
+        profile = self.profile(height, width, device=x.device)
+        gain = _band_gain(params["strength"], params["color_fractions"], x.device)
+        increment = None
+        if gain.shape[0] == 1:  # one strength for the batch (a level): the increment is cached
+            key = ("increment", height, width, str(x.device), x.dtype, tuple(gain[0].tolist()))
+            increment = self._cached(key, lambda: strip_increment(gain, profile, x.dtype))
+        return add_strip(x, params["strength"], params["color_fractions"], profile, increment)
 
     def _apply_rolling_shutter(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         height = x.shape[-2]
@@ -200,7 +259,7 @@ class LaserColorStrip(CameraAttack):
         # the paper's peak gain 4 S / pi grey levels, spread over whole rows
         gain = params["strength"].reshape(-1, 1).to(x.device) * (4.0 / math.pi / 255.0)
         added = (gain * params["color_fractions"].reshape(-1, 3).to(x.device))[:, :, None, None]
-        return (x + added * rows[:, None, :, None]).clamp(0.0, 1.0)
+        return (x + added * rows[:, None, :, None]).clamp_(0.0, 1.0)
 
     def extra_repr(self) -> str:
         return f"{super().extra_repr()}, color_fractions={self.color_fractions}"

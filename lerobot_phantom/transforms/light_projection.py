@@ -10,9 +10,14 @@ an offset, ``pos = ((W - w) // 2 + x_off, (H - h) // 2 + y_off)``, and alpha-com
 Levels (Table 2, "weight of pattern"): t = 0 / 0.1 / 0.5 / 0.9 at s = 0 / weak / medium / strong, linear in
 between (``interpolate_levels``).
 
-Pattern: a procedural, text-free shape (``patterns.PROJECTION_SHAPES``: ``stop_sign`` octagon, ``arrow``, ``can``,
-``disk``) or ``pattern=PATH`` for a user image (RGBA keeps its alpha; RGB is opaque). ``size`` is the watermark's
-longer side as a fraction of the image's shorter side (aspect kept). Offsets ``x_offset``/``y_offset`` are pixels at
+Pattern: a procedural, text-free shape (``patterns.PROJECTION_SHAPES``: ``can`` (default; the layout, size,
+alpha coverage and colour of the authors' ``can.png`` watermark), ``stop_sign`` octagon, ``arrow``, ``disk``) or
+``pattern=PATH`` for a user image (RGBA keeps its alpha; RGB is opaque). ``size="native"`` (default, the authors'
+code) pastes the pattern at its own pixel size on every frame: an image keeps its pixels, a procedural shape is 50
+pixels tall (the can 50x42, like ``can.png``), so it covers 2.3% of a 224x224 frame, 1.6% of 256x256 and 0.7% of
+480x640, exactly as the authors' watermark would. ``size=FRACTION`` instead scales the watermark's longer side to
+that fraction of the image's shorter side (aspect kept; images resized with PIL's LANCZOS filter), the same share
+of every frame. Offsets ``x_offset``/``y_offset`` are pixels at
 the 256x256 reference (``base.REFERENCE_SIZE``), scaled by ``W/256`` and ``H/256`` and rounded; the watermark may
 hang over the border (clipped). ``position="random"`` draws both offsets per sample uniformly in
 ``[-max_offset, max_offset]`` (reference pixels) instead. Only ``t`` (via the intensity) and, when asked, the
@@ -20,7 +25,8 @@ offsets are random; the shape is fixed per instance.
 
 Deviations from the paper's code: the watermark is built (or read) once and cached per size instead of being
 loaded on every call; randomness comes from the attack's seeded ``torch.Generator``; compositing is done in float
-(at most 1 grey level from PIL's integer arithmetic).
+(at most 1 grey level from PIL's integer ``paste``; with the authors' ``can.png`` the output is identical at all three
+levels). The uint8 kernel copies the frame and blends only under the watermark.
 """
 
 from __future__ import annotations
@@ -39,9 +45,11 @@ from lerobot_phantom.transforms.base import (
     from_float_rgb,
     to_float_rgb,
 )
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
+    NATIVE_SHAPE_HEIGHT,
     PROJECTION_SHAPES,
+    SHAPE_ASPECT,
     check_levels,
     fit_size,
     load_pattern_image,
@@ -138,13 +146,15 @@ class LightProjection(CameraAttack):
     """Light projection; see the module docstring. ``levels`` overrides the transparency table."""
 
     name: ClassVar[str] = "light_projection"
+    # the authors' adversarial training: weight uniform in [0.1, 0.9] per attacked sample
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(0.1, 0.9)
 
     def __init__(
         self,
         intensity: IntensitySpec = "medium",
         *,
-        pattern: str | Path = "stop_sign",
-        size: float = 0.5,
+        pattern: str | Path = "can",
+        size: float | str | None = "native",
         x_offset: float = 0.0,
         y_offset: float = 0.0,
         position: str = "fixed",
@@ -178,15 +188,20 @@ class LightProjection(CameraAttack):
             "white": float(white),
             "gamma": None if gamma is None else float(gamma),
         }
-        if not (0.0 < float(size) <= 4.0):
-            raise ValueError(f"size (watermark side / image shorter side) must be in (0, 4], got {size!r}")
+        if size is None or size == "native":
+            size = None
+        elif isinstance(size, str) or not (0.0 < float(size) <= 4.0):
+            raise ValueError(
+                f"size must be 'native' (the pattern's own pixel size) or the watermark's longer side / the "
+                f"image's shorter side in (0, 4], got {size!r}"
+            )
         if position not in ("fixed", "random"):
             raise ValueError(
                 f"unknown position {position!r}; valid: 'fixed' (x_offset, y_offset) or 'random'"
             )
         if max_offset < 0:
             raise ValueError(f"max_offset must be >= 0, got {max_offset}")
-        self.size = float(size)
+        self.size = None if size is None else float(size)
         self.offset = (float(x_offset), float(y_offset))
         self.position = position
         self.max_offset = float(max_offset)
@@ -222,13 +237,24 @@ class LightProjection(CameraAttack):
         return {"transparency": interpolate_levels(s, self.levels), "offset": offset}
 
     def watermark(self, height: int, width: int, device: torch.device | str | None = None) -> torch.Tensor:
-        """The RGBA watermark ``(4, h, w)`` for an image of this size (alpha on the 1/255 grid); cached."""
-        box = max(1, round(self.size * min(height, width)))
+        """The RGBA watermark ``(4, h, w)`` for an image of this size (on the 8-bit grid); cached.
+
+        ``size="native"``: an image keeps its own pixels on every frame, a procedural shape is
+        ``patterns.NATIVE_SHAPE_HEIGHT`` (50) pixels tall, the height of the authors' ``can.png``.
+        """
+        box = None if self.size is None else max(1, round(self.size * min(height, width)))
 
         def make() -> torch.Tensor:
             if self._user_pattern is None:
-                return projection_shape(self.pattern, box).to(device)
-            return _resize_rgba(self._user_pattern, *fit_size(*self._user_pattern.shape[-2:], box)).to(device)
+                shape_box = NATIVE_SHAPE_HEIGHT if box is None else box
+                if box is not None and SHAPE_ASPECT.get(self.pattern, 1.0) > 1.0:
+                    shape_box = max(1, round(box / SHAPE_ASPECT[self.pattern]))  # the longer side is the box
+                return projection_shape(self.pattern, shape_box).to(device)
+            if box is None:
+                return self._user_pattern.to(device)
+            return resize_pattern(self._user_pattern, *fit_size(*self._user_pattern.shape[-2:], box)).to(
+                device
+            )
 
         return self._cached((box, str(device)), make)
 
@@ -254,19 +280,46 @@ class LightProjection(CameraAttack):
             )
         return composite(x, rgba, params["transparency"], top, left)
 
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        """The paper's composite on uint8 ``(N, 3, H, W)``: a copy of the frame, blended only under the watermark.
+
+        Only the watermark's pixels (2.3% of a 224x224 frame by default) pass through float32; the float path
+        rounds the same blend, so the two agree up to rounding ties.
+        """
+        if self.model != "paper":
+            return NotImplemented
+        batch, _, height, width = x.shape
+        rgba = self.watermark(height, width, x.device)
+        grey = self._cached(("grey", rgba.shape, str(x.device)), lambda: rgba[:3] * 255.0)
+        top, left = placement(height, width, rgba.shape[-2], rgba.shape[-1], params["offset"].to(x.device))
+        t = params["transparency"].to(x.device, torch.float32).reshape(-1).expand(batch)
+        top, left = top.expand(batch), left.expand(batch)
+        out = x.clone(memory_format=torch.contiguous_format)
+        if bool((top == top[0]).all() and (left == left[0]).all()):
+            _composite_uint8(out, rgba, grey, t, int(top[0]), int(left[0]))
+        else:
+            for i in range(batch):
+                _composite_uint8(out[i : i + 1], rgba, grey, t[i : i + 1], int(top[i]), int(left[i]))
+        return out
+
     def extra_repr(self) -> str:
         return (
-            f"{super().extra_repr()}, pattern={self.pattern!r}, size={self.size}, position={self.position!r}"
+            f"{super().extra_repr()}, pattern={self.pattern!r}, size={self.size or 'native'!r}, "
+            f"position={self.position!r}"
         )
 
 
-def _resize_rgba(rgba: torch.Tensor, height: int, width: int) -> torch.Tensor:
-    """Resize premultiplied (no dark fringes at transparent edges), alpha back on the 1/255 grid."""
-    alpha = rgba[3:]
-    premultiplied = torch.cat([rgba[:3] * alpha, alpha])
-    resized = resize_pattern(premultiplied, height, width)
-    alpha = torch.round(resized[3:] * 255.0) / 255.0
-    rgb = torch.where(alpha > 0, resized[:3] / alpha.clamp_min(1e-6), torch.zeros_like(resized[:3])).clamp_(
-        0.0, 1.0
-    )
-    return torch.cat([rgb, alpha])
+def _composite_uint8(
+    out: torch.Tensor, rgba: torch.Tensor, grey: torch.Tensor, t: torch.Tensor, top: int, left: int
+) -> None:
+    """``composite`` in place on uint8 ``out`` ``(B, 3, H, W)`` at one top-left; ``grey`` = watermark RGB x 255."""
+    height, width = out.shape[-2:]
+    ph, pw = rgba.shape[-2:]
+    rs, re, cs, ce = max(0, top), min(height, top + ph), max(0, left), min(width, left + pw)
+    if rs >= re or cs >= ce:
+        return
+    window = (slice(rs - top, re - top), slice(cs - left, ce - left))
+    a = _scaled_alpha(rgba[3][window][None, None], t)  # (B, 1, h', w')
+    region = out[:, :, rs:re, cs:ce]
+    blended = torch.lerp(region.to(torch.float32), grey[(slice(None), *window)][None], a)
+    region.copy_(blended.add_(0.5))  # values lie in [0, 255.5]: truncation after + 0.5 rounds

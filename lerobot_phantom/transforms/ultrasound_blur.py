@@ -36,9 +36,13 @@ path is only a pixel or two long, ``int()`` quantises its direction, so a slight
 different (not a larger) set of neighbours.
 
 Fast path: with no rotation and no radial part (the paper's levels) the path offsets are the same for every pixel,
-so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds count map: ``~N`` strided adds per
-image. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical parameters,
-so per-sample parameters cost one pass per distinct parameter set.
+so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds count map. On the paper's diagonal
+(and any axis-aligned path) sample ``i`` sits exactly ``i`` pixels along the direction, so the sum is a box summed
+by doubling: ``~2 log2(N)`` shifted adds (5 instead of 17 at the strong level on 224x224); other directions take
+``~N`` strided adds. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical
+parameters (one pass per distinct displacement: at most 16 under ``"random"``, which draws the authors' whole-pixel
+``randint(5, 20)``). uint8 images are blurred on their 0-255 values (float32 sums of integers are exact) and
+rounded once, with no scaling to [0, 1] and back.
 """
 
 from __future__ import annotations
@@ -54,9 +58,11 @@ from lerobot_phantom.transforms.base import (
     CameraAttack,
     check_image,
     from_float_rgb,
+    from_uint8_rgb,
     to_float_rgb,
+    to_rgb,
 )
-from lerobot_phantom.transforms.intensity import IntensitySpec, interpolate_levels
+from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 
 MAX_SAMPLES = 100
 SNAP = 1e-6
@@ -108,18 +114,73 @@ def _axis_valid(
     return ((positions >= lo) & (positions < hi)).any(dim=1).to(torch.float32)
 
 
-def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
-    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views."""
+def _shift_add(
+    a: torch.Tensor, b: torch.Tensor, k: int, step: tuple[int, int], out: torch.Tensor
+) -> torch.Tensor:
+    """``out = a + b`` shifted by ``k`` steps along ``step`` (``out[r, c] = a[r, c] + b[r + k sr, c + k sc]``, zero
+    where that leaves the image). ``out`` must not overlap ``a`` or ``b``."""
+    height, width = a.shape[-2:]
+    dr, dc = k * step[0], k * step[1]
+    r0, r1, c0, c1 = max(0, -dr), min(height, height - dr), max(0, -dc), min(width, width - dc)
+    if r0 >= r1 or c0 >= c1:
+        return out.copy_(a)
+    torch.add(a[..., r0:r1, c0:c1], b[..., r0 + dr : r1 + dr, c0 + dc : c1 + dc], out=out[..., r0:r1, c0:c1])
+    for rows, cols in ((slice(0, r0), slice(None)), (slice(r1, None), slice(None))):
+        out[..., rows, cols].copy_(a[..., rows, cols])
+    for cols in (slice(0, c0), slice(c1, None)):
+        out[..., r0:r1, cols].copy_(a[..., r0:r1, cols])
+    return out
+
+
+def _box_sum(x: torch.Tensor, step: tuple[int, int], length: int) -> torch.Tensor:
+    """``sum_{i < length} x[r + i sr, c + i sc]`` (zero outside) by doubling: ~2 log2(length) shifted adds instead of
+    ``length`` (5 instead of 17 at the paper's strong level on 224x224), summed as a tree (float error ~log2)."""
+    result, covered, power, size = None, 0, x, 1
+    while True:
+        if length & 1:
+            if result is None:
+                result, covered = power, size
+            else:
+                result = _shift_add(result, power, covered, step, torch.empty_like(x))
+                covered += size
+        length >>= 1
+        if not length:
+            return result
+        power = _shift_add(power, power, size, step, torch.empty_like(x))
+        size *= 2
+
+
+def _linear_blur(x: torch.Tensor, d_row: float, d_col: float, upper: float | None = None) -> torch.Tensor:
+    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views.
+
+    ``upper``: clamp the result to [0, upper], chunk by chunk while it is in cache (a fresh tensor then)."""
     batch, _, height, width = x.shape
     num = min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES)
     if num <= 0:
-        return x
+        return x if upper is None else x.clamp(0.0, upper)
     spans = [
         (_axis_spans(height, i / num * d_row), _axis_spans(width, i / num * d_col)) for i in range(num + 1)
     ]
     row_valid = _axis_valid(height, [rows for rows, _ in spans], x.device)
     col_valid = _axis_valid(width, [cols for _, cols in spans], x.device)
     count = (row_valid.T @ col_valid).to(x.dtype)  # (H, W) in-bounds samples; sample 0 is the pixel itself
+    # The paper's diagonal (and any axis-aligned path): sample i sits exactly i steps of (0 or 1, 0 or 1) away,
+    # so the path is a box along one direction, summed by doubling.
+    shifts = [
+        (math.floor(i / num * d_row + SNAP), math.floor(i / num * d_col + SNAP)) for i in range(num + 1)
+    ]
+    step = shifts[1]
+    if step in ((1, 1), (1, 0), (0, 1)) and all(
+        s == (i * step[0], i * step[1]) for i, s in enumerate(shifts)
+    ):
+        out = torch.empty_like(x)
+        per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())  # a few images at a time stay in cache
+        for first in range(0, batch, per_chunk):
+            part = x[first : first + per_chunk]
+            torch.div(_box_sum(part, step, num + 1), count, out=out[first : first + per_chunk])
+            if upper is not None:
+                out[first : first + per_chunk].clamp_(0.0, upper)
+        return out
     out = torch.empty_like(x)
     # a few images at a time keep the ~N read-modify-write passes in cache
     per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())
@@ -131,11 +192,13 @@ def _linear_blur(x: torch.Tensor, d_row: float, d_col: float) -> torch.Tensor:
                 for c0, c1, cs in col_spans:
                     total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
         torch.div(total, count, out=out[first : first + per_chunk])
+        if upper is not None:
+            out[first : first + per_chunk].clamp_(0.0, upper)
     return out
 
 
 def _general_blur(
-    x: torch.Tensor, d_row: float, d_col: float, theta_deg: float, scale: float
+    x: torch.Tensor, d_row: float, d_col: float, theta_deg: float, scale: float, upper: float | None = None
 ) -> torch.Tensor:
     """General path (rotation and/or radial part): gather the samples of every pixel, float64 coordinates."""
     batch, channels, height, width = x.shape
@@ -176,7 +239,8 @@ def _general_blur(
         count += weight
     keep = count == 0
     out = torch.where(keep, flat, total / torch.where(keep, torch.ones_like(count), count))
-    return out.reshape(batch, channels, height, width)
+    out = out.reshape(batch, channels, height, width)
+    return out if upper is None else out.clamp_(0.0, upper)
 
 
 def ultrasound_blur_float(
@@ -185,8 +249,10 @@ def ultrasound_blur_float(
     dy: float | torch.Tensor,
     theta_deg: float | torch.Tensor = 0.0,
     scale: float | torch.Tensor = 0.0,
+    upper: float | None = None,
 ) -> torch.Tensor:
-    """``ultrasound_blur`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op)."""
+    """``ultrasound_blur`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op). ``upper``: also clamp
+    the result to [0, upper] while it is in cache (a fresh tensor then; the mean of in-range values is in range)."""
     batch = x.shape[0]
     columns = _per_sample(dx, batch, "dx")
     rows = _per_sample(dy, batch, "dy")
@@ -199,13 +265,19 @@ def ultrasound_blur_float(
     for (d_row, d_col, angle, radial), members in groups.items():
         part = x if out is None else x[members]
         if angle == 0.0 and radial == 0.0:
-            blurred = _linear_blur(part, d_row, d_col)
+            blurred = _linear_blur(part, d_row, d_col, upper)
         else:
-            blurred = _general_blur(part, d_row, d_col, angle, radial)
+            blurred = _general_blur(part, d_row, d_col, angle, radial, upper)
         if out is None:
             return blurred
         out[members] = blurred
     return out
+
+
+def _blur_uint8(x: torch.Tensor, dx, dy, theta_deg, scale) -> torch.Tensor:
+    """uint8 RGB: the blur on the 0-255 values themselves (float32 sums of integers are exact), rounded once; no
+    scaling to [0, 1] and back (the mean of in-range values needs no clamp)."""
+    return ultrasound_blur_float(x.to(torch.float32), dx, dy, theta_deg, scale).round_().to(torch.uint8)
 
 
 def ultrasound_blur(
@@ -221,6 +293,9 @@ def ultrasound_blur(
     degrees; ``scale``: radial part. Each a float or one value per image. Returns the input's shape, dtype, device.
     """
     check_image(image)
+    if image.dtype == torch.uint8:
+        x, alpha = to_rgb(image)
+        return from_uint8_rgb(_blur_uint8(x, dx, dy, theta_deg, scale), alpha, image)
     x, alpha = to_float_rgb(image)
     return from_float_rgb(ultrasound_blur_float(x, dx, dy, theta_deg, scale), alpha, image)
 
@@ -236,7 +311,12 @@ class UltrasoundBlur(CameraAttack):
     """
 
     name: ClassVar[str] = "ultrasound_blur"
+    _apply_in_unit_range: ClassVar[bool] = True  # _apply clamps chunk by chunk, in cache
     LEVEL_DISPLACEMENT_PX: ClassVar[tuple[float, float, float, float]] = LEVEL_DISPLACEMENT_PX
+    # the authors' adversarial training: displacement randint(5, 20) px (both ends included) at the reference size
+    random_parameter: ClassVar[RandomParameter] = RandomParameter(
+        5, 20, integer=True, levels=LEVEL_DISPLACEMENT_PX
+    )
 
     def __init__(
         self,
@@ -278,7 +358,11 @@ class UltrasoundBlur(CameraAttack):
         """Linear displacement per axis, pixels at the 256x256 reference, at intensity ``s`` (per sample)."""
         if self.displacement_px is not None:
             return torch.full_like(s, self.displacement_px, dtype=torch.float32)
-        return interpolate_levels(s, self.LEVEL_DISPLACEMENT_PX)
+        d = interpolate_levels(s, self.LEVEL_DISPLACEMENT_PX)
+        # "random" draws whole pixels and reports s through the inverse level map; the float32 round trip comes
+        # back a few 1e-6 px short of the integer, which would drop a sample from the path: snap it
+        whole = d.round()
+        return torch.where((d - whole).abs() < 1e-4, whole, d)
 
     def _sample(self, s, height, width, generator, device):
         d = self.displacement_for(s).to(torch.float64)
@@ -305,8 +389,15 @@ class UltrasoundBlur(CameraAttack):
             gamma = 1.0 if self.gamma is None else self.gamma
             blurred = physics.encode(physics.line_blur(physics.decode(x, gamma), dx, dy, offsets), gamma)
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
-            return torch.where(still, x, blurred)
-        return ultrasound_blur_float(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
+            return torch.where(still, x, blurred).clamp_(0.0, 1.0)
+        return ultrasound_blur_float(
+            x, params["dx"], params["dy"], params["theta_deg"], params["scale"], upper=1.0
+        )
+
+    def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+        if self.path != "uniform" or self.gamma is not None:
+            return NotImplemented
+        return _blur_uint8(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
 
     def extra_repr(self) -> str:
         extra = [f"{k}={getattr(self, k)!r}" for k in ("displacement_px", "rotation_deg", "radial_scale")]

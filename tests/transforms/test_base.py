@@ -123,3 +123,39 @@ def test_input_is_never_modified_in_place(attack):
 @pytest.mark.parametrize("name", CAMERA_ATTACKS)
 def test_every_attack_class_carries_its_registry_name(name):
     assert get_attack_class(name).name == name
+
+
+# -- torchvision v2 semantics -------------------------------------------------------------------------------
+def test_image_and_video_tv_tensors_come_back_as_their_type(attack):
+    from torchvision import tv_tensors
+
+    for wrapped in (tv_tensors.Image(_image((3, 16, 16))), tv_tensors.Video(_image((2, 3, 16, 16)))):
+        out = attack(wrapped)
+        assert type(out) is type(wrapped)
+        assert out.shape == wrapped.shape and out.dtype == wrapped.dtype
+        assert not torch.equal(out.as_subclass(torch.Tensor), wrapped.as_subclass(torch.Tensor))
+
+
+def test_masks_boxes_and_other_inputs_pass_through_untouched(attack):
+    from torchvision import tv_tensors
+
+    image = tv_tensors.Image(_image((3, 16, 16)))
+    mask = tv_tensors.Mask(_image((16, 16)))
+    boxes = tv_tensors.BoundingBoxes([[1, 2, 5, 6]], format="XYXY", canvas_size=(16, 16))
+    sample = {"image": image, "mask": mask, "boxes": boxes, "label": 3, "name": "front"}
+    out = attack(sample)
+    assert out["mask"] is mask and out["boxes"] is boxes and out["label"] == 3 and out["name"] == "front"
+    assert type(out["image"]) is tv_tensors.Image and not torch.equal(out["image"], image)
+    # the mask comes first: parameters are still drawn for the image, and the mask is not attacked
+    mask_out, image_out = attack(mask, image)
+    assert mask_out is mask and image_out.shape == image.shape
+
+
+def test_a_call_without_an_image_passes_through_and_draws_nothing(attack):
+    from torchvision import tv_tensors
+
+    mask = tv_tensors.Mask(_image((16, 16)))
+    state = attack._get_generator().get_state()
+    out_mask, out_text = attack(mask, "text")
+    assert out_mask is mask and out_text == "text"
+    assert torch.equal(attack._get_generator().get_state(), state)

@@ -37,10 +37,12 @@ def test_matches_reference_within_one_grey_level(shape, num_stripes):
     img = _random_uint8(shape, seed=shape[1] + num_stripes)
     expected = _reference(img, num_stripes)
     out = em_color_strip(img, num_stripes)
-    diff = (out.int() - expected.int()).abs()
-    # the reference truncates with int() like the paper, the kernel rounds: at most one grey level apart
-    assert int(diff.max()) <= 1
+    # uint8 is computed in integers: the paper's int() formula exactly
+    torch.testing.assert_close(out, expected, atol=0, rtol=0)
     assert not torch.equal(out, img)
+    # float keeps continuous values: within one grey level of the paper's truncation
+    out_float = em_color_strip(img.float() / 255, num_stripes)
+    assert float((out_float * 255 - expected.float()).abs().max()) <= 1.0
 
 
 @pytest.mark.parametrize("level", ["weak", "medium", "strong"])
@@ -125,7 +127,7 @@ def test_params_mapping_hits_levels():
 
 def test_batch_with_per_sample_parameters_matches_single_calls():
     imgs = _random_uint8((6, 3, 40, 20), 6)
-    attack = EMColorStrip("random")
+    attack = EMColorStrip((0.0, 1.0))  # continuous: thinned bands and cross-fades, one pattern per sample
     params = attack.sample_params(6, 40, 20, generator=torch.Generator().manual_seed(1))
     assert len(set(params["intensity"].tolist())) == 6
     out = attack.apply_params(imgs, params)
@@ -179,3 +181,34 @@ def test_full_hd_frame_keeps_shape_and_dtype():
     frame = _random_uint8((3, 1080, 1920), seed=12)
     out = EMColorStrip("strong")(frame)
     assert out.shape == frame.shape and out.dtype == frame.dtype and not torch.equal(out, frame)
+
+
+@pytest.mark.parametrize("intensity", ["weak", "strong", (0.0, 1.0), "random", 0.9])
+@pytest.mark.parametrize("channels", [3, 4, 1])
+def test_uint8_kernel_is_within_one_grey_level_of_the_float_path(intensity, channels):
+    """uint8 images never take the float round trip; the result is the float path's within one grey level."""
+    imgs = _random_uint8((5, channels, 37, 29), seed=channels)
+    attack = EMColorStrip(intensity)
+    params = attack.sample_params(5, 37, 29, generator=torch.Generator().manual_seed(2))
+    out = attack.apply_params(imgs, params)
+    out_float = attack.apply_params(imgs.float() / 255, params)
+    assert out.dtype == torch.uint8 and out.shape == imgs.shape
+    assert float((out_float.double() * 255 - out.double()).abs().max()) <= 1.0
+    assert not torch.equal(out, imgs)
+
+
+def test_random_draws_the_authors_integer_stripe_counts():
+    """ "random" = the authors' training: N = randint(8, 16), each the paper's pattern for that N exactly."""
+    attack = EMColorStrip("random")
+    params = attack.sample_params(900, 64, 64, generator=torch.Generator().manual_seed(3))
+    stripes = params["num_stripes"]
+    assert set(stripes.tolist()) == set(range(8, 17))
+    assert (params["mix"] == 0).all() and (params["band_fraction"] == 1).all()
+    counts = torch.bincount(stripes.long(), minlength=17)[8:].double()
+    assert float((counts / 900 - 1 / 9).abs().max()) < 0.04  # uniform over the nine counts
+    imgs = _random_uint8((4, 3, 50, 20), seed=4)
+    small = attack.sample_params(4, 50, 20, generator=torch.Generator().manual_seed(5))
+    out = attack.apply_params(imgs, small)
+    for i in range(4):
+        expected = _reference(imgs[i], int(small["num_stripes"][i]))
+        torch.testing.assert_close(out[i], expected, atol=0, rtol=0)

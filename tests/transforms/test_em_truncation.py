@@ -161,3 +161,25 @@ def test_full_hd_frame_keeps_shape_and_dtype():
     frame = _random_uint8((3, 1080, 1920), seed=12)
     out = EMTruncation("strong")(frame)
     assert out.shape == frame.shape and out.dtype == frame.dtype and not torch.equal(out, frame)
+
+
+def test_random_draws_the_authors_uniform_ratio():
+    """ "random" = the authors' training: ratio ~ U(0.1, 0.3)."""
+    params = EMTruncation("random").sample_params(4000, 224, 224, generator=torch.Generator().manual_seed(0))
+    ratio = params["ratio"].double()
+    assert float(ratio.min()) >= 0.1 - 1e-6 and float(ratio.max()) <= 0.3 + 1e-6
+    for quantile in (0.25, 0.5, 0.75):
+        assert float((ratio < 0.1 + 0.2 * quantile).double().mean()) == pytest.approx(quantile, abs=0.03)
+
+
+def test_one_shared_ratio_and_per_sample_ratios_take_the_same_rows():
+    """The shared-ratio fast path (cached row index) equals the per-sample gather, for every dtype."""
+    for img in (
+        _random_uint8((3, 4, 29, 7), 9),
+        torch.rand(3, 1, 29, 7, generator=torch.Generator().manual_seed(1)),
+    ):
+        shared = em_truncation(img, 0.3)
+        per_sample = em_truncation(img, torch.tensor([0.3, 0.3, 0.0]))
+        torch.testing.assert_close(per_sample[:2], shared[:2], atol=0, rtol=0)
+        torch.testing.assert_close(per_sample[2], img[2], atol=0, rtol=0)
+        assert shared.data_ptr() != img.data_ptr()

@@ -6,8 +6,20 @@ import pytest
 import torch
 from reference_optical import laser_blinding_reference
 
-from lerobot_phantom.transforms.laser_blinding import ALPHA_LEVELS, LaserBlinding, laser_blinding
-from lerobot_phantom.transforms.patterns import LASER_COLORS, laser_spot, parse_color
+from lerobot_phantom.transforms.laser_blinding import (
+    ALPHA_LEVELS,
+    LaserBlinding,
+    LaserPhysics,
+    LaserSpot,
+    laser_blinding,
+)
+from lerobot_phantom.transforms.patterns import (
+    LASER_COLORS,
+    laser_glare,
+    laser_spot,
+    parse_color,
+    resize_pattern,
+)
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
@@ -165,3 +177,86 @@ def test_missing_pattern_and_bad_parameters_raise():
 def test_levels_override_changes_alpha():
     attack = LaserBlinding("strong", levels=(0.0, 0.2, 0.4, 0.6))
     assert float(attack.sample_params(1, 8, 8)["alpha"][0]) == pytest.approx(0.6)
+
+
+def test_default_pattern_is_a_red_glare_flooding_the_frame():
+    attack = LaserBlinding("strong")
+    assert attack.pattern == "red"
+    pattern = attack.patterns_for(torch.tensor([[0.5, 0.5]]), 224, 224, CPU)[0]
+    assert torch.equal(pattern, laser_glare(224, 224))
+    assert torch.equal(pattern[:, 112, 112], torch.ones(3))  # white core
+    corner = pattern[:, 0, 0]
+    assert corner[0] > 0.75 and corner[1] < 0.1 and corner[2] < 0.3  # the red field reaches the corners
+    assert torch.equal(torch.round(pattern * 255) / 255, pattern)  # an 8-bit pattern, like a capture
+    # the authors' red.png (README of their patterns): mean colour (245, 79, 132); here within 4 grey levels
+    mean = (pattern.mean((1, 2)) * 255).tolist()
+    assert mean == pytest.approx([245, 79, 132], abs=4)
+
+
+def test_glare_stretches_with_the_frame_like_a_resized_capture():
+    square = laser_glare(200, 200)
+    wide = laser_glare(100, 300)
+    shrunk = resize_pattern(square, 100, 300)
+    assert (wide - shrunk).abs().mean() < 0.01
+
+
+@pytest.mark.parametrize("level", ["weak", "medium", "strong"])
+@pytest.mark.parametrize("position", ["center", "random"])
+@pytest.mark.parametrize("pattern", ["red", "spot"])
+def test_uint8_path_matches_float_path(level, position, pattern):
+    img = _random_uint8((5, 3, 30, 44), seed=3)
+    attack = LaserBlinding(level, pattern=pattern, position=position, seed=1)
+    params = attack.sample_params(5, 30, 44, generator=torch.Generator().manual_seed(7))
+    fast = attack.apply_params(img, params)
+    assert torch.equal(fast, attack._apply_uint8(img, params))  # apply_params took the uint8 kernel
+    slow = torch.round(attack.apply_params(img.float() / 255, params) * 255).to(torch.uint8)
+    assert (fast.int() - slow.int()).abs().max() <= 1
+    single = attack.apply_params(img[1], {k: v[1:2] for k, v in params.items()})
+    assert torch.equal(single, fast[1])
+
+
+def test_uint8_kernel_leaves_the_physical_model_to_the_float_path():
+    attack = LaserBlinding("strong", model="physical", gain=2.0)
+    img = _random_uint8((2, 3, 16, 16), seed=0)
+    params = attack.sample_params(2, 16, 16)
+    assert attack._apply_uint8(img, params) is NotImplemented
+    assert attack.apply_params(img, params).dtype == torch.uint8
+
+
+def test_options_objects_and_flat_options_are_the_same():
+    flat = LaserBlinding(color="red", core_radius=0.05, gain=1.5, model="physical")
+    grouped = LaserBlinding(
+        spot=LaserSpot(color="red", core_radius=0.05), physics={"gain": 1.5}, model="physical"
+    )
+    assert flat.spot == grouped.spot and flat.physics == grouped.physics == LaserPhysics(gain=1.5)
+    assert flat.pattern == grouped.pattern == "spot"  # spot options (and the physical model) use the spot
+    with pytest.raises(TypeError, match="core_radius"):
+        LaserBlinding(core_radis=0.1)
+    with pytest.raises(ValueError, match="spot"):
+        LaserBlinding(pattern="red", color="green")
+    with pytest.raises(ValueError, match="glare_scale_ref_px"):
+        LaserPhysics(glare_scale_ref_px=0.0)
+    with pytest.raises(ValueError, match="red"):
+        LaserBlinding(pattern="laser")
+
+
+def test_random_intensity_draws_alpha_uniform_in_authors_range():
+    attack = LaserBlinding("random")
+    params = attack.sample_params(2000, 8, 8, generator=torch.Generator().manual_seed(0))
+    alpha, s = params["alpha"], params["intensity"]
+    assert float(alpha.min()) >= 0.1 - 1e-6 and float(alpha.max()) <= 0.9 + 1e-6
+    assert float((alpha < 0.5).float().mean()) == pytest.approx(0.5, abs=0.04)
+    assert float(s.min()) >= 1 / 3 - 1e-6 and float(s.max()) <= 1.0
+
+
+def test_resize_pattern_is_pil_lanczos():
+    from PIL import Image
+
+    array = _random_uint8((9, 13, 3), seed=5).numpy()
+    expected = np.asarray(Image.fromarray(array).resize((31, 20), Image.Resampling.LANCZOS))
+    as_uint8 = resize_pattern(torch.from_numpy(array).permute(2, 0, 1), 20, 31)
+    as_float = resize_pattern(torch.from_numpy(array).permute(2, 0, 1).float() / 255, 20, 31)
+    assert np.array_equal(_hwc(as_uint8), expected)
+    assert np.array_equal(_hwc(torch.round(as_float * 255).to(torch.uint8)), expected)
+    smooth = torch.rand(3, 9, 13, generator=torch.Generator().manual_seed(1))  # off the 8-bit grid
+    assert resize_pattern(smooth, 20, 31).shape == (3, 20, 31)

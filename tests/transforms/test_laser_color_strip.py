@@ -92,3 +92,28 @@ def test_bad_arguments_raise():
         LaserColorStrip(levels=(0, 1500, 500, 2500))
     with pytest.raises(ValueError, match="strength"):
         laser_color_strip(torch.zeros(3, 4, 4), -1.0)
+
+
+@pytest.mark.parametrize("intensity", ["weak", "strong", "random", (0.0, 1.0)])
+@pytest.mark.parametrize("channels", [3, 4, 1])
+def test_uint8_kernel_is_within_one_grey_level_of_the_float_path(intensity, channels):
+    """uint8 images are attacked in uint8 (a saturating add of the rounded increment), no float round trip."""
+    imgs = _random_uint8((4, channels, 30, 26), seed=channels)
+    attack = LaserColorStrip(intensity)
+    params = attack.sample_params(4, 30, 26, generator=torch.Generator().manual_seed(1))
+    out = attack.apply_params(imgs, params)
+    out_float = attack.apply_params(imgs.float() / 255, params)
+    assert out.dtype == torch.uint8 and out.shape == imgs.shape
+    assert float((out_float.double() * 255 - out.double()).abs().max()) <= 1.0
+    start, _ = band_rows(30)
+    torch.testing.assert_close(out[..., :start, :], imgs[..., :start, :], atol=0, rtol=0)
+    assert not torch.equal(out, imgs)
+
+
+def test_random_draws_the_authors_uniform_strength():
+    """ "random" = the authors' training: S ~ U(500, 2500) grey-level units."""
+    params = LaserColorStrip("random").sample_params(4000, 64, 64, generator=torch.Generator().manual_seed(0))
+    strength = params["strength"].double()
+    assert float(strength.min()) >= 500 - 1e-3 and float(strength.max()) <= 2500 + 1e-3
+    for quantile in (0.25, 0.5, 0.75):
+        assert float((strength < 500 + 2000 * quantile).double().mean()) == pytest.approx(quantile, abs=0.03)

@@ -24,7 +24,7 @@ ImageTransforms = transforms_module.ImageTransforms
 def registered():
     register_image_transforms()
     yield
-    register_image_transforms()  # leave the plugin registered, as importing lerobot_phantom will
+    register_image_transforms()  # leave the plugin registered, as lerobot_phantom.register() does
 
 
 def _config(type_name, **kwargs):
@@ -84,6 +84,7 @@ def test_every_camera_attack_has_a_class_name():
     assert resolve_camera_attack("VoiceSpoofing") is None
     assert resolve_camera_attack("ColorJitter") is None
     assert resolve_camera_attack("LightProjection").name == "light_projection"
+    assert resolve_camera_attack("PhantomMix").name == "phantom_mix"
 
 
 def test_dataset_config_from_json_goes_through_make_dataset(registered, tmp_path):
@@ -127,6 +128,6 @@ def test_newer_lerobot_custom_transforms_table_is_used_when_present(registered, 
     monkeypatch.setattr(transforms_module, "_CUSTOM_TRANSFORMS", table, raising=False)
     factory_before = transforms_module.make_transform_from_config
     assert register_image_transforms() == "table"
-    assert set(table) == {"SharpnessJitter", *camera_attack_class_names()}
-    assert table["UltrasoundBlur"].name == "ultrasound_blur"
+    assert set(table) == {"SharpnessJitter", "PhantomMix", *camera_attack_class_names()}
+    assert table["UltrasoundBlur"].name == "ultrasound_blur" and table["PhantomMix"].name == "phantom_mix"
     assert transforms_module.make_transform_from_config is factory_before  # the table, not the wrapper

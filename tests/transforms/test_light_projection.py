@@ -76,16 +76,64 @@ def test_offsets_scale_with_image_size():
 
 
 def test_watermark_size_is_relative_and_cached():
-    attack = LightProjection(size=0.5)
+    attack = LightProjection(pattern="stop_sign", size=0.5)
     assert attack.watermark(96, 128).shape == (4, 48, 48)
     assert attack.watermark(480, 640).shape == (4, 240, 240)
     assert attack.watermark(96, 128) is attack.watermark(96, 128)
+    assert LightProjection(size=0.5).watermark(96, 128).shape == (4, 48, 40)  # the can: longer side 48
+
+
+def test_native_size_keeps_the_pattern_pixels_on_every_frame(tmp_path):
+    from PIL import Image
+
+    default = LightProjection()
+    for height, width in [(96, 96), (224, 224), (480, 640)]:
+        assert default.watermark(height, width).shape == (4, 50, 42)  # the authors' can.png is 50x42
+    array = np.zeros((7, 11, 4), dtype=np.uint8)
+    array[..., 0], array[..., 3] = 200, 255
+    path = tmp_path / "logo.png"
+    Image.fromarray(array, mode="RGBA").save(path)
+    native = LightProjection("strong", pattern=path, size="native")
+    assert native.watermark(300, 400).shape == (4, 7, 11)
+    assert torch.equal(native.watermark(300, 400), torch.from_numpy(array).permute(2, 0, 1).float() / 255)
+    with pytest.raises(ValueError, match="native"):
+        LightProjection(size="big")
+
+
+def test_default_covers_the_authors_share_of_a_224_frame():
+    rgba = LightProjection().watermark(224, 224)
+    coverage = float(rgba[3].sum()) / (224 * 224)
+    # the authors' can.png covers sum(alpha) / 224^2 = 2.75% (test_authors_parity compares with the file itself)
+    assert coverage == pytest.approx(0.0275, abs=0.001)
+
+
+@pytest.mark.parametrize("level", ["weak", "medium", "strong"])
+@pytest.mark.parametrize("position", ["fixed", "random"])
+def test_uint8_path_matches_float_path(level, position):
+    img = _random_uint8((6, 3, 40, 52), seed=11)
+    attack = LightProjection(level, position=position, max_offset=60, seed=4)
+    params = attack.sample_params(6, 40, 52, generator=torch.Generator().manual_seed(2))
+    fast = attack.apply_params(img, params)
+    slow = torch.round(attack.apply_params(img.float() / 255, params) * 255).to(torch.uint8)
+    assert (fast.int() - slow.int()).abs().max() <= 1
+    assert torch.equal(fast, attack._apply_uint8(img, params))  # apply_params took the uint8 kernel
+    single = attack.apply_params(img[2], {k: v[2:3] for k, v in params.items()})
+    assert torch.equal(single, fast[2])
+    assert not torch.equal(fast, img)
+
+
+def test_random_intensity_draws_transparency_uniform_in_authors_range():
+    attack = LightProjection("random", seed=0)
+    params = attack.sample_params(2000, 32, 32, generator=torch.Generator().manual_seed(0))
+    t = params["transparency"]
+    assert float(t.min()) >= 0.1 - 1e-6 and float(t.max()) <= 0.9 + 1e-6
+    assert float((t < 0.5).float().mean()) == pytest.approx(0.5, abs=0.04)
 
 
 @pytest.mark.parametrize("shape", PROJECTION_SHAPES)
 def test_procedural_shapes_are_coloured_with_transparent_surround(shape):
     rgba = projection_shape(shape, 64)
-    assert rgba.shape == (4, 64, 64)
+    assert rgba.shape == (4, 64, 54 if shape == "can" else 64)
     assert float(rgba[3].max()) == 1.0
     assert float(rgba[3, 0, 0]) == 0.0 or (shape == "disk" and float(rgba[3, 0, 0]) < 0.5)
     assert torch.equal(torch.round(rgba[3] * 255) / 255, rgba[3])  # 8-bit alpha as in the paper's PIL code
@@ -122,6 +170,8 @@ def test_bad_arguments_raise():
         LightProjection(position="left")
     with pytest.raises(ValueError, match="size"):
         LightProjection(size=0.0)
+    with pytest.raises(ValueError, match="can"):
+        LightProjection(pattern="banana")
     with pytest.raises(ValueError, match="RGBA"):
         light_projection(torch.zeros(3, 4, 4), torch.zeros(3, 2, 2), 0.5)
 

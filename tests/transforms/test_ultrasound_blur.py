@@ -233,3 +233,16 @@ def test_full_hd_frame_keeps_shape_and_caps_the_path_at_100_samples():
         frame[:, int(i * 0.84375 + SNAP), int(i * 1.5 + SNAP)].double() for i in range(101) if i * 1.5 < 1920
     ]
     torch.testing.assert_close(out[:, 0, 0].double(), torch.stack(samples).mean(0).round(), atol=1, rtol=0)
+
+
+def test_random_draws_the_authors_integer_displacements():
+    """ "random" = the authors' training: d = randint(5, 20) px at the 256x256 reference, P(d < 10) = 5/16."""
+    params = UltrasoundBlur("random").sample_params(
+        4000, 256, 256, generator=torch.Generator().manual_seed(0)
+    )
+    d = params["dx"]
+    torch.testing.assert_close(d, params["dy"])
+    assert set(d.tolist()) == set(range(5, 21))  # whole pixels: the level map's round trip is snapped
+    assert float((d < 10).double().mean()) == pytest.approx(5 / 16, abs=0.03)
+    half = UltrasoundBlur("random").sample_params(8, 128, 128, generator=torch.Generator().manual_seed(0))
+    torch.testing.assert_close(half["dx"] * 2, d[:8])  # same draws, scaled with the image
