@@ -228,6 +228,31 @@ def rollout_metadata(
     }
 
 
+def make_envs(cfg: PhantomEvalConfig):
+    """LeRobot's ``make_env(cfg.env)``: ``{group: {env_id: vector_env}}``."""
+    from lerobot.envs.factory import make_env
+
+    return make_env(
+        cfg.env,
+        n_envs=cfg.eval.batch_size,
+        use_async_envs=cfg.eval.use_async_envs,
+        trust_remote_code=cfg.trust_remote_code,
+    )
+
+
+def rollout_report(metadata: dict[str, Any], results: list[dict[str, Any]], complete: bool) -> dict[str, Any]:
+    """The eval.json content (``metadata.complete`` false while conditions are still missing)."""
+    metadata["complete"] = complete
+    return {
+        "format": EVAL_FORMAT,
+        "mode": "rollout",
+        "metadata": metadata,
+        "results": results,
+        "summary": pooled_summary(results),
+        "summary_per_task": per_task_summary(results),
+    }
+
+
 def evaluate(
     cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None, envs=None
 ) -> dict[str, Any]:
@@ -244,57 +269,34 @@ def evaluate(
         return evaluate_offline(cfg, policy, preprocessor, postprocessor)
     if cfg.seed is None:
         raise ValueError("paired comparisons need fixed env seeds: pass --seed=<int> (default 1000)")
-    from lerobot.envs.factory import make_env
-
     started = time.time()
     # Every attack is built up front, so that a bad name or calibration fails before any rollout.
     steps = [AttackStep(condition, cfg.phantom) for condition in build_conditions(cfg.phantom)]
     policy, preprocessor, postprocessor = ready_policy(cfg, policy, preprocessor, postprocessor)
-    env_preprocessor, env_postprocessor = compat.eval_env_processors(cfg.env, cfg.policy or policy.config)
-    processors = (env_preprocessor, env_postprocessor, preprocessor, postprocessor)
+    env_processors = compat.eval_env_processors(cfg.env, cfg.policy or policy.config)
+    processors = (*env_processors, preprocessor, postprocessor)
     owns_envs = envs is None
-    if owns_envs:
-        envs = make_env(
-            cfg.env,
-            n_envs=cfg.eval.batch_size,
-            use_async_envs=cfg.eval.use_async_envs,
-            trust_remote_code=cfg.trust_remote_code,
-        )
+    envs = make_envs(cfg) if owns_envs else envs
     task_envs = [
         TaskEnv(suite_name(group, cfg.env), env_id, env)
         for group, by_id in envs.items()
         for env_id, env in by_id.items()
     ]
     metadata = rollout_metadata(cfg, policy, steps, task_envs, started)
-    done = resumable_rows(cfg, metadata)
 
-    def report_of(results: list[dict[str, Any]], complete: bool) -> dict[str, Any]:
-        metadata.update(duration_s=round(time.time() - started, 3), complete=complete)
-        return {
-            "format": EVAL_FORMAT,
-            "mode": "rollout",
-            "metadata": metadata,
-            "results": results,
-            "summary": pooled_summary(results),
-            "summary_per_task": per_task_summary(results),
-        }
+    def checkpoint(rows: list[dict[str, Any]]) -> None:
+        # Rewritten after every condition, so that an interrupted sweep resumes per condition (--resume=true).
+        metadata["duration_s"] = round(time.time() - started, 3)
+        write_eval(cfg.output_dir, rollout_report(metadata, rows, complete=False))
 
     try:
-        # eval.json is rewritten after every condition (metadata.complete = false until the end) so that an
-        # interrupted sweep resumes per condition with --resume=true.
-        results = run_all(
-            cfg,
-            task_envs,
-            steps,
-            policy,
-            processors,
-            done,
-            lambda rows: write_eval(cfg.output_dir, report_of(rows, False)),
-        )
+        done = resumable_rows(cfg, metadata)
+        results = run_all(cfg, task_envs, steps, policy, processors, done, checkpoint)
     finally:
         if owns_envs:
             compat.eval_close_envs(envs)
-    report = report_of(results, True)
+    metadata["duration_s"] = round(time.time() - started, 3)
+    report = rollout_report(metadata, results, complete=True)
     write_eval(cfg.output_dir, report)
     return report
 
