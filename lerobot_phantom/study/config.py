@@ -39,6 +39,8 @@ class CleanTrainSettings:
     config_path: str = CLEAN_TRAIN_CONFIG
     steps: int | None = None  # None: the config's
     batch_size: int | None = None  # None: the config's
+    # Checkpoint every N steps (an interrupted run resumes from the last one; the final step is always saved).
+    save_freq: int | None = None  # None: the config's
     seed: int = 0
     extra_args: tuple[str, ...] = ()  # further lerobot-phantom-train flags
 
@@ -51,6 +53,7 @@ class LoRASettings:
     config_path: str = LORA_CONFIG
     steps: int = 1000
     batch_size: int | None = None  # None: the config's
+    save_freq: int = 250  # checkpoints to resume from (the final step is always saved)
     rate: float = 0.3  # fraction of attacked samples (paper: 0.3)
     intensity: str = "random"  # uniform between weak and strong (paper)
     attacks: tuple[str, ...] = tuple(

@@ -183,7 +183,8 @@ class Planner:
             "--output_dir=train/clean",
             "--phantom.rate=0",
             f"--seed={t.seed}",
-            *([f"--steps={t.steps}", f"--save_freq={t.steps}"] if t.steps is not None else []),
+            *([f"--steps={t.steps}"] if t.steps is not None else []),
+            *([f"--save_freq={t.save_freq}"] if t.save_freq is not None else []),
             *([f"--batch_size={t.batch_size}"] if t.batch_size is not None else []),
             *t.extra_args,
         ]
@@ -206,7 +207,7 @@ class Planner:
             *self.dataset_args(),
             f"--output_dir=train/{name}",
             f"--steps={lo.steps}",
-            f"--save_freq={lo.steps}",
+            f"--save_freq={lo.save_freq}",
             f"--seed={lo.seed}",
             f"--peft.r={lo.lora_rank}",
             f"--phantom.rate={rate}",
