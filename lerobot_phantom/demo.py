@@ -19,8 +19,9 @@ It runs the same commands a user would type, printing each one before running it
 Step 2 gives meaningful numbers in a minute or two. Step 3 is sized to fit the whole demo in about a quarter of an
 hour on two cores, which is a fraction of the recipe's training (docs/recipe/README.md has the learning curve and
 the TSR each scale reaches): it shows the pipeline and its outputs, and its clean TSR says how far a short run gets.
-With ``--clean_policy=<pretrained_model dir>`` (a policy trained by ``lerobot-phantom-study`` or by the full recipe),
-step 3 skips clean training and runs the defence on that policy. ``--gallery_only`` stops after step 1.
+With ``--clean_policy=<pretrained_model dir>`` (a policy trained by the full recipe), or when a
+``lerobot-phantom-study`` run left its clean policy in ``outputs/study``, step 3 skips clean training and runs the
+defence on that policy. ``--gallery_only`` stops after step 1.
 """
 
 from __future__ import annotations
@@ -57,6 +58,8 @@ class DemoConfig:
     # then evaluates and fine-tunes it instead of the policy trained here in a few minutes, which cannot solve the
     # tasks yet (docs/recipe/README.md)
     clean_policy: str | None = None
+    # Without --clean_policy, use the clean policy of a `lerobot-phantom-study` run in outputs/study when present
+    use_study_policy: bool = True
     # Episodes per condition for the reference policy's robustness table (step 2)
     servo_episodes: int = 10
     # Attacks evaluated (besides the clean control), as LeRobot lists: '[laser_blinding,voice_dos]'
@@ -128,10 +131,27 @@ def demo(cfg: DemoConfig) -> dict[str, Path]:
     if not cfg.train:
         return demo_run.outputs
     dataset = _collect(demo_run)
-    clean_policy = _train_clean(demo_run, dataset) if cfg.clean_policy is None else Path(cfg.clean_policy)
+    clean_policy = _trained_policy(cfg)
+    trained_here = clean_policy is None
+    if trained_here:
+        clean_policy = _train_clean(demo_run, dataset)
     phantom_policy = _train_adversarial(demo_run, dataset, clean_policy)
-    _before_after(demo_run, clean_policy, phantom_policy)
+    _before_after(demo_run, clean_policy, phantom_policy, trained_here)
     return demo_run.outputs
+
+
+# Where `lerobot-phantom-study` (default --output_dir) leaves its clean policy, relative to the working directory.
+STUDY_CLEAN_POLICY = Path("outputs/study/train/clean/checkpoints/last/pretrained_model")
+
+
+def _trained_policy(cfg: DemoConfig) -> Path | None:
+    """--clean_policy, else the study's clean policy when a study has run here, else None (train one)."""
+    if cfg.clean_policy is not None:
+        return Path(cfg.clean_policy)
+    if cfg.use_study_policy and (STUDY_CLEAN_POLICY / "config.json").exists():
+        print(f"\nusing the clean policy trained by lerobot-phantom-study: {STUDY_CLEAN_POLICY}", flush=True)
+        return STUDY_CLEAN_POLICY
+    return None
 
 
 def _start(cfg: DemoConfig) -> _Run:
@@ -295,7 +315,7 @@ def _train_adversarial(demo_run: _Run, dataset: dict[str, str], clean_policy: Pa
     return phantom_dir / "checkpoints" / "last" / "pretrained_model"
 
 
-def _before_after(demo_run: _Run, clean_policy: Path, phantom_policy: Path) -> None:
+def _before_after(demo_run: _Run, clean_policy: Path, phantom_policy: Path, trained_here: bool) -> None:
     """Clean vs attacked task success before and after stage 2, and the Table-5 style report."""
     cfg, out = demo_run.cfg, demo_run.out
     evals = {}
@@ -327,25 +347,25 @@ def _before_after(demo_run: _Run, clean_policy: Path, phantom_policy: Path) -> N
         report=report,
     )
     _print_summary(report)
-    _print_clean_tsr(cfg, evals["before"] / "eval.json")
+    _print_clean_tsr(evals["before"] / "eval.json", clean_policy, cfg.clean_steps if trained_here else None)
 
 
-def _print_clean_tsr(cfg: DemoConfig, eval_json: Path) -> None:
+def _print_clean_tsr(eval_json: Path, clean_policy: Path, steps_trained_here: int | None) -> None:
     """State plainly what the clean policy achieved and what a demo-sized run can show."""
     summary = json.loads(eval_json.read_text())["summary"]
     clean = next(row for row in summary if row["condition"] == "clean")
     low, high = clean["ci95"]
     source = (
-        f"the policy given by --clean_policy ({cfg.clean_policy})"
-        if cfg.clean_policy is not None
-        else f"the policy trained here ({cfg.clean_steps} steps)"
+        f"the trained policy {clean_policy}"
+        if steps_trained_here is None
+        else f"the policy trained here ({steps_trained_here} steps)"
     )
     print(
         f"\nClean TSR of {source}: {clean['successes']}/{clean['episodes']} = {100 * clean['tsr']:.0f} % "
         f"(95 % Wilson interval {100 * low:.0f}-{100 * high:.0f} %).",
         flush=True,
     )
-    if cfg.clean_policy is None:
+    if steps_trained_here is not None:
         print(
             "A few minutes of CPU training is far from the recipe's full run (docs/recipe/README.md has its learning "
             "curve): expect a low clean TSR, so the before/after table shows the pipeline, not the defence. Pass "

@@ -60,6 +60,7 @@ def test_the_whole_loop_runs_at_microscopic_scale(tmp_path):
             out=str(tmp_path / "demo"),
             episodes=2,
             vlm_size="tiny",
+            use_study_policy=False,
             chunk_size=4,
             n_action_steps=4,
             clean_steps=2,
