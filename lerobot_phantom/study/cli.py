@@ -180,6 +180,12 @@ class Study:
 
     def save(self) -> None:
         self.manifest["results"] = self.results()
+        self.manifest["conditions"] = {
+            role: json.loads((self.dir / path).read_text())["metadata"].get("conditions", [])
+            for role, path in self.manifest["results"].items()
+        }
+        report = self.records.get("report", {})
+        self.manifest["report"] = report["output"] if report.get("status") == "done" else None
         write_manifest(self.dir, self.manifest)
 
     def results(self) -> dict[str, str]:

@@ -31,6 +31,8 @@ def test_micro_study_runs_every_stage_then_skips_them_all(micro):
             assert [e["seed"] for e in row["per_episode"]] == [1000, 1001]
             assert all(isinstance(e["task_index"], int) and e["instruction"] for e in row["per_episode"])
     assert set(manifest["results"]) == {"before", "after", "control"}
+    assert manifest["conditions"] == {key: ["clean", "laser_blinding@strong"] for key in manifest["results"]}
+    assert manifest["report"] == "report"
     # The AT run fine-tuned a LoRA adapter from the clean checkpoint; the control too, at rate 0.
     for name, rate in (("at", 0.3), ("control", 0.0)):
         config = json.loads(

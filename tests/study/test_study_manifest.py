@@ -35,7 +35,8 @@ class FakeRunner:
             if not interrupted:
                 (out / PRETRAINED / "config.json").write_text("{}")
         elif stage.kind == "sweep":
-            (out / "eval.json").write_text(json.dumps({"metadata": {"complete": not interrupted}}))
+            metadata = {"complete": not interrupted, "conditions": ["clean", "laser_blinding@strong"]}
+            (out / "eval.json").write_text(json.dumps({"metadata": metadata}))
         elif stage.kind == "collect":
             (out / "meta").mkdir()
             (out / "meta" / "info.json").write_text("{}")
@@ -79,6 +80,8 @@ def test_manifest_records_every_stage_and_maps_roles_to_relative_eval_files(micr
     }
     for path in manifest["results"].values():
         assert (micro_dir(micro) / path).is_file()
+    assert manifest["conditions"]["after"] == ["clean", "laser_blinding@strong"]
+    assert manifest["report"] == "report"
     # The recorded command re-reads the config the study wrote.
     saved = json.loads((micro_dir(micro) / "study_config.json").read_text())
     assert saved["lora"]["steps"] == micro.lora.steps
