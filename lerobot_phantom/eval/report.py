@@ -650,9 +650,11 @@ def tsr_figure(runs: list[EvalRun]):
     handles, labels = axes[0][0].get_legend_handles_labels()
     handles.append(Patch(color="grey", alpha=0.3))
     labels.append(f"shaded: {INTERVAL}")
-    axes[0][0].legend(handles, labels, fontsize=7)
+    # Below the panels, so that it hides no curve.
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=min(4, len(labels)))
     fig.suptitle(f"Task success rate (TSR, %) under each attack; shaded bands: {INTERVAL}", fontsize=10)
-    fig.tight_layout()
+    legend_rows = (len(labels) + 3) // 4
+    fig.tight_layout(rect=(0, 0.05 * legend_rows + 0.02, 1, 1))
     return fig
 
 

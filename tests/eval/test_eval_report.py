@@ -275,7 +275,7 @@ def test_figures_name_the_interval_plot_voice_attacks_and_spell_out_attacks(eval
     # One curve per suite with the clean and the attacked point; 83.3 % on spatial under VD.
     curves = {line.get_label(): line.get_ydata().tolist() for line in voice.get_lines()}
     assert curves["spatial"] == pytest.approx([100.0, 100 * 5 / 6])
-    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    (legend,) = [[t.get_text() for t in legend.get_texts()] for legend in fig.legends]
     assert f"shaded: {INTERVAL}" in legend
     heatmap = before_after_figure(
         [
