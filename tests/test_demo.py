@@ -1,10 +1,13 @@
 """The README's main job (``lerobot-phantom-demo``) must keep working on a fresh machine: these tests run it."""
 
 import json
+from pathlib import Path
 
 import pytest
 
-from lerobot_phantom.demo import DemoConfig, demo
+from lerobot_phantom.demo import DemoConfig, demo, recipe_policy_flags
+
+CPU_RECIPE = Path(__file__).resolve().parents[1] / "configs" / "smolvla_goal_cpu.json"
 
 
 def test_gallery_only_writes_the_gallery_and_refuses_to_overwrite(tmp_path):
@@ -22,12 +25,44 @@ def test_unknown_suite_is_refused_naming_the_valid_ones(tmp_path):
         demo(DemoConfig(out=str(tmp_path / "demo"), suite="kitchen"))
 
 
+def test_clean_policy_without_a_checkpoint_is_refused(tmp_path):
+    with pytest.raises(FileNotFoundError, match="pretrained_model"):
+        demo(DemoConfig(out=str(tmp_path / "demo"), clean_policy=str(tmp_path / "nothing")))
+    assert not (tmp_path / "demo").exists()
+
+
+def test_demo_trains_with_the_shipped_cpu_recipe(tmp_path):
+    """The demo's clean training is configs/smolvla_goal_cpu.json at a smaller scale, never LeRobot's frozen-VLM
+    defaults (which keep the weight-free VLM at its random initialisation)."""
+    flags = dict(
+        flag.removeprefix("--").split("=", 1) for flag in recipe_policy_flags(DemoConfig(), tmp_path)
+    )
+    recipe = json.loads(CPU_RECIPE.read_text())["policy"]
+    compared = (
+        "load_vlm_weights",
+        "freeze_vision_encoder",
+        "train_expert_only",
+        "resize_imgs_with_padding",
+        "chunk_size",
+        "n_action_steps",
+        "optimizer_lr",
+        "scheduler_decay_lr",
+    )
+    for key in compared:
+        assert json.loads(flags[f"policy.{key}"]) == recipe[key], key
+    assert flags["policy.freeze_vision_encoder"] == flags["policy.train_expert_only"] == "false"
+
+
 @pytest.mark.slow
 def test_the_whole_loop_runs_at_microscopic_scale(tmp_path):
     outputs = demo(
         DemoConfig(
             out=str(tmp_path / "demo"),
             episodes=2,
+            vlm_size="tiny",
+            use_study_policy=False,
+            chunk_size=4,
+            n_action_steps=4,
             clean_steps=2,
             phantom_steps=2,
             batch_size=2,

@@ -7,6 +7,7 @@
   cameras, and when (``onset``/``duration`` in env steps). The clean control is always run.
 * ``--dataset.*`` (LeRobot's ``DatasetConfig``): offline mode for real-robot data without a simulator; give it
   *instead of* ``--env.*``.
+* ``--resume=true``: continue an interrupted run in the same ``--output_dir``, condition by condition.
 """
 
 from __future__ import annotations
@@ -121,6 +122,9 @@ class PhantomEvalConfig(EvalPipelineConfig):
     env: EnvConfig | None = None
     phantom: EvalPhantomConfig = field(default_factory=EvalPhantomConfig)
     dataset: DatasetConfig | None = None
+    # Keep the finished conditions of an interrupted run in <output_dir>/eval.json (same policy, env, seeds and
+    # --phantom.*) and run only the missing ones. Rollout mode only.
+    resume: bool = False
 
     def __post_init__(self) -> None:
         check_policy_path(parser.get_path_arg("policy"))

@@ -14,10 +14,10 @@ With ``--dataset.*`` instead of ``--env.*`` it runs the offline mode (``lerobot_
 """
 
 import json
-import platform
 import time
+from collections.abc import Callable
 from contextlib import nullcontext
-from dataclasses import asdict
+from dataclasses import asdict, dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -26,75 +26,56 @@ import numpy as np
 import torch
 from tqdm import tqdm
 
-import lerobot_phantom
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
-from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT, pooled_summary, summarize
-from lerobot_phantom.eval.rollout import AttackStep, build_conditions, episode_outcomes
+from lerobot_phantom.eval.loading import (
+    identity_processors,
+    load_policy,
+    policy_metadata,
+    ready_policy,
+    versions,
+    with_step,
+)
+from lerobot_phantom.eval.results import (
+    EVAL_FILENAME,
+    EVAL_FORMAT,
+    per_task_summary,
+    pooled_summary,
+    summarize,
+    write_eval,
+)
+from lerobot_phantom.eval.rollout import (
+    AttackStep,
+    Condition,
+    EpisodeTasks,
+    build_conditions,
+    episode_outcomes,
+)
 from lerobot_phantom.transforms.base import derive_seed
 
-
-def identity_processors():
-    """Pass-through pre/post processors for an in-memory policy that needs no normalisation."""
-    from lerobot.processor import PolicyProcessorPipeline
-    from lerobot.processor.converters import policy_action_to_transition, transition_to_policy_action
-
-    return (
-        PolicyProcessorPipeline(steps=[]),
-        PolicyProcessorPipeline(
-            steps=[], to_transition=policy_action_to_transition, to_output=transition_to_policy_action
-        ),
-    )
+# Re-exported for scripts that import them from here (they live in loading.py, shared with the offline mode).
+__all__ = ["evaluate", "identity_processors", "load_policy", "run_condition", "with_step"]
 
 
-def load_policy(cfg: PhantomEvalConfig, ds_meta=None):
-    """Policy and its pre/post processors from ``--policy.path``, exactly as ``lerobot-eval`` builds them
-    (``ds_meta``: a dataset's metadata instead of the env config, for the offline mode)."""
-    from lerobot.policies.factory import make_policy, make_pre_post_processors
+@dataclass(frozen=True)
+class TaskEnv:
+    """One vector env of LeRobot's ``make_env`` output: ``{group: {env_id: env}}``."""
 
-    if cfg.policy is None:
-        raise ValueError(
-            "no policy to evaluate: pass --policy.path=<checkpoint dir> (or policy= to evaluate())"
+    suite: str
+    env_id: int
+    env: Any
+
+
+def write_videos(
+    videos_dir: Path, step: AttackStep, seeds: list[int], outcomes: list[dict], fps: int
+) -> None:
+    """The recorded frames of the first ``step.record`` envs of a batch, one mp4 per episode seed."""
+    videos_dir.mkdir(parents=True, exist_ok=True)
+    frames = np.stack(step.frames, axis=1)  # (envs, steps, H, W, 3)
+    for i in range(step.record):
+        compat.eval_write_video(
+            videos_dir / f"episode_seed{seeds[i]}.mp4", frames[i, : outcomes[i]["steps"] + 1], fps
         )
-    # A dataset's metadata (offline mode) or the env config tells make_policy the features.
-    source = {"ds_meta": ds_meta} if ds_meta is not None else {"env_cfg": cfg.env}
-    policy = make_policy(cfg=cfg.policy, rename_map=cfg.rename_map, **source)
-    preprocessor, postprocessor = make_pre_post_processors(
-        policy_cfg=cfg.policy,
-        pretrained_path=cfg.policy.pretrained_path,
-        preprocessor_overrides={
-            "device_processor": {"device": str(policy.config.device)},
-            "rename_observations_processor": {"rename_map": cfg.rename_map},
-        },
-    )
-    return policy, preprocessor, postprocessor
-
-
-def with_step(pipeline, step):
-    """A copy of ``pipeline`` with ``step`` appended (same converters), leaving the original untouched."""
-    return type(pipeline)(
-        steps=[*pipeline.steps, step],
-        name=pipeline.name,
-        to_transition=pipeline.to_transition,
-        to_output=pipeline.to_output,
-    )
-
-
-def versions() -> dict[str, str]:
-    return {
-        "lerobot": compat.lerobot_version(),
-        "lerobot_phantom": lerobot_phantom.__version__,
-        "torch": torch.__version__,
-        "python": platform.python_version(),
-    }
-
-
-def policy_metadata(cfg: PhantomEvalConfig, policy) -> dict[str, Any]:
-    path = (
-        None if cfg.policy is None or cfg.policy.pretrained_path is None else str(cfg.policy.pretrained_path)
-    )
-    config = getattr(policy, "config", None)
-    return {"path": path, "type": getattr(config, "type", None) or type(policy).__name__}
 
 
 def run_condition(
@@ -106,9 +87,11 @@ def run_condition(
     videos_dir: Path | None,
     progress: tqdm,
 ) -> list[dict[str, Any]]:
-    """All episodes of one condition on one vectorised task env; one record per episode (seed, success, ...)."""
+    """All episodes of one condition on one vectorised env; one record per episode (seed, task, success, ...)."""
     env_preprocessor, env_postprocessor, preprocessor, postprocessor = processors
-    attacked_env_preprocessor = with_step(env_preprocessor, step)
+    tasks = EpisodeTasks(env)
+    # The task recorder runs before the attacker, so instruction attacks do not change the recorded instruction.
+    attacked_env_preprocessor = with_step(env_preprocessor, tasks, step)
     rollout = compat.eval_rollout()
     n_episodes, num_envs = cfg.eval.n_episodes, env.num_envs
     records: list[dict[str, Any]] = []
@@ -117,6 +100,7 @@ def run_condition(
         seeds = list(range(cfg.seed + batch_start, cfg.seed + batch_start + num_envs))
         record = max(0, min(cfg.phantom.videos - batch_start, num_envs)) if videos_dir is not None else 0
         step.arm(seeds, record=record)
+        tasks.arm()
         # Stochastic policies sample from the global RNGs: reseed identically in every condition so that policy
         # noise is paired too, and only the attack differs between conditions.
         compat.eval_seed_everything(derive_seed(cfg.seed, batch_start) % 2**32)
@@ -131,17 +115,12 @@ def run_condition(
         )
         outcomes = episode_outcomes(data)
         used = min(num_envs, n_episodes - batch_start)
-        for i in range(used):
-            records.append({"seed": seeds[i], **outcomes[i], "attack_params": step.episode_params(i)})
+        records += [
+            {"seed": seeds[i], **tasks.tasks[i], **outcomes[i], "attack_params": step.episode_params(i)}
+            for i in range(used)
+        ]
         if record:
-            videos_dir.mkdir(parents=True, exist_ok=True)
-            frames = np.stack(step.frames, axis=1)  # (envs, steps, H, W, 3)
-            for i in range(record):
-                compat.eval_write_video(
-                    videos_dir / f"episode_seed{seeds[i]}.mp4",
-                    frames[i, : outcomes[i]["steps"] + 1],
-                    cfg.env.fps,
-                )
+            write_videos(videos_dir, step, seeds, outcomes, cfg.env.fps)
         progress.update(used)
     return records
 
@@ -150,6 +129,128 @@ def suite_name(group: str, env_cfg) -> str:
     """Name of a task group in the tables. LeRobot's ``make_env`` files single-id envs under the env type (e.g.
     ``{"pusht": {0: env}}``); the task (``PushT-v0``, a phantom_table suite) says more there."""
     return env_cfg.task if group == env_cfg.type and env_cfg.task else group
+
+
+def result_row(condition: Condition, task_env: TaskEnv, records: list[dict[str, Any]]) -> dict[str, Any]:
+    return {
+        "condition": condition.key,
+        "attack": condition.attack,
+        "intensity": condition.intensity,
+        "intensity_value": condition.intensity_value,
+        "suite": task_env.suite,
+        "task_id": task_env.env_id,
+        **summarize(records),
+        "per_episode": records,
+    }
+
+
+def run_all(
+    cfg: PhantomEvalConfig,
+    task_envs: list[TaskEnv],
+    steps: list[AttackStep],
+    policy,
+    processors: tuple,
+    done: dict[tuple, dict[str, Any]],
+    on_row: Callable[[list[dict[str, Any]]], None],
+) -> list[dict[str, Any]]:
+    """Every condition on every env (same seeds everywhere); one result row per (env, condition). Rows already in
+    ``done`` (keyed by ``row_key``, from an interrupted run) are kept, not re-run; ``on_row`` sees the rows so far
+    after each new one."""
+    device = torch.device(str(getattr(policy.config, "device", "cpu") or "cpu"))
+    use_amp = bool(getattr(cfg.policy, "use_amp", False))
+    results: list[dict[str, Any]] = []
+    progress = tqdm(total=len(steps) * len(task_envs) * cfg.eval.n_episodes, desc="conditions x episodes")
+    try:
+        with torch.no_grad(), torch.autocast(device_type=device.type) if use_amp else nullcontext():
+            for task_env, step in ((t, s) for t in task_envs for s in steps):
+                key = (step.condition.key, task_env.suite, task_env.env_id)
+                if key in done:
+                    results.append(done[key])
+                    progress.update(cfg.eval.n_episodes)
+                    continue
+                progress.set_postfix_str(f"{task_env.suite}/{task_env.env_id} {step.condition.key}")
+                videos_dir = None
+                if cfg.phantom.videos > 0:
+                    name = f"{task_env.suite}_{task_env.env_id}"
+                    videos_dir = Path(cfg.output_dir) / "videos" / step.condition.key.replace("@", "_") / name
+                records = run_condition(task_env.env, step, cfg, policy, processors, videos_dir, progress)
+                results.append(result_row(step.condition, task_env, records))
+                on_row(results)
+    finally:
+        progress.close()
+    return results
+
+
+def row_key(row: dict[str, Any]) -> tuple:
+    return (row["condition"], row["suite"], row["task_id"])
+
+
+# Metadata that must be equal for an interrupted run's rows to be reused by --resume.
+RESUME_MUST_MATCH = ("policy", "env", "n_episodes", "episode_seeds", "phantom")
+
+
+def resumable_rows(cfg: PhantomEvalConfig, metadata: dict[str, Any]) -> dict[tuple, dict[str, Any]]:
+    """Result rows of ``<output_dir>/eval.json`` that ``--resume=true`` may keep; {} without --resume or file."""
+    path = Path(cfg.output_dir) / EVAL_FILENAME
+    if not cfg.resume or not path.is_file():
+        return {}
+    with open(path) as f:
+        previous = json.load(f)
+    if previous.get("format") != EVAL_FORMAT or previous.get("mode") != "rollout":
+        raise ValueError(f"--resume: {path} is not a rollout eval.json of format {EVAL_FORMAT}")
+    differs = [k for k in RESUME_MUST_MATCH if previous["metadata"].get(k) != metadata[k]]
+    if differs:
+        raise ValueError(
+            f"--resume: {path} was written with other settings ({', '.join(differs)} differ); "
+            "evaluate into a fresh --output_dir or drop --resume"
+        )
+    return {row_key(row): row for row in previous["results"]}
+
+
+def rollout_metadata(
+    cfg: PhantomEvalConfig, policy, steps: list[AttackStep], task_envs: list[TaskEnv], started: float
+) -> dict[str, Any]:
+    return {
+        "created": datetime.fromtimestamp(started, UTC).isoformat(timespec="seconds"),
+        "duration_s": 0.0,
+        "policy": policy_metadata(cfg, policy),
+        "env": {"type": cfg.env.type, "task": cfg.env.task},
+        "suites": list(dict.fromkeys(t.suite for t in task_envs)),
+        "n_episodes": cfg.eval.n_episodes,
+        "batch_size": cfg.eval.batch_size,
+        "seed": cfg.seed,
+        "episode_seeds": [cfg.seed + i for i in range(cfg.eval.n_episodes)],
+        "conditions": [step.condition.key for step in steps],
+        "attacks": {step.condition.key: repr(step.attack) for step in steps if step.attack is not None},
+        "phantom": asdict(cfg.phantom),
+        "versions": versions(),
+        "complete": False,
+    }
+
+
+def make_envs(cfg: PhantomEvalConfig):
+    """LeRobot's ``make_env(cfg.env)``: ``{group: {env_id: vector_env}}``."""
+    from lerobot.envs.factory import make_env
+
+    return make_env(
+        cfg.env,
+        n_envs=cfg.eval.batch_size,
+        use_async_envs=cfg.eval.use_async_envs,
+        trust_remote_code=cfg.trust_remote_code,
+    )
+
+
+def rollout_report(metadata: dict[str, Any], results: list[dict[str, Any]], complete: bool) -> dict[str, Any]:
+    """The eval.json content (``metadata.complete`` false while conditions are still missing)."""
+    metadata["complete"] = complete
+    return {
+        "format": EVAL_FORMAT,
+        "mode": "rollout",
+        "metadata": metadata,
+        "results": results,
+        "summary": pooled_summary(results),
+        "summary_per_task": per_task_summary(results),
+    }
 
 
 def evaluate(
@@ -168,101 +269,60 @@ def evaluate(
         return evaluate_offline(cfg, policy, preprocessor, postprocessor)
     if cfg.seed is None:
         raise ValueError("paired comparisons need fixed env seeds: pass --seed=<int> (default 1000)")
-    from lerobot.envs.factory import make_env
-
     started = time.time()
-    conditions = build_conditions(cfg.phantom)
     # Every attack is built up front, so that a bad name or calibration fails before any rollout.
-    steps = [AttackStep(condition, cfg.phantom) for condition in conditions]
-    if policy is None:
-        policy, preprocessor, postprocessor = load_policy(cfg)
-    elif preprocessor is None or postprocessor is None:
-        preprocessor, postprocessor = identity_processors()
-    policy.eval()
-    env_preprocessor, env_postprocessor = compat.eval_env_processors(cfg.env, cfg.policy or policy.config)
-    processors = (env_preprocessor, env_postprocessor, preprocessor, postprocessor)
-
-    output_dir = Path(cfg.output_dir)
-    output_dir.mkdir(parents=True, exist_ok=True)
+    steps = [AttackStep(condition, cfg.phantom) for condition in build_conditions(cfg.phantom)]
+    policy, preprocessor, postprocessor = ready_policy(cfg, policy, preprocessor, postprocessor)
+    env_processors = compat.eval_env_processors(cfg.env, cfg.policy or policy.config)
+    processors = (*env_processors, preprocessor, postprocessor)
     owns_envs = envs is None
-    if owns_envs:
-        envs = make_env(
-            cfg.env,
-            n_envs=cfg.eval.batch_size,
-            use_async_envs=cfg.eval.use_async_envs,
-            trust_remote_code=cfg.trust_remote_code,
-        )
-    tasks = [
-        (suite_name(group, cfg.env), task_id, env)
+    envs = make_envs(cfg) if owns_envs else envs
+    task_envs = [
+        TaskEnv(suite_name(group, cfg.env), env_id, env)
         for group, by_id in envs.items()
-        for task_id, env in by_id.items()
+        for env_id, env in by_id.items()
     ]
-    results: list[dict[str, Any]] = []
-    device = torch.device(str(getattr(policy.config, "device", "cpu") or "cpu"))
-    use_amp = bool(getattr(cfg.policy, "use_amp", False))
-    progress = tqdm(total=len(conditions) * len(tasks) * cfg.eval.n_episodes, desc="conditions x episodes")
+    metadata = rollout_metadata(cfg, policy, steps, task_envs, started)
+
+    def checkpoint(rows: list[dict[str, Any]]) -> None:
+        # Rewritten after every condition, so that an interrupted sweep resumes per condition (--resume=true).
+        metadata["duration_s"] = round(time.time() - started, 3)
+        write_eval(cfg.output_dir, rollout_report(metadata, rows, complete=False))
+
     try:
-        with torch.no_grad(), torch.autocast(device_type=device.type) if use_amp else nullcontext():
-            for suite, task_id, env in tasks:
-                for condition, step in zip(conditions, steps, strict=True):
-                    progress.set_postfix_str(f"{suite}/{task_id} {condition.key}")
-                    videos_dir = None
-                    if cfg.phantom.videos > 0:
-                        videos_dir = (
-                            output_dir / "videos" / condition.key.replace("@", "_") / f"{suite}_{task_id}"
-                        )
-                    records = run_condition(env, step, cfg, policy, processors, videos_dir, progress)
-                    results.append(
-                        {
-                            "condition": condition.key,
-                            "attack": condition.attack,
-                            "intensity": condition.intensity,
-                            "intensity_value": condition.intensity_value,
-                            "suite": suite,
-                            "task_id": task_id,
-                            **summarize(records),
-                            "per_episode": records,
-                        }
-                    )
+        done = resumable_rows(cfg, metadata)
+        results = run_all(cfg, task_envs, steps, policy, processors, done, checkpoint)
     finally:
-        progress.close()
         if owns_envs:
             compat.eval_close_envs(envs)
-
-    report = {
-        "format": EVAL_FORMAT,
-        "mode": "rollout",
-        "metadata": {
-            "created": datetime.now(UTC).isoformat(timespec="seconds"),
-            "duration_s": round(time.time() - started, 3),
-            "policy": policy_metadata(cfg, policy),
-            "env": {"type": cfg.env.type, "task": cfg.env.task},
-            "suites": list(dict.fromkeys(suite for suite, _, _ in tasks)),
-            "n_episodes": cfg.eval.n_episodes,
-            "batch_size": cfg.eval.batch_size,
-            "seed": cfg.seed,
-            "episode_seeds": [cfg.seed + i for i in range(cfg.eval.n_episodes)],
-            "conditions": [c.key for c in conditions],
-            "attacks": {step.condition.key: repr(step.attack) for step in steps if step.attack is not None},
-            "phantom": asdict(cfg.phantom),
-            "versions": versions(),
-        },
-        "results": results,
-        "summary": pooled_summary(results),
-    }
-    with open(output_dir / EVAL_FILENAME, "w") as f:
-        json.dump(report, f, indent=2)
+    metadata["duration_s"] = round(time.time() - started, 3)
+    report = rollout_report(metadata, results, complete=True)
+    write_eval(cfg.output_dir, report)
     return report
 
 
 def format_summary(report: dict[str, Any]) -> str:
-    lines = [f"{'condition':<28} {'TSR':>7}  95% CI"]
+    """The pooled TSR per condition with its Wilson interval, then TSR (%) per task (columns) and condition."""
+    lines = [f"{'condition':<28} {'TSR':>7}  95% Wilson CI"]
     for row in report["summary"]:
         low, high = row["ci95"]
         lines.append(
             f"{row['condition']:<28} {100 * row['tsr']:6.1f}%  [{100 * low:.1f}, {100 * high:.1f}]"
             f"  ({row['successes']}/{row['episodes']})"
         )
+    per_task = report.get("summary_per_task") or []
+    tasks = list(dict.fromkeys((r["suite"], r["task"]) for r in per_task))
+    if len(tasks) > 1:
+        lines += ["", "TSR (%) per task:"]
+        lines += [f"  T{i}: {suite} / {task}" for i, (suite, task) in enumerate(tasks)]
+        lines.append(f"{'condition':<28} " + " ".join(f"{f'T{i}':>6}" for i in range(len(tasks))))
+        cell = {(r["condition"], r["suite"], r["task"]): r for r in per_task}
+        for row in report["summary"]:
+            values = [cell.get((row["condition"], *task)) for task in tasks]
+            lines.append(
+                f"{row['condition']:<28} "
+                + " ".join("     -" if v is None else f"{100 * v['tsr']:6.1f}" for v in values)
+            )
     return "\n".join(lines)
 
 

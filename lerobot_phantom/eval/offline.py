@@ -10,12 +10,10 @@ policy's own distance from the recorded action as a yardstick.
         --phantom.attacks='[laser_blinding,voice_dos]' --phantom.offline_frames=256 --eval.batch_size=16
 """
 
-import json
 import statistics
 import time
-from dataclasses import asdict
+from dataclasses import asdict, dataclass, field
 from datetime import UTC, datetime
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -24,9 +22,15 @@ from tqdm import tqdm
 
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.eval.config import PhantomEvalConfig
-from lerobot_phantom.eval.eval import identity_processors, load_policy, policy_metadata, versions, with_step
-from lerobot_phantom.eval.results import EVAL_FILENAME, EVAL_FORMAT
-from lerobot_phantom.eval.rollout import AttackStep, build_conditions
+from lerobot_phantom.eval.loading import (
+    identity_processors,
+    policy_metadata,
+    ready_policy,
+    versions,
+    with_step,
+)
+from lerobot_phantom.eval.results import EVAL_FORMAT, write_eval
+from lerobot_phantom.eval.rollout import AttackStep, Condition, build_conditions
 from lerobot_phantom.transforms.base import derive_seed
 
 
@@ -55,78 +59,104 @@ def deviation_stats(distances: list[float], normalised: list[float]) -> dict[str
     }
 
 
-def evaluate_offline(
-    cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None
-) -> dict[str, Any]:
-    """Action deviation clean vs attacked per condition over dataset frames; writes and returns eval.json."""
-    from lerobot.datasets.lerobot_dataset import LeRobotDataset
-    from torch.utils.data import Subset, default_collate
+@dataclass
+class Deviations:
+    """Per-frame distances between attacked and clean actions, per condition (raw L2 and std-normalised)."""
 
-    if cfg.phantom.onset != 0 or cfg.phantom.duration is not None:
-        raise ValueError(
-            "--phantom.onset/--phantom.duration need rollouts (--env.*); offline frames are single steps"
-        )
-    started = time.time()
-    dataset = LeRobotDataset(
+    conditions: list[Condition]
+    distances: list[list[float]] = field(default_factory=list)
+    normalised: list[list[float]] = field(default_factory=list)
+    clean_vs_recorded: list[float] = field(default_factory=list)
+
+    def __post_init__(self) -> None:
+        self.distances = [[] for _ in self.conditions]
+        self.normalised = [[] for _ in self.conditions]
+
+    def add(self, k: int, diff: torch.Tensor, action_std: torch.Tensor) -> None:
+        self.distances[k] += diff.norm(dim=1).tolist()
+        self.normalised[k] += (diff / action_std).pow(2).mean(dim=1).sqrt().tolist()
+
+    def rows(self, frames: int) -> list[dict[str, Any]]:
+        return [
+            {
+                "condition": condition.key,
+                "attack": condition.attack,
+                "intensity": condition.intensity,
+                "intensity_value": condition.intensity_value,
+                "frames": frames,
+                **deviation_stats(self.distances[k], self.normalised[k]),
+                "per_frame_l2": [round(d, 6) for d in self.distances[k]],
+            }
+            for k, condition in enumerate(self.conditions)
+        ]
+
+
+def load_dataset(cfg: PhantomEvalConfig):
+    from lerobot.datasets.lerobot_dataset import LeRobotDataset
+
+    return LeRobotDataset(
         cfg.dataset.repo_id,
         root=cfg.dataset.root,
         episodes=cfg.dataset.episodes,
         revision=cfg.dataset.revision,
         video_backend=cfg.dataset.video_backend,
     )
-    conditions = build_conditions(cfg.phantom)[1:]  # the clean frame is every condition's reference
-    steps = [AttackStep(condition, cfg.phantom) for condition in conditions]
-    if policy is None:
-        policy, preprocessor, postprocessor = load_policy(cfg, ds_meta=dataset.meta)
-    elif preprocessor is None or postprocessor is None:
-        preprocessor, postprocessor = identity_processors()
-    policy.eval()
+
+
+def measure(cfg: PhantomEvalConfig, dataset, indices: list[int], steps: list[AttackStep], policy, processors):
+    """Clean and attacked first actions on every chosen frame, batch by batch (same RNG state for both)."""
+    from torch.utils.data import Subset, default_collate
+
+    preprocessor, postprocessor = processors
     identity, _ = identity_processors()
     attackers = [with_step(identity, step) for step in steps]
-
     std = dataset.meta.stats["action"]["std"]
     action_std = torch.as_tensor(np.asarray(std), dtype=torch.float32).reshape(-1).clamp(min=1e-6)
-    indices = frame_indices(len(dataset), cfg.phantom.offline_frames)
     frames = Subset(dataset, indices)
-    batch_size = cfg.eval.batch_size
-    distances: list[list[float]] = [[] for _ in conditions]
-    normalised: list[list[float]] = [[] for _ in conditions]
-    clean_vs_recorded: list[float] = []
-    progress = tqdm(total=len(indices) * len(conditions), desc="conditions x frames")
+    deviations = Deviations([step.condition for step in steps])
+    progress = tqdm(total=len(indices) * len(steps), desc="conditions x frames")
     try:
-        for start in range(0, len(indices), batch_size):
-            batch = default_collate([frames[i] for i in range(start, min(start + batch_size, len(indices)))])
+        for start in range(0, len(indices), cfg.eval.batch_size):
+            stop = min(start + cfg.eval.batch_size, len(indices))
+            batch = default_collate([frames[i] for i in range(start, stop)])
             seed = derive_seed(cfg.seed or 0, start) % 2**32
             clean = act(policy, preprocessor, postprocessor, batch, seed)
-            clean_vs_recorded += (clean - batch["action"].reshape(clean.shape)).norm(dim=1).tolist()
+            deviations.clean_vs_recorded += (
+                (clean - batch["action"].reshape(clean.shape)).norm(dim=1).tolist()
+            )
             for k, (step, attacker) in enumerate(zip(steps, attackers, strict=True)):
                 # Each frame is its own "episode": its attack parameters are seeded by its dataset index.
                 step.arm(batch["index"].tolist())
                 attacked = act(policy, preprocessor, postprocessor, attacker(dict(batch)), seed)
-                diff = attacked - clean
-                distances[k] += diff.norm(dim=1).tolist()
-                normalised[k] += (diff / action_std).pow(2).mean(dim=1).sqrt().tolist()
+                deviations.add(k, attacked - clean, action_std)
                 progress.update(len(clean))
     finally:
         progress.close()
+    return deviations
 
-    results = [
-        {
-            "condition": condition.key,
-            "attack": condition.attack,
-            "intensity": condition.intensity,
-            "intensity_value": condition.intensity_value,
-            "frames": len(indices),
-            **deviation_stats(distances[k], normalised[k]),
-            "per_frame_l2": [round(d, 6) for d in distances[k]],
-        }
-        for k, condition in enumerate(conditions)
-    ]
+
+def evaluate_offline(
+    cfg: PhantomEvalConfig, policy=None, preprocessor=None, postprocessor=None
+) -> dict[str, Any]:
+    """Action deviation clean vs attacked per condition over dataset frames; writes and returns eval.json."""
+    if cfg.phantom.onset != 0 or cfg.phantom.duration is not None:
+        raise ValueError(
+            "--phantom.onset/--phantom.duration need rollouts (--env.*); offline frames are single steps"
+        )
+    started = time.time()
+    dataset = load_dataset(cfg)
+    # The clean frame is every condition's reference, so the clean control is not a condition here.
+    steps = [AttackStep(condition, cfg.phantom) for condition in build_conditions(cfg.phantom)[1:]]
+    policy, preprocessor, postprocessor = ready_policy(
+        cfg, policy, preprocessor, postprocessor, ds_meta=dataset.meta
+    )
+    indices = frame_indices(len(dataset), cfg.phantom.offline_frames)
+    deviations = measure(cfg, dataset, indices, steps, policy, (preprocessor, postprocessor))
     report = {
         "format": EVAL_FORMAT,
         "mode": "offline",
         "metadata": {
-            "created": datetime.now(UTC).isoformat(timespec="seconds"),
+            "created": datetime.fromtimestamp(started, UTC).isoformat(timespec="seconds"),
             "duration_s": round(time.time() - started, 3),
             "policy": policy_metadata(cfg, policy),
             "dataset": {
@@ -135,15 +165,12 @@ def evaluate_offline(
             },
             "frame_indices": indices,
             "seed": cfg.seed,
-            "clean_vs_recorded_l2": statistics.fmean(clean_vs_recorded),
-            "conditions": [c.key for c in conditions],
+            "clean_vs_recorded_l2": statistics.fmean(deviations.clean_vs_recorded),
+            "conditions": [step.condition.key for step in steps],
             "phantom": asdict(cfg.phantom),
             "versions": versions(),
         },
-        "results": results,
+        "results": deviations.rows(len(indices)),
     }
-    output_dir = Path(cfg.output_dir)
-    output_dir.mkdir(parents=True, exist_ok=True)
-    with open(output_dir / EVAL_FILENAME, "w") as f:
-        json.dump(report, f, indent=2)
+    write_eval(cfg.output_dir, report)
     return report

@@ -5,11 +5,19 @@
 
 * ``robustness.{md,csv,tex}`` (Table 3): rows = clean + attack x intensity, columns = suites (x labels when several
   inputs); cells = TSR in %. ``results.csv`` has every number with its 95 % Wilson interval.
+* ``per_task.{md,csv,tex}`` (when episodes ran more than one task): TSR (%) per condition and task;
+  ``per_task_results.csv`` with intervals.
 * ``before_after.{md,csv,tex}`` (Table 5): for each before/after pair, the after TSR with its change and an exact
   McNemar test on matched episodes (same suite, task and env seed); pairs whose seeds, env or conditions do not
-  match are refused.
-* ``tsr_vs_intensity.png`` (TSR against intensity per attack, Wilson bands) and ``before_after_heatmap.png``.
-* ``summary.md``: the largest drops under attack and the largest gains/losses after training.
+  match are refused. Several pairs (e.g. AT vs before and AT vs a clean-training control) get one column group
+  each, labelled "<after> vs <before>".
+* ``tsr_vs_intensity.png`` (TSR against intensity per attack, voice attacks as clean vs on, Wilson bands) and
+  ``before_after_heatmap.png``.
+* ``summary.md``: the largest drops under attack and the largest gains/losses after training (every condition tied
+  at one of the listed values is listed).
+
+Tables and figures spell every attack out (with the paper's abbreviation) and carry a note saying what the cells
+mean, so that they read without this documentation.
 """
 
 import csv
@@ -19,10 +27,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from lerobot_phantom.eval.results import CLEAN, EVAL_FILENAME, EVAL_FORMAT
+from lerobot_phantom.eval.results import CLEAN, EVAL_FILENAME, EVAL_FORMAT, episode_task
 from lerobot_phantom.eval.stats import PairedTest, mcnemar_exact, wilson_interval
 from lerobot_phantom.transforms.intensity import LEVELS, parse_intensity
-from lerobot_phantom.transforms.registry import ATTACK_NAMES
+from lerobot_phantom.transforms.registry import ATTACK_NAMES, CAMERA_ATTACKS
 
 ABBREVIATIONS = {
     CLEAN: "Clean",
@@ -35,7 +43,28 @@ ABBREVIATIONS = {
     "voice_dos": "VD",
     "voice_spoofing": "VS",
 }
+ATTACK_TITLES = {
+    CLEAN: "Clean",
+    "laser_blinding": "Laser blinding",
+    "light_projection": "Light projection",
+    "laser_color_strip": "Laser color strip",
+    "em_color_strip": "EM color strip",
+    "em_truncation": "EM truncation",
+    "ultrasound_blur": "Ultrasound blur",
+    "voice_dos": "Voice DoS",
+    "voice_spoofing": "Voice spoofing",
+}
 SIGNIFICANCE = 0.05
+INTERVAL = "95% Wilson score interval"
+ROBUSTNESS_NOTE = (
+    "Cells: task success rate (TSR) in %, pooled over the suite's tasks; every condition runs the same env seeds. "
+    "Intensities weak/medium/strong as in the paper; voice attacks act in full (one row each)."
+)
+BEFORE_AFTER_NOTE = (
+    "Cells: TSR after training in %, then in parentheses the paired change after - before in percentage points "
+    "(pp) on the same seeds; '0.0 (+0.0)' means 0 % success both before and after (no change, not a missing value); "
+    "'-' = not evaluated; * = p < 0.05, exact McNemar test on the matched episodes."
+)
 
 
 @dataclass
@@ -154,12 +183,23 @@ def ordered_conditions(runs: list[EvalRun]) -> list[str]:
     return sorted(every, key=condition_sort_key)
 
 
+def attack_title(attack: str) -> str:
+    """``Laser blinding (LB)``: the attack spelt out with the paper's abbreviation; ``Clean`` for the control."""
+    if attack == CLEAN:
+        return ATTACK_TITLES[CLEAN]
+    if attack not in ATTACK_TITLES:
+        return attack
+    return f"{ATTACK_TITLES[attack]} ({ABBREVIATIONS[attack]})"
+
+
 def condition_label(condition: str, latex: bool = False) -> str:
+    """``Laser blinding (LB), strong``; LaTeX-escaped with the clean control in bold when ``latex``."""
     attack, _, level = condition.partition("@")
-    name = ABBREVIATIONS.get(attack, attack)
-    if not level:
-        return f"\\textbf{{{name}}}" if latex and condition == CLEAN else name
-    return f"${name}_{{{level}}}$" if latex else f"{name} {level}"
+    name = attack_title(attack) + (f", {level}" if level else "")
+    if latex:
+        name = latex_escape(name)
+        return f"\\textbf{{{name}}}" if condition == CLEAN else name
+    return name
 
 
 def percent(value: float) -> str:
@@ -177,6 +217,10 @@ class Table:
     columns: list[str]
     rows: list[tuple[str, list[str]]]  # (condition, cells)
     corner: str = "Attack"
+    # What the cells mean (units, symbols); printed under the Markdown and LaTeX tables.
+    notes: tuple[str, ...] = ()
+    # Unit of the cells, named in the CSV header (CSV has no room for notes).
+    unit: str = "TSR %"
 
     @property
     def column_groups(self) -> list[str]:
@@ -193,6 +237,8 @@ class Table:
             "|" + "|".join(["---"] + ["---:"] * len(headers)) + "|",
         ]
         lines += ["| " + " | ".join([condition_label(c), *cells]) + " |" for c, cells in self.rows]
+        for note in self.notes:
+            lines += ["", note]
         return "\n".join(lines) + "\n"
 
     def csv(self) -> str:
@@ -200,7 +246,7 @@ class Table:
         writer = csv.writer(buffer, lineterminator="\n")
         if any(self.column_groups):
             writer.writerow(["", *self.column_groups])
-        writer.writerow(["condition", *self.columns])
+        writer.writerow([f"condition [{self.unit}]", *self.columns])
         for condition, cells in self.rows:
             writer.writerow([condition, *cells])
         return buffer.getvalue()
@@ -223,7 +269,12 @@ class Table:
             lines.append(" & ".join([condition_label(condition, latex=True), *cells]) + " \\\\")
             if condition == CLEAN:
                 lines.append("\\midrule")
-        lines += ["\\bottomrule", "\\end{tabular}"]
+        lines.append("\\bottomrule")
+        lines += [
+            f"\\multicolumn{{{n + 1}}}{{l}}{{\\footnotesize {latex_escape(note)}}} \\\\"
+            for note in self.notes
+        ]
+        lines.append("\\end{tabular}")
         return "\n".join(lines) + "\n"
 
 
@@ -234,6 +285,8 @@ def latex_escape(text: str) -> str:
         ("%", "\\%"),
         ("&", "\\&"),
         ("#", "\\#"),
+        ("<", "$<$"),
+        (">", "$>$"),
     ):
         text = text.replace(char, escaped)
     return text
@@ -253,7 +306,66 @@ def robustness_table(runs: list[EvalRun]) -> Table:
                 counts = pooled(run, condition, suite)
                 cells.append("-" if counts is None else percent(counts[0] / counts[1]))
         rows.append((condition, cells))
-    return Table(groups=groups, columns=columns, rows=rows)
+    return Table(groups=groups, columns=columns, rows=rows, notes=(ROBUSTNESS_NOTE,))
+
+
+def task_columns(runs: list[EvalRun]) -> list[tuple[EvalRun, str, tuple]]:
+    """(run, suite, task) of every task the runs' episodes recorded, in first-seen order."""
+    columns = []
+    for run in runs:
+        for suite in run.suites:
+            tasks = dict.fromkeys(
+                episode_task(e) for r in run.data["results"] if r["suite"] == suite for e in r["per_episode"]
+            )
+            columns += [(run, suite, task) for task in tasks]
+    return columns
+
+
+def task_episodes(run: EvalRun, condition: str, suite: str, task: tuple) -> list[bool]:
+    return [
+        bool(e["success"])
+        for r in run.data["results"]
+        if r["condition"] == condition and r["suite"] == suite
+        for e in r["per_episode"]
+        if episode_task(e) == task
+    ]
+
+
+def per_task_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
+    """TSR (%) per condition (rows) and task (columns: suite: task name), with interval records."""
+    columns = task_columns(runs)
+    groups = [(run.label if len(runs) > 1 else "", sum(1 for c in columns if c[0] is run)) for run in runs]
+    rows, records = [], []
+    for condition in ordered_conditions(runs):
+        cells = []
+        for run, suite, task in columns:
+            outcomes = task_episodes(run, condition, suite, task)
+            if not outcomes:
+                cells.append("-")
+                continue
+            successes, n = sum(outcomes), len(outcomes)
+            low, high = wilson_interval(successes, n)
+            cells.append(percent(successes / n))
+            records.append(
+                {
+                    "label": run.label,
+                    "suite": suite,
+                    "task_index": task[0],
+                    "task": task[1],
+                    "condition": condition,
+                    "successes": successes,
+                    "episodes": n,
+                    "tsr": successes / n,
+                    "ci95_low": low,
+                    "ci95_high": high,
+                }
+            )
+        rows.append((condition, cells))
+    note = "Cells: TSR in % per task (the goal each episode's env drew), over that task's episodes."
+    table = Table(
+        groups=groups, columns=[f"{suite}: {task[1]}" for _, suite, task in columns], rows=rows, notes=(note,)
+    )
+    return table, records
 
 
 def results_rows(runs: list[EvalRun]) -> list[dict[str, Any]]:
@@ -327,7 +439,7 @@ def before_after(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dict
     )
     groups, columns, rows, records = [], [], [], []
     for b, a in pairs:
-        groups.append((a.label if len(pairs) > 1 else "", len(b.suites)))
+        groups.append((f"{a.label} vs {b.label}" if len(pairs) > 1 else "", len(b.suites)))
         columns += b.suites
     for condition in conditions:
         cells = []
@@ -358,7 +470,8 @@ def before_after(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dict
                     }
                 )
         rows.append((condition, cells))
-    return Table(groups=groups, columns=columns, rows=rows), records
+    compared = "; ".join(f"before = {b.label}, after = {a.label}" for b, a in pairs)
+    return Table(groups=groups, columns=columns, rows=rows, notes=(BEFORE_AFTER_NOTE, compared)), records
 
 
 def offline_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
@@ -382,7 +495,72 @@ def offline_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
         (c, [f"{value[(run.label, c)]:.3f}" if (run.label, c) in value else "-" for run in runs])
         for c in conditions
     ]
-    return Table(groups=[("", len(runs))], columns=[run.label for run in runs], rows=rows), records
+    note = (
+        "Cells: mean action deviation attacked vs clean on recorded frames (RMS z-score, action std units)."
+    )
+    table = Table(
+        groups=[("", len(runs))],
+        columns=[run.label for run in runs],
+        rows=rows,
+        notes=(note,),
+        unit="RMS z-score",
+    )
+    return table, records
+
+
+def with_ties(rows: list[dict[str, Any]], value, top: int) -> list[dict[str, Any]]:
+    """The rows whose ``value`` is among the ``top`` most extreme distinct values (rows pre-sorted, most extreme
+    first): every row tied at a listed value is listed, so no tied condition is silently dropped."""
+    kept = list(dict.fromkeys(round(value(r), 12) for r in rows))[:top]
+    return [r for r in rows if round(value(r), 12) in kept]
+
+
+def drop_lines(results: list[dict[str, Any]], top: int) -> list[str]:
+    drops = [r for r in results if r["delta_vs_clean"] is not None and r["delta_vs_clean"] < 0]
+    if not drops:
+        return []
+    drops.sort(key=lambda r: (r["delta_vs_clean"], r["label"], r["suite"]))
+    lines = [
+        "Largest drops under attack, in percentage points (pp) of TSR against the clean control on the same "
+        "seeds (exact McNemar p):",
+        "",
+    ]
+    for r in with_ties(drops, lambda r: r["delta_vs_clean"], top):
+        lines.append(
+            f"- {r['label']} / {r['suite']}: {condition_label(r['condition'])} "
+            f"{100 * r['delta_vs_clean']:+.1f} pp (TSR {percent(r['tsr'])}%, p = {r['p_vs_clean']:.3g})"
+        )
+    return [*lines, ""]
+
+
+def change_lines(changes: list[dict[str, Any]], top: int) -> list[str]:
+    lines = []
+    for title, sign in (("Largest gains after training", 1), ("Largest losses after training", -1)):
+        chosen = sorted((r for r in changes if sign * r["delta"] > 0), key=lambda r: -sign * r["delta"])
+        lines += [f"{title} (paired change in pp, exact McNemar on matched episodes):", ""]
+        if not chosen:
+            lines.append("- none")
+        for r in with_ties(chosen, lambda r: r["delta"], top):
+            lines.append(
+                f"- {r['after']} vs {r['before']} / {r['suite']}: {condition_label(r['condition'])} "
+                f"{percent(r['tsr_before'])}% -> {percent(r['tsr_after'])}% "
+                f"({100 * r['delta']:+.1f} pp, p = {r['p_value']:.3g})"
+            )
+        lines.append("")
+    return lines
+
+
+def deviation_lines(deviations: list[dict[str, Any]], top: int) -> list[str]:
+    if not deviations:
+        return []
+    lines = ["Largest action deviations on recorded frames (offline, std-normalised):", ""]
+    chosen = sorted(deviations, key=lambda r: -r["mean_normalized"])
+    for r in with_ties(chosen, lambda r: r["mean_normalized"], top):
+        lines.append(
+            f"- {r['label']}: {condition_label(r['condition'])} {r['mean_normalized']:.3f} "
+            f"(mean L2 {r['mean_l2']:.3g} over {r['frames']} frames)"
+        )
+    return [*lines, ""]
 
 
 def summary_text(
@@ -391,46 +569,12 @@ def summary_text(
     deviations: list[dict[str, Any]] = (),
     top: int = 3,
 ) -> str:
-    lines = ["# Summary", ""]
-    drops = [r for r in results if r["delta_vs_clean"] is not None]
-    if drops:
-        lines.append("Largest drops under attack (paired with the clean control on the same seeds):")
-        lines.append("")
-        for r in sorted(drops, key=lambda r: (r["delta_vs_clean"], r["label"], r["suite"]))[:top]:
-            lines.append(
-                f"- {r['label']} / {r['suite']}: {condition_label(r['condition'])} "
-                f"{100 * r['delta_vs_clean']:+.1f} pp (TSR {percent(r['tsr'])}%, p = {r['p_vs_clean']:.3g})"
-            )
-        lines.append("")
-    if changes:
-        for title, chosen in (
-            ("Largest gains after training", sorted(changes, key=lambda r: -r["delta"])[:top]),
-            ("Largest losses after training", sorted(changes, key=lambda r: r["delta"])[:top]),
-        ):
-            chosen = [r for r in chosen if (r["delta"] > 0 if "gains" in title else r["delta"] < 0)]
-            lines.append(f"{title} (exact McNemar on matched episodes):")
-            lines.append("")
-            if not chosen:
-                lines.append("- none")
-            for r in chosen:
-                lines.append(
-                    f"- {r['after']} / {r['suite']}: {condition_label(r['condition'])} "
-                    f"{percent(r['tsr_before'])}% -> {percent(r['tsr_after'])}% "
-                    f"({100 * r['delta']:+.1f} pp, p = {r['p_value']:.3g})"
-                )
-            lines.append("")
-    if deviations:
-        lines.append("Largest action deviations on recorded frames (offline, std-normalised):")
-        lines.append("")
-        for r in sorted(deviations, key=lambda r: -r["mean_normalized"])[:top]:
-            lines.append(
-                f"- {r['label']}: {condition_label(r['condition'])} {r['mean_normalized']:.3f} "
-                f"(mean L2 {r['mean_l2']:.3g} over {r['frames']} frames)"
-            )
-        lines.append("")
-    if len(lines) == 2:
-        lines.append("No attacked conditions to summarise.")
-    return "\n".join(lines).rstrip() + "\n"
+    """The ``top`` largest drops, gains, losses and deviations (with every condition tied at those values)."""
+    body = drop_lines(results, top) + (change_lines(changes, top) if changes else [])
+    body += deviation_lines(list(deviations), top)
+    if not body:
+        body = ["No attacked conditions to summarise."]
+    return "\n".join(["# Summary", "", *body]).rstrip() + "\n"
 
 
 def write_records(path: Path, records: list[dict[str, Any]]) -> None:
@@ -445,52 +589,86 @@ def write_records(path: Path, records: list[dict[str, Any]]) -> None:
 # ----------------------------------------------------------------------------------------------------------------
 # figures
 # ----------------------------------------------------------------------------------------------------------------
-def plot_tsr_vs_intensity(runs: list[EvalRun], path: Path) -> None:
+def attack_levels(run: EvalRun, attack: str) -> list[tuple[float, str]]:
+    """(x position, condition) of one attack's curve: clean at 0, then each level at its intensity midpoint; an
+    all-or-nothing (voice) condition sits at 1 ("on")."""
+    attacked = [c for c in run.conditions if c == attack or c.startswith(f"{attack}@")]
+    points = [(0.0, CLEAN)] + [(condition_sort_key(c)[1], c) for c in attacked]
+    return sorted(points)
+
+
+def plot_attack_panel(ax, runs: list[EvalRun], attack: str) -> None:
+    for run in runs:
+        for suite in run.suites:
+            xs, ys, lows, highs = [], [], [], []
+            for x, condition in attack_levels(run, attack):
+                counts = pooled(run, condition, suite)
+                if counts is None:
+                    continue
+                low, high = wilson_interval(*counts)
+                xs.append(x)
+                ys.append(100 * counts[0] / counts[1])
+                lows.append(100 * low)
+                highs.append(100 * high)
+            name = f"{run.label} {suite}".strip() if len(runs) > 1 else suite
+            (line,) = ax.plot(xs, ys, marker="o", label=name)
+            ax.fill_between(xs, lows, highs, color=line.get_color(), alpha=0.2)
+    ax.set_title(attack_title(attack), fontsize=9)
+    if attack in CAMERA_ATTACKS:
+        ax.set_xticks([0.0, *LEVELS.values()], ["clean", *LEVELS])
+    else:
+        ax.set_xticks([0.0, 1.0], ["clean", "attack on"])
+    ax.set_ylim(-2, 102)
+    ax.grid(alpha=0.3)
+
+
+def tsr_figure(runs: list[EvalRun]):
+    """One panel per attack (camera attacks against intensity, voice attacks clean vs on), Wilson bands; None
+    when no attack was evaluated."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import Patch
 
-    attacks = [a for a in ATTACK_NAMES if any(c.startswith(f"{a}@") for run in runs for c in run.conditions)]
+    attacks = [
+        a
+        for a in ATTACK_NAMES
+        if any(c == a or c.startswith(f"{a}@") for run in runs for c in run.conditions)
+    ]
     if not attacks:
-        return
+        return None
     cols = min(3, len(attacks))
     rows = (len(attacks) + cols - 1) // cols
-    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3 * rows), squeeze=False, sharey=True)
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3 * rows + 0.6), squeeze=False, sharey=True)
     for ax, attack in zip(axes.flat, attacks, strict=False):
-        for run in runs:
-            for suite in run.suites:
-                attacked = sorted(
-                    (c for c in run.conditions if c.startswith(f"{attack}@")), key=condition_sort_key
-                )
-                levels = [CLEAN, *attacked]
-                xs, ys, lows, highs = [], [], [], []
-                for condition in levels:
-                    counts = pooled(run, condition, suite)
-                    if counts is None:
-                        continue
-                    low, high = wilson_interval(*counts)
-                    xs.append(0.0 if condition == CLEAN else condition_sort_key(condition)[1])
-                    ys.append(100 * counts[0] / counts[1])
-                    lows.append(100 * low)
-                    highs.append(100 * high)
-                name = f"{run.label} {suite}".strip() if len(runs) > 1 else suite
-                (line,) = ax.plot(xs, ys, marker="o", label=name)
-                ax.fill_between(xs, lows, highs, color=line.get_color(), alpha=0.2)
-        ax.set_title(ABBREVIATIONS.get(attack, attack))
-        ax.set_xticks([0.0, *LEVELS.values()], ["clean", *LEVELS])
-        ax.set_ylim(-2, 102)
-        ax.grid(alpha=0.3)
+        plot_attack_panel(ax, runs, attack)
     for ax in list(axes.flat)[len(attacks) :]:
         ax.axis("off")
-    axes[0][0].set_ylabel("TSR (%)")
-    axes[0][0].legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    for row in axes:
+        row[0].set_ylabel("TSR (%)")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    handles.append(Patch(color="grey", alpha=0.3))
+    labels.append(f"shaded: {INTERVAL}")
+    # Below the panels, so that it hides no curve.
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=min(4, len(labels)))
+    fig.suptitle(f"Task success rate (TSR, %) under each attack; shaded bands: {INTERVAL}", fontsize=10)
+    legend_rows = (len(labels) + 3) // 4
+    fig.tight_layout(rect=(0, 0.05 * legend_rows + 0.02, 1, 1))
+    return fig
 
 
-def plot_before_after(records: list[dict[str, Any]], path: Path) -> None:
+def plot_tsr_vs_intensity(runs: list[EvalRun], path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig = tsr_figure(runs)
+    if fig is not None:
+        fig.savefig(path, dpi=120)
+        plt.close(fig)
+
+
+def before_after_figure(records: list[dict[str, Any]]):
+    """Heatmap of the paired TSR changes (pp) per condition and comparison, '*' where p < 0.05."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -498,21 +676,36 @@ def plot_before_after(records: list[dict[str, Any]], path: Path) -> None:
     import numpy as np
 
     conditions = sorted({r["condition"] for r in records}, key=condition_sort_key)
-    columns = list(dict.fromkeys((r["after"], r["suite"]) for r in records))
+    columns = list(dict.fromkeys((r["after"], r["before"], r["suite"]) for r in records))
     grid = np.full((len(conditions), len(columns)), np.nan)
+    significant = np.zeros_like(grid, dtype=bool)
     for r in records:
-        grid[conditions.index(r["condition"]), columns.index((r["after"], r["suite"]))] = 100 * r["delta"]
+        i, j = conditions.index(r["condition"]), columns.index((r["after"], r["before"], r["suite"]))
+        grid[i, j] = 100 * r["delta"]
+        significant[i, j] = r["p_value"] < SIGNIFICANCE
     limit = max(1.0, float(np.nanmax(np.abs(grid))))
-    fig, ax = plt.subplots(figsize=(1.2 * len(columns) + 2.5, 0.4 * len(conditions) + 1.5))
+    fig, ax = plt.subplots(figsize=(1.6 * len(columns) + 3.5, 0.4 * len(conditions) + 2.0))
     image = ax.imshow(grid, cmap="RdBu", vmin=-limit, vmax=limit, aspect="auto")
     for (i, j), value in np.ndenumerate(grid):
         if not np.isnan(value):
             colour = "white" if abs(value) > 0.6 * limit else "black"  # readable on the saturated ends
-            ax.text(j, i, f"{value:+.0f}", ha="center", va="center", fontsize=7, color=colour)
-    ax.set_yticks(range(len(conditions)), [condition_label(c) for c in conditions])
-    ax.set_xticks(range(len(columns)), [f"{a}\n{s}" for a, s in columns], fontsize=8)
-    fig.colorbar(image, ax=ax, label="TSR change after - before (pp)")
+            mark = "*" if significant[i, j] else ""
+            ax.text(j, i, f"{value:+.0f}{mark}", ha="center", va="center", fontsize=7, color=colour)
+    ax.set_yticks(range(len(conditions)), [condition_label(c) for c in conditions], fontsize=7)
+    ax.set_xticks(range(len(columns)), [f"{a} vs {b}\n{s}" for a, b, s in columns], fontsize=8)
+    ax.set_title(
+        f"Paired TSR change after - before (pp); * p < {SIGNIFICANCE}, exact McNemar on matched seeds",
+        fontsize=9,
+    )
+    fig.colorbar(image, ax=ax, label="TSR change after - before (percentage points)")
     fig.tight_layout()
+    return fig
+
+
+def plot_before_after(records: list[dict[str, Any]], path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    fig = before_after_figure(records)
     fig.savefig(path, dpi=120)
     plt.close(fig)
 
@@ -520,17 +713,10 @@ def plot_before_after(records: list[dict[str, Any]], path: Path) -> None:
 # ----------------------------------------------------------------------------------------------------------------
 # entry points
 # ----------------------------------------------------------------------------------------------------------------
-def make_report(
-    paths: list[str | Path],
-    out_dir: str | Path,
-    *,
-    labels: list[str] | None = None,
-    before: list[str | Path] | None = None,
-    after: list[str | Path] | None = None,
-    figures: bool = True,
-) -> dict[str, Path]:
-    """Write every table, figure and the summary to ``out_dir``; returns {artefact name: path}."""
-    before, after = list(before or []), list(after or [])
+def load_inputs(
+    paths: list, labels: list[str] | None, before: list, after: list
+) -> tuple[list[EvalRun], list[EvalRun], list[tuple[EvalRun, EvalRun]]]:
+    """(rollout runs merged by label, offline runs, before/after pairs) with every input checked."""
     if not paths and not before:
         raise ValueError("nothing to report: give --inputs and/or --before/--after eval.json files")
     if labels is not None and len(labels) != len(paths):
@@ -554,47 +740,75 @@ def make_report(
         run_a.label = label_of.get(run_a.path.resolve(), run_a.label)
         pairs.append((run_b, run_a))
 
+    return runs, offline, pairs
+
+
+def make_report(
+    paths: list[str | Path],
+    out_dir: str | Path,
+    *,
+    labels: list[str] | None = None,
+    before: list[str | Path] | None = None,
+    after: list[str | Path] | None = None,
+    figures: bool = True,
+) -> dict[str, Path]:
+    """Write every table, figure and the summary to ``out_dir``; returns {artefact name: path}."""
+    runs, offline, pairs = load_inputs(paths, labels, list(before or []), list(after or []))
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    written: dict[str, Path] = {}
-
-    def write(name: str, text: str) -> None:
-        (out / name).write_text(text)
-        written[name] = out / name
-
+    writer = ReportWriter(out)
     results: list[dict[str, Any]] = []
     if runs:
-        table = robustness_table(runs)
-        write("robustness.md", table.markdown())
-        write("robustness.csv", table.csv())
-        write("robustness.tex", table.latex())
+        writer.table("robustness", robustness_table(runs))
         results = results_rows(runs)
-        write_records(out / "results.csv", results)
-        written["results.csv"] = out / "results.csv"
+        writer.records("results.csv", results)
+        if any(len({c[2] for c in task_columns([run])}) > 1 for run in runs):
+            table, per_task = per_task_table(runs)
+            writer.table("per_task", table)
+            writer.records("per_task_results.csv", per_task)
         if figures:
-            plot_tsr_vs_intensity(runs, out / "tsr_vs_intensity.png")
-            written["tsr_vs_intensity.png"] = out / "tsr_vs_intensity.png"
+            writer.figure("tsr_vs_intensity.png", plot_tsr_vs_intensity, runs)
     changes: list[dict[str, Any]] = []
     if pairs:
         table, changes = before_after(pairs)
-        write("before_after.md", table.markdown())
-        write("before_after.csv", table.csv())
-        write("before_after.tex", table.latex())
-        write_records(out / "before_after_tests.csv", changes)
-        written["before_after_tests.csv"] = out / "before_after_tests.csv"
+        writer.table("before_after", table)
+        writer.records("before_after_tests.csv", changes)
         if figures:
-            plot_before_after(changes, out / "before_after_heatmap.png")
-            written["before_after_heatmap.png"] = out / "before_after_heatmap.png"
+            writer.figure("before_after_heatmap.png", plot_before_after, changes)
     deviations: list[dict[str, Any]] = []
     if offline:
         table, deviations = offline_table(offline)
-        write("offline.md", table.markdown())
-        write("offline.csv", table.csv())
-        write("offline.tex", table.latex())
-        write_records(out / "offline_results.csv", deviations)
-        written["offline_results.csv"] = out / "offline_results.csv"
-    write("summary.md", summary_text(results, changes, deviations))
-    return written
+        writer.table("offline", table)
+        writer.records("offline_results.csv", deviations)
+    writer.text("summary.md", summary_text(results, changes, deviations))
+    return writer.written
+
+
+@dataclass
+class ReportWriter:
+    """Writes the report's files into ``out`` and remembers them ({name: path})."""
+
+    out: Path
+    written: dict[str, Path] = field(default_factory=dict)
+
+    def text(self, name: str, text: str) -> None:
+        (self.out / name).write_text(text)
+        self.written[name] = self.out / name
+
+    def table(self, stem: str, table: Table) -> None:
+        """``<stem>.md``, ``<stem>.csv`` and ``<stem>.tex`` of one table."""
+        for suffix, text in (("md", table.markdown()), ("csv", table.csv()), ("tex", table.latex())):
+            self.text(f"{stem}.{suffix}", text)
+
+    def records(self, name: str, records: list[dict[str, Any]]) -> None:
+        if records:
+            write_records(self.out / name, records)
+            self.written[name] = self.out / name
+
+    def figure(self, name: str, plot, data) -> None:
+        plot(data, self.out / name)
+        if (self.out / name).is_file():
+            self.written[name] = self.out / name
 
 
 def report_cli(cfg: ReportConfig) -> dict[str, Path]:

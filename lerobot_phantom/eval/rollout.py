@@ -274,6 +274,45 @@ class AttackStep(ProcessorStep):
         return features  # attacks change pixel values and strings, never shapes or keys
 
 
+class EpisodeTasks(ProcessorStep):
+    """Records which task each env of a batch runs, from the first observation of the batch (before any attack).
+
+    Suites such as phantom_table draw their task per episode from the reset seed, and a vector env auto-resets
+    finished envs to new tasks, so the task must be read at the first step. ``instruction`` is the language string
+    the policy is given (LeRobot's ``task`` feature); ``task_index``/``task`` are the env's own ``task_id``/``task``
+    attributes when it exposes them (None otherwise).
+    """
+
+    def __init__(self, env) -> None:
+        self.env = env
+        self.tasks: list[dict[str, Any]] = []
+
+    def arm(self) -> None:
+        self.tasks = []
+
+    def _env_attribute(self, name: str) -> list[Any] | None:
+        envs = getattr(self.env, "envs", None)
+        if not envs or not envs[0].has_wrapper_attr(name):
+            return None
+        return list(self.env.call(name))
+
+    def __call__(self, transition: dict) -> dict:
+        if not self.tasks:
+            instructions = list((transition.get(TransitionKey.COMPLEMENTARY_DATA) or {}).get("task") or [])
+            count = self.env.num_envs
+            indices = self._env_attribute("task_id") or [None] * count
+            names = self._env_attribute("task") or [None] * count
+            instructions = instructions or [None] * count
+            self.tasks = [
+                {"task_index": None if i is None else int(i), "task": n, "instruction": t}
+                for i, n, t in zip(indices, names, instructions, strict=True)
+            ]
+        return transition
+
+    def transform_features(self, features: dict) -> dict:
+        return features
+
+
 def episode_outcomes(rollout_data: dict[str, torch.Tensor]) -> list[dict[str, Any]]:
     """Per-env success, rewards and length of one LeRobot rollout, masked after each env's first done exactly as
     ``lerobot-eval``'s ``eval_policy`` does (the done step and the one after it still count)."""

@@ -1,15 +1,15 @@
-"""Honest uncertainty for success counts: Wilson score intervals and exact paired tests on matched seeds.
+"""Honest uncertainty for success counts: Wilson score intervals and the exact McNemar test on matched seeds.
 
-Pure Python (``math``/``statistics``): these are a few lines each and run inside report loops, so they do not pull
-in scipy; the tests check them against scipy's independent implementations.
+Both are scipy's (``scipy.stats.binomtest``); this module adds the argument checks with clear messages and the
+paired bookkeeping (which episodes gained or lost success).
 """
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterable
 from dataclasses import dataclass
-from statistics import NormalDist
+
+from scipy.stats import binomtest
 
 
 def wilson_interval(successes: int, episodes: int, confidence: float = 0.95) -> tuple[float, float]:
@@ -24,26 +24,10 @@ def wilson_interval(successes: int, episodes: int, confidence: float = 0.95) -> 
         raise ValueError(f"successes must lie in [0, episodes={episodes}], got {successes}")
     if not 0.0 < confidence < 1.0:
         raise ValueError(f"confidence must lie in (0, 1), got {confidence}")
-    z = NormalDist().inv_cdf(0.5 + confidence / 2.0)
-    p = successes / episodes
-    denom = 1.0 + z * z / episodes
-    centre = (p + z * z / (2.0 * episodes)) / denom
-    half = z * math.sqrt(p * (1.0 - p) / episodes + z * z / (4.0 * episodes * episodes)) / denom
-    # Clamp rounding noise only; the exact interval touches 0 or 1 when successes is 0 or n.
-    low = 0.0 if successes == 0 else max(0.0, centre - half)
-    high = 1.0 if successes == episodes else min(1.0, centre + half)
-    return low, high
-
-
-def binomial_two_sided_p(k: int, n: int) -> float:
-    """Exact two-sided p-value of ``k`` successes in ``n`` fair coin flips (the sign test)."""
-    if n < 0 or not 0 <= k <= n:
-        raise ValueError(f"need 0 <= k <= n, got k={k}, n={n}")
-    if n == 0:
-        return 1.0
-    tail = min(k, n - k)
-    p = 2.0 * sum(math.comb(n, i) for i in range(tail + 1)) / 2.0**n
-    return min(1.0, p)
+    interval = binomtest(int(successes), int(episodes)).proportion_ci(
+        confidence_level=confidence, method="wilson"
+    )
+    return float(interval.low), float(interval.high)
 
 
 @dataclass(frozen=True)
@@ -63,7 +47,8 @@ class PairedTest:
 
 
 def mcnemar_exact(before: Iterable[bool], after: Iterable[bool]) -> PairedTest:
-    """Exact McNemar (= sign test on discordant pairs) for two success sequences over the same episodes."""
+    """Exact McNemar test for two success sequences over the same episodes: the two-sided exact binomial test of
+    ``gained`` out of the ``gained + lost`` discordant pairs against 1/2 (p = 1 with no discordant pair)."""
     before, after = [bool(b) for b in before], [bool(a) for a in after]
     if len(before) != len(after):
         raise ValueError(
@@ -72,10 +57,6 @@ def mcnemar_exact(before: Iterable[bool], after: Iterable[bool]) -> PairedTest:
     gained = sum(1 for b, a in zip(before, after, strict=True) if a and not b)
     lost = sum(1 for b, a in zip(before, after, strict=True) if b and not a)
     both = sum(1 for b, a in zip(before, after, strict=True) if a and b)
-    return PairedTest(
-        pairs=len(before),
-        both=both,
-        gained=gained,
-        lost=lost,
-        p_value=binomial_two_sided_p(gained, gained + lost),
-    )
+    discordant = gained + lost
+    p_value = 1.0 if discordant == 0 else float(binomtest(gained, discordant, 0.5).pvalue)
+    return PairedTest(pairs=len(before), both=both, gained=gained, lost=lost, p_value=p_value)

@@ -21,6 +21,7 @@ recipe: train clean, then ``--policy.path=<clean>/checkpoints/last/pretrained_mo
 
 # No `from __future__ import annotations`: LeRobot's parser.wrap reads the config class from the annotation.
 import logging
+import os
 import sys
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -211,11 +212,31 @@ def _run_from_cli(cfg: PhantomTrainPipelineConfig) -> None:
     train_phantom(cfg)
 
 
+# At most this many cores: one torch thread per process (see default_torch_threads).
+FEW_CORES = 2
+
+
+def default_torch_threads() -> int | None:
+    """One torch thread on a machine with at most ``FEW_CORES`` cores, unless ``OMP_NUM_THREADS`` says otherwise.
+
+    On two shared cores torch's default (one thread per core) made a SmolVLA update about four times slower than one
+    thread whenever anything else ran (issue 11; ``scripts/bench_train.py --threads``). Returns the count set, or
+    None when torch's own default is kept.
+    """
+    if "OMP_NUM_THREADS" in os.environ or (os.cpu_count() or 1) > FEW_CORES:
+        return None
+    import torch
+
+    torch.set_num_threads(1)
+    return 1
+
+
 def main(args: Sequence[str] | None = None) -> None:
     """``lerobot-phantom-train [lerobot-train flags] [--phantom.* flags]``; ``args`` defaults to ``sys.argv[1:]``."""
     from lerobot_phantom import register
 
     register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
+    default_torch_threads()
     compat.register_lerobot_plugins()
     # Importing LeRobot's training script registers every policy/env/optimizer config type for draccus.
     compat.train_script_module()

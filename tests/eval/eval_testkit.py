@@ -23,7 +23,11 @@ GYM_ID = "eval_testkit/DotReach-v0"
 MAX_STEPS = 20
 STEP_LIMIT = 0.2
 SUCCESS_RADIUS = 0.06
-TASK = "move to the red dot"
+# Two tasks with the same goal, drawn per episode at reset (as phantom_table's suites do): the per-task rows of
+# eval.json have something to separate.
+TASK_NAMES = ("move", "reach")
+INSTRUCTIONS = ("move to the red dot", "reach the red dot")
+TASK = INSTRUCTIONS[0]
 
 
 class DotReachEnv(gym.Env):
@@ -43,8 +47,9 @@ class DotReachEnv(gym.Env):
             }
         )
         self.action_space = spaces.Box(-STEP_LIMIT, STEP_LIMIT, (2,), np.float32)
-        self.task = TASK
-        self.task_description = TASK
+        self.task_id = 0
+        self.task = TASK_NAMES[0]
+        self.task_description = INSTRUCTIONS[0]
         self.agent = np.full(2, 0.5, np.float32)
         self.target = np.full(2, 0.5, np.float32)
         self.steps = 0
@@ -78,6 +83,8 @@ class DotReachEnv(gym.Env):
             self.target = self.np_random.uniform(0.1, 0.9, 2).astype(np.float32)
             if np.linalg.norm(self.target - self.agent) > 0.25:
                 break
+        self.task_id = int(self.np_random.integers(len(TASK_NAMES)))
+        self.task, self.task_description = TASK_NAMES[self.task_id], INSTRUCTIONS[self.task_id]
         return self._obs(), {"is_success": False}
 
     def step(self, action):

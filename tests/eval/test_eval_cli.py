@@ -79,7 +79,11 @@ def test_eval_cli_with_checkpoint_then_report(checkpoint, tmp_path, monkeypatch)
     report_module.main()
     table = (tmp_path / "report" / "robustness.md").read_text().splitlines()
     assert table[0] == "| Attack | goal |"
-    assert [line.split(" | ")[0] for line in table[2:]] == ["| Clean", "| LB strong", "| VD"]
+    assert [line.split(" | ")[0] for line in table[2:5]] == [
+        "| Clean",
+        "| Laser blinding (LB), strong",
+        "| Voice DoS (VD)",
+    ]
 
 
 @pytest.mark.slow  # collects an expert episode in MuJoCo, then runs ACT on its frames

@@ -8,6 +8,7 @@ from lerobot.envs.factory import make_env
 
 from lerobot_phantom import _lerobot_compat as compat
 from lerobot_phantom.envs.lerobot_config import PhantomTableEnvConfig
+from lerobot_phantom.envs.suites import get_task
 from lerobot_phantom.eval.config import EvalPhantomConfig, PhantomEvalConfig
 from lerobot_phantom.eval.eval import evaluate
 
@@ -40,3 +41,14 @@ def test_scripted_expert_is_perfect_and_untouched_by_camera_attacks(tmp_path):
     assert (blinded["front"] - clean["front"]).abs().mean() > 0.1
     assert torch.equal(blinded["wrist"], clean["wrist"])
     assert torch.equal(muted["front"], clean["front"])
+    # Each episode names the goal the env drew for it (suite task index, name and instruction), whatever the attack.
+    for row in report["results"]:
+        for episode in row["per_episode"]:
+            task = get_task("goal", episode["task_index"])
+            assert (episode["task"], episode["instruction"]) == (task["name"], task["language"])
+        assert [e["task_index"] for e in row["per_episode"]] == [
+            e["task_index"] for e in report["results"][0]["per_episode"]
+        ]
+    assert {r["task"] for r in report["summary_per_task"]} == {
+        e["task"] for e in report["results"][0]["per_episode"]
+    }

@@ -1,6 +1,7 @@
 """Rollouts under attack on a tiny LeRobot env (tests/eval/eval_testkit.py) with real LeRobot test policies."""
 
 import json
+import random
 
 import eval_testkit as kit
 import pytest
@@ -164,3 +165,71 @@ def test_camera_selection(tmp_path):
     # Exactly the episodes whose front camera was picked are lost.
     (row,) = [r for r in one["results"] if r["condition"] == "laser_blinding@strong"]
     assert [not e["success"] for e in row["per_episode"]] == [p == ["front"] for p in picks]
+
+
+def test_each_episode_records_its_task_before_any_instruction_attack(tmp_path):
+    cfg = make_cfg(tmp_path, n_episodes=8, attacks=["voice_dos"], intensities=["strong"])
+    report = evaluate(cfg, policy=kit.make_toy_policy("instructed"))
+    clean, muted = report["results"]
+    tasks = [(e["task_index"], e["task"], e["instruction"]) for e in clean["per_episode"]]
+    # The same seeds draw the same tasks in every condition, and the recorded instruction is the env's, not the
+    # attacked (emptied) one the policy saw.
+    assert tasks == [(e["task_index"], e["task"], e["instruction"]) for e in muted["per_episode"]]
+    assert {t for t in tasks} <= {(i, kit.TASK_NAMES[i], kit.INSTRUCTIONS[i]) for i in range(2)}
+    assert len({t[0] for t in tasks}) == 2, "8 seeds should draw both tasks"
+    per_task = report["summary_per_task"]
+    assert {(r["condition"], r["task"]) for r in per_task} == {
+        (c, name) for c in ("clean", "voice_dos") for name in {t[1] for t in tasks}
+    }
+    for row in per_task:
+        expected = [
+            e for r in report["results"] if r["condition"] == row["condition"] for e in r["per_episode"]
+        ]
+        expected = [e for e in expected if e["task"] == row["task"]]
+        assert row["episodes"] == len(expected)
+        assert row["successes"] == sum(e["success"] for e in expected)
+        assert row["instruction"] == kit.INSTRUCTIONS[row["task_index"]]
+    # Per task, the pooled counts add up.
+    for summary in report["summary"]:
+        rows = [r for r in per_task if r["condition"] == summary["condition"]]
+        assert sum(r["episodes"] for r in rows) == summary["episodes"]
+        assert sum(r["successes"] for r in rows) == summary["successes"]
+
+
+def test_format_summary_has_a_column_per_task(tmp_path):
+    from lerobot_phantom.eval.eval import format_summary
+
+    report = evaluate(make_cfg(tmp_path, n_episodes=8, attacks=[]), policy=kit.make_toy_policy("oracle"))
+    text = format_summary(report)
+    assert "95% Wilson CI" in text
+    legend = {line.strip() for line in text.splitlines() if line.strip().startswith(("T0:", "T1:"))}
+    assert {entry.split(" / ")[1] for entry in legend} == set(kit.TASK_NAMES)
+    (clean_line,) = [line for line in text.splitlines()[-1:] if line.startswith("clean")]
+    assert clean_line.split()[1:] == ["100.0", "100.0"]  # the oracle solves both tasks
+
+
+def test_resume_keeps_finished_conditions_and_runs_the_rest(tmp_path):
+    full = evaluate(
+        make_cfg(tmp_path / "full", attacks=["laser_blinding", "em_truncation"], intensities=["strong"]),
+        policy=kit.make_toy_policy("colour"),
+    )
+    # An interrupted run: only the clean control and the first attack were written.
+    cfg = make_cfg(tmp_path / "resumed", attacks=["laser_blinding", "em_truncation"], intensities=["strong"])
+    partial = json.loads(json.dumps(full))
+    partial["results"] = partial["results"][:2]
+    partial["metadata"]["complete"] = False
+    marker = random.Random(0).random()
+    partial["results"][1]["marker"] = marker  # a kept row is copied, not recomputed
+    cfg.output_dir.mkdir(parents=True)
+    (cfg.output_dir / EVAL_FILENAME).write_text(json.dumps(partial))
+    cfg.resume = True
+    resumed = evaluate(cfg, policy=kit.make_toy_policy("colour"))
+    assert resumed["metadata"]["complete"] is True
+    assert resumed["results"][1]["marker"] == marker
+    assert [r["condition"] for r in resumed["results"]] == [r["condition"] for r in full["results"]]
+    assert resumed["results"][2]["per_episode"] == full["results"][2]["per_episode"]
+    # Other settings: refused, naming what differs.
+    other = make_cfg(tmp_path / "resumed", n_episodes=4, attacks=["laser_blinding"], intensities=["strong"])
+    other.resume = True
+    with pytest.raises(ValueError, match="n_episodes"):
+        evaluate(other, policy=kit.make_toy_policy("colour"))

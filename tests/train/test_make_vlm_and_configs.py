@@ -51,6 +51,8 @@ def test_tiny_config_is_an_offline_cpu_smolvla():
     cfg = parse_config("tiny_smolvla_cpu")
     assert cfg.policy.type == "smolvla" and cfg.policy.device == "cpu"
     assert cfg.policy.load_vlm_weights is False and cfg.peft is None
+    # LeRobot's defaults would freeze the weight-free VLM at its random initialisation (issue 11: 3% vs 34% TSR).
+    assert cfg.policy.freeze_vision_encoder is False and cfg.policy.train_expert_only is False
     assert list(cfg.policy.resize_imgs_with_padding) == [VLM_SIZES["tiny"]["image_size"]] * 2
     assert cfg.phantom.rate == pytest.approx(0.3) and cfg.phantom.where == "dataloader"
 

@@ -211,3 +211,22 @@ def test_two_processes_share_one_epoch_plan(tmp_path, tiny_dataset_root, tiny_vl
     (record,) = loss_log(out)
     assert record["seen"]["total"] == FRAMES  # 6 steps x batch 2 x 2 processes
     assert record["seen"]["attacked"] == round(0.3 * FRAMES)
+
+
+def test_one_torch_thread_on_two_cores_unless_omp_num_threads_is_set(monkeypatch):
+    import torch
+
+    from lerobot_phantom.train import train as train_module
+
+    before = torch.get_num_threads()
+    try:
+        monkeypatch.setenv("OMP_NUM_THREADS", "2")
+        assert train_module.default_torch_threads() is None
+        monkeypatch.delenv("OMP_NUM_THREADS")
+        monkeypatch.setattr(train_module.os, "cpu_count", lambda: 16)
+        assert train_module.default_torch_threads() is None
+        monkeypatch.setattr(train_module.os, "cpu_count", lambda: 2)
+        assert train_module.default_torch_threads() == 1
+        assert torch.get_num_threads() == 1
+    finally:
+        torch.set_num_threads(before)

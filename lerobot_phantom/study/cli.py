@@ -1,0 +1,286 @@
+"""``lerobot-phantom-study``: run (or continue) the whole study in one directory.
+
+    lerobot-phantom-study --output_dir=docs/study --collect.episodes=100 --lora.steps=1000 --sweep.n_episodes=50
+
+Each stage runs an existing CLI (as a subprocess with one torch thread unless ``--threads``), its output streamed
+to ``logs/<stage>.log``. ``study.json`` records, per stage, the command, its fingerprint, status and wall time; a
+second invocation skips finished stages whose fingerprint is unchanged, continues an interrupted training run
+with LeRobot's ``--resume`` and an interrupted sweep condition by condition, and re-runs a stage (and the stages
+after it) whose settings changed.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import json
+import os
+import platform
+import shlex
+import shutil
+import subprocess
+import sys
+import time
+from collections.abc import Callable
+from dataclasses import asdict
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+import lerobot_phantom
+from lerobot_phantom.study.config import StudyConfig
+from lerobot_phantom.study.stages import (
+    EVAL_FILE,
+    RESUME,
+    RUN,
+    SKIP,
+    SWEEP,
+    Stage,
+    decide,
+    fingerprints,
+    plan,
+)
+
+MANIFEST = "study.json"
+MANIFEST_FORMAT = "lerobot_phantom.study/1"
+CONFIG_FILE = "study_config.json"
+
+# Console script -> module whose main() it calls (the same mapping as pyproject's [project.scripts]).
+MODULES = {
+    "lerobot-phantom-collect": "lerobot_phantom.envs.collect",
+    "lerobot-phantom-make-vlm": "lerobot_phantom.train.make_vlm",
+    "lerobot-phantom-train": "lerobot_phantom.train.train",
+    "lerobot-phantom-eval": "lerobot_phantom.eval.eval",
+    "lerobot-phantom-report": "lerobot_phantom.eval.report",
+}
+
+
+def git_commit() -> str | None:
+    """The commit of the package's source tree, or None outside a git checkout."""
+    repo = Path(lerobot_phantom.__file__).resolve().parents[1]
+    result = subprocess.run(
+        ["git", "-C", str(repo), "rev-parse", "HEAD"], capture_output=True, text=True, check=False
+    )
+    return result.stdout.strip() if result.returncode == 0 else None
+
+
+def versions() -> dict[str, str]:
+    from importlib.metadata import version
+
+    return {
+        "lerobot_phantom": lerobot_phantom.__version__,
+        "lerobot": version("lerobot"),
+        "torch": version("torch"),
+        "python": platform.python_version(),
+    }
+
+
+def read_manifest(study_dir: Path) -> dict[str, Any]:
+    path = study_dir / MANIFEST
+    if not path.is_file():
+        return {}
+    manifest = json.loads(path.read_text())
+    if manifest.get("format") != MANIFEST_FORMAT:
+        raise ValueError(f"{path} is not a lerobot-phantom-study manifest (format {MANIFEST_FORMAT})")
+    return manifest
+
+
+def write_manifest(study_dir: Path, manifest: dict[str, Any]) -> None:
+    """Atomically (an interrupted write never leaves a truncated study.json)."""
+    tmp = study_dir / f".{MANIFEST}.tmp"
+    tmp.write_text(json.dumps(manifest, indent=2))
+    tmp.replace(study_dir / MANIFEST)
+
+
+def stage_env(threads: int) -> dict[str, str]:
+    """One torch/OpenMP thread per process unless configured (a user's own OMP_NUM_THREADS does not win here:
+    the study's setting is recorded in study.json)."""
+    n = str(threads)
+    return {**os.environ, "OMP_NUM_THREADS": n, "MKL_NUM_THREADS": n, "HF_HUB_OFFLINE": "1"}
+
+
+def run_subprocess(argv: list[str], study_dir: Path, log, cfg: StudyConfig) -> None:
+    """The stage's CLI as a subprocess in the study directory, output to the log (and the terminal if verbose)."""
+    threads, verbose = cfg.threads, cfg.verbose
+    module = MODULES[argv[0]]
+    command = [sys.executable, "-c", f"import sys; from {module} import main; sys.exit(main())", *argv[1:]]
+    process = subprocess.Popen(
+        command, cwd=study_dir, env=stage_env(threads), stdout=subprocess.PIPE, stderr=subprocess.STDOUT
+    )
+    for chunk in iter(lambda: process.stdout.read1(4096), b""):
+        log.write(chunk)
+        if verbose:
+            sys.stderr.buffer.write(chunk)
+            sys.stderr.flush()
+    if process.wait() != 0:
+        raise RuntimeError(f"{argv[0]} failed (exit {process.returncode}); its output is in {log.name}")
+
+
+@contextlib.contextmanager
+def inside(study_dir: Path, argv: list[str]):
+    cwd, saved = Path.cwd(), sys.argv
+    os.chdir(study_dir)
+    sys.argv = list(argv)
+    try:
+        yield
+    finally:
+        os.chdir(cwd)
+        sys.argv = saved
+
+
+def run_in_process(argv: list[str], study_dir: Path, log, cfg: StudyConfig) -> None:
+    """The stage's CLI in this process (tests): same command line, same working directory."""
+    log.write(b"(run in process)\n")
+    with inside(study_dir, argv), contextlib.redirect_stdout(sys.stderr):
+        importlib.import_module(MODULES[argv[0]]).main()
+
+
+def clear(path: Path) -> None:
+    """Remove a stage's own output (never anything outside the study directory)."""
+    if path.is_dir():
+        shutil.rmtree(path)
+    elif path.exists():
+        path.unlink()
+
+
+class Study:
+    """One invocation: decides, runs and records every stage."""
+
+    def __init__(self, cfg: StudyConfig, invocation: list[str], runner: Callable | None = None) -> None:
+        self.cfg = cfg
+        # runner(argv, study_dir, log, cfg) runs one command line; tests may pass their own.
+        self.runner = runner or (run_in_process if cfg.in_process else run_subprocess)
+        self.dir = Path(cfg.output_dir).resolve()
+        self.stages = plan(cfg)
+        self.fingerprints = fingerprints(self.stages)
+        previous = read_manifest(self.dir)
+        self.records: dict[str, dict[str, Any]] = previous.get("stages", {})
+        self.manifest: dict[str, Any] = {
+            "format": MANIFEST_FORMAT,
+            # Re-runs (or continues) this study from the directory the study was started in.
+            "command": ["lerobot-phantom-study", f"--config_path={Path(cfg.output_dir) / CONFIG_FILE}"],
+            "invocation": invocation,
+            "config": json.loads(json.dumps(asdict(cfg))),  # as study.json stores it (tuples -> lists)
+            "seeds": {
+                "collect": cfg.collect.seed,
+                "train": cfg.train.seed,
+                "lora": cfg.lora.seed,
+                "sweep_env_seeds": [cfg.sweep.seed, cfg.sweep.seed + cfg.sweep.n_episodes - 1],
+            },
+            "versions": versions(),
+            "git_commit": git_commit(),
+            "threads": cfg.threads,
+            "started": datetime.now(UTC).isoformat(timespec="seconds"),
+            "stages": self.records,
+            "last_invocation": {},
+            "results": {},
+        }
+
+    def save(self) -> None:
+        self.manifest["results"] = self.results()
+        self.manifest["conditions"] = {
+            role: json.loads((self.dir / path).read_text())["metadata"].get("conditions", [])
+            for role, path in self.manifest["results"].items()
+        }
+        report = self.records.get("report", {})
+        self.manifest["report"] = report["output"] if report.get("status") == "done" else None
+        write_manifest(self.dir, self.manifest)
+
+    def results(self) -> dict[str, str]:
+        """Sweep role -> its eval.json, relative to the study directory, for every finished sweep."""
+        return {
+            stage.role: f"{stage.output}/{EVAL_FILE}"
+            for stage in self.stages
+            if stage.kind == SWEEP and self.records.get(stage.name, {}).get("status") == "done"
+        }
+
+    def run_stage(self, stage: Stage, decision: str) -> None:
+        fp = self.fingerprints[stage.name]
+        argv = stage.resume_argv() if decision == RESUME else stage.argv
+        if decision == RUN:
+            clear(self.dir / stage.output)
+        record = self.records.get(stage.name) if decision == RESUME else None
+        record = record or {"wall_s": 0.0, "runs": []}
+        record.update(status="running", fingerprint=fp, argv=stage.argv, output=stage.output)
+        record.update(log=f"logs/{stage.name}.log", depends=list(stage.depends))
+        record["runs"] = [*record["runs"], {"argv": argv, "action": decision}]
+        self.records[stage.name] = record
+        self.save()
+        started = time.time()
+        with open(self.dir / record["log"], "ab") as log:
+            log.write(f"\n$ {shlex.join(argv)}\n".encode())
+            log.flush()
+            self.runner(argv, self.dir, log, self.cfg)
+        wall = time.time() - started
+        record["runs"][-1]["wall_s"] = round(wall, 3)
+        record.update(status="done", wall_s=round(record["wall_s"] + wall, 3))
+        self.save()
+
+    def decisions(self) -> dict[str, str]:
+        """What this invocation would do with each stage (--dry_run), assuming every stage that runs succeeds."""
+        out: dict[str, str] = {}
+        for stage in self.stages:
+            upstream_ran = any(out.get(d) in (RUN, RESUME) for d in stage.depends)
+            out[stage.name] = decide(
+                stage, self.fingerprints[stage.name], self.records.get(stage.name), self.dir, upstream_ran
+            )
+        return out
+
+    def run(self) -> dict[str, Any]:
+        started = time.time()
+        (self.dir / "logs").mkdir(parents=True, exist_ok=True)
+        (self.dir / CONFIG_FILE).write_text(json.dumps(asdict(self.cfg), indent=2))
+        done: dict[str, str] = {}
+        progress = tqdm(self.stages, desc="study", unit="stage", disable=not self.cfg.verbose)
+        for stage in progress:
+            progress.set_postfix_str(stage.name)
+            upstream_ran = any(done.get(d) in (RUN, RESUME) for d in stage.depends)
+            decision = decide(
+                stage, self.fingerprints[stage.name], self.records.get(stage.name), self.dir, upstream_ran
+            )
+            done[stage.name] = self.manifest["last_invocation"][stage.name] = decision
+            if decision == SKIP:
+                self.save()
+                continue
+            self.run_stage(stage, decision)
+        progress.close()
+        # Records of stages no longer in the plan (e.g. an optional stage switched off) are kept but marked.
+        for name, record in self.records.items():
+            record["in_plan"] = name in self.fingerprints
+        self.manifest["wall_s"] = round(time.time() - started, 3)
+        self.save()
+        return self.manifest
+
+
+def run_study(
+    cfg: StudyConfig, invocation: list[str] | None = None, runner: Callable | None = None
+) -> dict[str, Any]:
+    """Run or continue the study in ``cfg.output_dir``; returns the manifest (also in ``study.json``)."""
+    return Study(cfg, invocation or ["lerobot-phantom-study"], runner).run()
+
+
+def main(args: list[str] | None = None) -> None:
+    import draccus
+
+    from lerobot_phantom import register
+
+    register()  # the LeRobot registrations, as every lerobot-phantom-* script does
+
+    argv = sys.argv[1:] if args is None else list(args)
+    cfg = draccus.parse(StudyConfig, args=argv)
+    if cfg.dry_run:
+        for name, decision in Study(cfg, ["lerobot-phantom-study", *argv]).decisions().items():
+            print(f"{decision:>6}  {name}")
+        return
+    manifest = run_study(cfg, ["lerobot-phantom-study", *argv])
+    study_dir = Path(cfg.output_dir)
+    print(f"study in {study_dir}: " + ", ".join(f"{k} {v}" for k, v in manifest["last_invocation"].items()))
+    summary = study_dir / "report" / "summary.md"
+    if summary.is_file():
+        print(summary.read_text())
+
+
+if __name__ == "__main__":
+    main()

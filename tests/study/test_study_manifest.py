@@ -1,0 +1,137 @@
+"""Study invocations with a stand-in runner (writes each stage's outputs instantly): manifest, skip, re-run of
+changed stages, resume of interrupted training and sweeps. The real stages run in test_study_end_to_end.py."""
+
+import dataclasses
+import json
+
+import pytest
+
+from lerobot_phantom.study.cli import MANIFEST, main, run_study
+from lerobot_phantom.study.stages import PRETRAINED, plan
+
+
+class FakeRunner:
+    """Writes what each stage's CLI would write; can fail one stage once after writing part of its outputs."""
+
+    def __init__(self, cfg, fail: str | None = None):
+        self.stages = plan(cfg)
+        self.calls: list[list[str]] = []
+        self.fail = fail
+
+    def stage_of(self, argv):
+        return next(
+            s for s in self.stages if argv in (s.argv, s.kind in ("train", "sweep") and s.resume_argv())
+        )
+
+    def __call__(self, argv, study_dir, log, cfg):
+        self.calls.append(argv)
+        stage = self.stage_of(argv)
+        out = study_dir / stage.output
+        out.mkdir(parents=True, exist_ok=True)
+        interrupted = stage.name == self.fail
+        if stage.kind == "train":
+            (out / PRETRAINED).mkdir(parents=True, exist_ok=True)
+            (out / PRETRAINED / "train_config.json").write_text("{}")
+            if not interrupted:
+                (out / PRETRAINED / "config.json").write_text("{}")
+        elif stage.kind == "sweep":
+            metadata = {"complete": not interrupted, "conditions": ["clean", "laser_blinding@strong"]}
+            (out / "eval.json").write_text(json.dumps({"metadata": metadata}))
+        elif stage.kind == "collect":
+            (out / "meta").mkdir()
+            (out / "meta" / "info.json").write_text("{}")
+        elif stage.kind == "vlm":
+            (out / "config.json").write_text("{}")
+        else:
+            (out / "summary.md").write_text("# Summary\n")
+        if interrupted:
+            self.fail = None
+            raise KeyboardInterrupt(f"interrupted {stage.name}")
+
+
+def ran(runner):
+    return [runner.stage_of(argv).name for argv in runner.calls]
+
+
+def test_manifest_records_every_stage_and_maps_roles_to_relative_eval_files(micro):
+    runner = FakeRunner(micro)
+    manifest = run_study(micro, runner=runner)
+    names = [s.name for s in plan(micro)]
+    assert ran(runner) == names
+    on_disk = json.loads((micro_dir(micro) / MANIFEST).read_text())
+    assert on_disk == manifest
+    assert manifest["format"] == "lerobot_phantom.study/1"
+    assert manifest["command"][0] == "lerobot-phantom-study"
+    assert manifest["config"]["sweep"]["n_episodes"] == micro.sweep.n_episodes
+    assert manifest["seeds"]["sweep_env_seeds"] == [micro.sweep.seed, micro.sweep.seed + 1]
+    assert set(manifest["versions"]) >= {"lerobot", "lerobot_phantom", "torch", "python"}
+    assert "git_commit" in manifest
+    assert manifest["last_invocation"] == dict.fromkeys(names, "run")
+    for name in names:
+        record = manifest["stages"][name]
+        assert record["status"] == "done"
+        assert record["argv"][0].startswith("lerobot-phantom-")
+        assert record["wall_s"] >= 0 and len(record["fingerprint"]) == 16
+        assert (micro_dir(micro) / record["log"]).is_file()
+    assert manifest["results"] == {
+        "before": "sweeps/before/eval.json",
+        "after": "sweeps/after/eval.json",
+        "control": "sweeps/control/eval.json",
+    }
+    for path in manifest["results"].values():
+        assert (micro_dir(micro) / path).is_file()
+    assert manifest["conditions"]["after"] == ["clean", "laser_blinding@strong"]
+    assert manifest["report"] == "report"
+    # The recorded command re-reads the config the study wrote.
+    saved = json.loads((micro_dir(micro) / "study_config.json").read_text())
+    assert saved["lora"]["steps"] == micro.lora.steps
+
+
+def micro_dir(cfg):
+    from pathlib import Path
+
+    return Path(cfg.output_dir)
+
+
+def test_second_invocation_skips_everything_and_a_changed_setting_reruns_downstream_only(micro):
+    run_study(micro, runner=FakeRunner(micro))
+    again = FakeRunner(micro)
+    manifest = run_study(micro, runner=again)
+    assert again.calls == []
+    assert set(manifest["last_invocation"].values()) == {"skip"}
+    changed = dataclasses.replace(micro, sweep=dataclasses.replace(micro.sweep, seed=2000))
+    third = FakeRunner(changed)
+    manifest = run_study(changed, runner=third)
+    assert ran(third) == ["sweep_before", "sweep_after", "sweep_control", "report"]
+    assert manifest["last_invocation"]["train_at"] == "skip"
+
+
+@pytest.mark.parametrize("interrupted", ["train_at", "sweep_after"])
+def test_an_interrupted_stage_resumes_and_the_stages_after_it_run(micro, interrupted):
+    first = FakeRunner(micro, fail=interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        run_study(micro, runner=first)
+    manifest = json.loads((micro_dir(micro) / MANIFEST).read_text())
+    assert manifest["stages"][interrupted]["status"] == "running"
+    second = FakeRunner(micro)
+    manifest = run_study(micro, runner=second)
+    assert manifest["last_invocation"][interrupted] == "resume"
+    stage = next(s for s in plan(micro) if s.name == interrupted)
+    assert second.calls[0] == stage.resume_argv()
+    assert [a["action"] for a in manifest["stages"][interrupted]["runs"]] == ["run", "resume"]
+    names = [s.name for s in plan(micro)]
+    # Stages finished before the interruption are skipped; the interrupted one and all after it run.
+    assert ran(second) == names[names.index(interrupted) :]
+    assert manifest["stages"]["report"]["status"] == "done"
+
+
+def test_dry_run_prints_decisions_without_running(micro, capsys):
+    run_study(micro, runner=FakeRunner(micro))
+    args = [
+        f"--config_path={micro_dir(micro) / 'study_config.json'}",
+        "--dry_run=true",
+        "--sweep.n_episodes=3",
+    ]
+    main(args)
+    lines = dict(reversed(line.split()) for line in capsys.readouterr().out.splitlines())
+    assert lines["train_clean"] == "skip" and lines["sweep_before"] == "run" and lines["report"] == "run"

@@ -1,0 +1,205 @@
+"""The study's stage logic: the plan, fingerprints, skip/resume/run decisions, the config's checks."""
+
+import dataclasses
+import json
+import shutil
+
+import pytest
+from conftest import micro_config
+
+from lerobot_phantom.study.config import BeyondSettings, LoRASettings, StudyConfig, SweepSettings
+from lerobot_phantom.study.stages import (
+    PRETRAINED,
+    RESUME,
+    RUN,
+    SKIP,
+    Stage,
+    decide,
+    fingerprints,
+    plan,
+)
+from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
+
+PAPER_LOOP = [
+    "collect",
+    "vlm",
+    "train_clean",
+    "sweep_before",
+    "train_at",
+    "train_control",
+    "sweep_after",
+    "sweep_control",
+    "report",
+]
+
+
+def by_name(stages):
+    return {s.name: s for s in stages}
+
+
+def flag(stage: Stage, name: str) -> str:
+    (value,) = [a.split("=", 1)[1] for a in stage.args if a.startswith(f"--{name}=")]
+    return value
+
+
+def test_paper_loop_in_dependency_order(micro):
+    stages = plan(micro)
+    assert [s.name for s in stages] == PAPER_LOOP
+    seen = set()
+    for stage in stages:
+        assert set(stage.depends) <= seen, stage.name
+        seen.add(stage.name)
+    s = by_name(stages)
+    assert s["train_at"].depends == ("train_clean",) == s["train_control"].depends
+    assert s["sweep_after"].depends == ("train_at",)
+    assert {x.role for x in stages if x.kind == "sweep"} == {"before", "after", "control"}
+
+
+def test_at_and_control_differ_only_in_rate(micro):
+    s = by_name(plan(micro))
+    at, control = s["train_at"], s["train_control"]
+    assert flag(at, "phantom.rate") == "0.3" and flag(control, "phantom.rate") == "0.0"
+    assert flag(at, "policy.path") == f"train/clean/{PRETRAINED}"
+    differing = set(at.args) ^ set(control.args)
+    assert {a.split("=")[0] for a in differing} == {"--phantom.rate", "--output_dir"}
+    # The paper's recipe: the six camera attacks, intensity uniform weak..strong.
+    assert json.loads(flag(at, "phantom.attacks")) == list(CAMERA_ATTACKS)
+    assert flag(at, "phantom.intensity") == "random"
+    assert flag(s["train_clean"], "phantom.rate") == "0"
+
+
+def test_sweeps_share_seeds_and_conditions(micro):
+    sweeps = [s for s in plan(micro) if s.kind == "sweep"]
+    for name in ("seed", "eval.n_episodes", "phantom.attacks", "phantom.intensities", "env.task"):
+        assert len({flag(s, name) for s in sweeps}) == 1, name
+
+
+def test_report_compares_at_with_before_and_with_control(micro):
+    report = by_name(plan(micro))["report"]
+    before, after = json.loads(flag(report, "before")), json.loads(flag(report, "after"))
+    assert list(zip(before, after, strict=True)) == [
+        ("sweeps/before/eval.json", "sweeps/after/eval.json"),
+        ("sweeps/control/eval.json", "sweeps/after/eval.json"),
+    ]
+    assert json.loads(flag(report, "labels")) == ["before", "AT", "control"]
+
+
+def test_optional_stages(tmp_path):
+    cfg = micro_config(
+        tmp_path,
+        beyond=BeyondSettings(
+            leave_one_out=("laser_blinding",),
+            calibration=str(tmp_path),
+            instruction_attacks=("voice_dos",),
+        ),
+    )
+    s = by_name(plan(cfg))
+    held_out = s["train_at_without_laser_blinding"]
+    assert "laser_blinding" not in json.loads(flag(held_out, "phantom.attacks"))
+    assert len(json.loads(flag(held_out, "phantom.attacks"))) == len(CAMERA_ATTACKS) - 1
+    assert json.loads(flag(s["sweep_at_without_laser_blinding"], "phantom.attacks")) == ["laser_blinding"]
+    assert flag(s["train_at_calibrated"], "phantom.calibration") == str(tmp_path.resolve())
+    for role in ("before", "after", "at_calibrated"):
+        assert flag(s[f"sweep_{role}_calibrated_physics"], "phantom.calibration") == str(tmp_path.resolve())
+    assert "--phantom.calibration" not in " ".join(s["sweep_at_calibrated"].args)
+    assert json.loads(flag(s["train_at_instruction"], "phantom.instruction_attacks")) == ["voice_dos"]
+    report = s["report"]
+    pairs = list(zip(json.loads(flag(report, "before")), json.loads(flag(report, "after")), strict=True))
+    assert ("sweeps/before/eval.json", "sweeps/at_without_laser_blinding/eval.json") in pairs
+    assert (
+        "sweeps/before_calibrated_physics/eval.json",
+        "sweeps/at_calibrated_calibrated_physics/eval.json",
+    ) in pairs
+    # Calibrated-physics sweeps are compared with each other only, never with a naive-physics sweep.
+    for b, a in pairs:
+        assert b.endswith("_calibrated_physics/eval.json") == a.endswith("_calibrated_physics/eval.json"), (
+            b,
+            a,
+        )
+
+
+def changed_stages(before: StudyConfig, after: StudyConfig) -> set[str]:
+    old, new = fingerprints(plan(before)), fingerprints(plan(after))
+    return {name for name in new if old.get(name) != new[name]}
+
+
+def test_a_changed_setting_changes_its_stage_and_the_ones_downstream_only(micro):
+    more_episodes = dataclasses.replace(micro, sweep=dataclasses.replace(micro.sweep, n_episodes=3))
+    assert changed_stages(micro, more_episodes) == {"sweep_before", "sweep_after", "sweep_control", "report"}
+    longer_lora = dataclasses.replace(micro, lora=dataclasses.replace(micro.lora, steps=3))
+    assert changed_stages(micro, longer_lora) == {
+        "train_at",
+        "train_control",
+        "sweep_after",
+        "sweep_control",
+        "report",
+    }
+    assert changed_stages(micro, dataclasses.replace(micro, verbose=True, threads=2)) == set()
+
+
+def test_fingerprint_follows_config_file_content_not_its_path(micro, tmp_path):
+    copy = tmp_path / "copy.json"
+    shutil.copy(micro.train.config_path, copy)
+    moved = dataclasses.replace(micro, train=dataclasses.replace(micro.train, config_path=str(copy)))
+    assert changed_stages(micro, moved) == set()
+    copy.write_text(copy.read_text().replace('"chunk_size": 4', '"chunk_size": 2'))
+    assert "train_clean" in changed_stages(micro, moved)
+
+
+def make_outputs(stage: Stage, study_dir, complete=True):
+    out = study_dir / stage.output
+    if stage.kind == "train":
+        (out / PRETRAINED).mkdir(parents=True)
+        (out / PRETRAINED / "train_config.json").write_text("{}")
+        if complete:
+            (out / PRETRAINED / "config.json").write_text("{}")
+    elif stage.kind == "sweep":
+        out.mkdir(parents=True)
+        (out / "eval.json").write_text(json.dumps({"metadata": {"complete": complete}}))
+
+
+@pytest.mark.parametrize("kind", ["train", "sweep"])
+def test_decisions(micro, tmp_path, kind):
+    stage = next(s for s in plan(micro) if s.kind == kind)
+    assert decide(stage, "fp", None, tmp_path) == RUN
+    make_outputs(stage, tmp_path, complete=False)
+    running = {"fingerprint": "fp", "status": "running"}
+    assert decide(stage, "fp", running, tmp_path) == RESUME
+    assert decide(stage, "other", running, tmp_path) == RUN  # settings changed: start over
+    assert decide(stage, "fp", running, tmp_path, upstream_ran=True) == RUN
+    done = {"fingerprint": "fp", "status": "done"}
+    assert decide(stage, "fp", done, tmp_path) == RUN  # recorded done, but the outputs are not whole
+    shutil.rmtree(tmp_path / stage.output)
+    make_outputs(stage, tmp_path, complete=True)
+    assert decide(stage, "fp", done, tmp_path) == SKIP
+    assert decide(stage, "other", done, tmp_path) == RUN
+    assert decide(stage, "fp", done, tmp_path, upstream_ran=True) == RUN
+
+
+def test_resume_commands(micro):
+    s = by_name(plan(micro))
+    assert s["train_at"].resume_argv() == [
+        "lerobot-phantom-train",
+        f"--config_path=train/at/{PRETRAINED}/train_config.json",
+        "--resume=true",
+    ]
+    assert s["sweep_after"].resume_argv() == [*s["sweep_after"].argv, "--resume=true"]
+    with pytest.raises(ValueError, match="cannot resume"):
+        s["collect"].resume_argv()
+
+
+def test_bad_settings_name_the_valid_values(tmp_path):
+    with pytest.raises(ValueError, match="valid attacks"):
+        micro_config(tmp_path, sweep=SweepSettings(attacks=("laser",)))
+    with pytest.raises(ValueError, match="camera attacks"):
+        micro_config(tmp_path, lora=LoRASettings(attacks=("voice_dos",)))
+    with pytest.raises(ValueError, match="voice_dos"):
+        micro_config(tmp_path, beyond=BeyondSettings(instruction_attacks=("laser_blinding",)))
+    with pytest.raises(ValueError, match="tiny"):
+        micro_config(tmp_path, vlm=dataclasses.replace(micro_config(tmp_path).vlm, size="huge"))
+    with pytest.raises(FileNotFoundError, match="not found"):
+        plan(
+            micro_config(
+                tmp_path, train=dataclasses.replace(micro_config(tmp_path).train, config_path="no.json")
+            )
+        )
