@@ -5,7 +5,7 @@ import json
 import shutil
 
 import pytest
-from conftest import micro_config
+from study_testkit import micro_config
 
 from lerobot_phantom.study.config import BeyondSettings, LoRASettings, StudyConfig, SweepSettings
 from lerobot_phantom.study.stages import (
