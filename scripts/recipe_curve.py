@@ -20,7 +20,8 @@ from datetime import datetime
 from pathlib import Path
 
 LOG_LINE = re.compile(
-    r"INFO (\d{4}-\d\d-\d\d \d\d:\d\d:\d\d) .*? step:(\d+) .*?loss:([\d.]+) .*?updt_s:([\d.]+) data_s:([\d.]+)"
+    r"INFO (\d{4}-\d\d-\d\d \d\d:\d\d:\d\d) .*? step:([\d.]+K?) .*?loss:([\d.]+) .*?updt_s:([\d.]+) "
+    r"data_s:([\d.]+)"
 )
 
 
@@ -56,6 +57,9 @@ def curve_rows(rollout_files: list[Path]) -> list[dict]:
                     "median_dz_cm_hit": _cm(grasp["median_dz_m_hit"]),
                     "max_closes_in_an_episode": grasp["max_closes_in_an_episode"],
                     "median_action_err_vs_expert": summary["median_action_err_vs_expert"],
+                    "per_task_successes": " ".join(
+                        f"{task}:{v['successes']}/{v['episodes']}" for task, v in summary["per_task"].items()
+                    ),
                     "eval_seconds": summary["seconds"],
                     "eval_load_average_1min": round(summary["load_average"][0], 2),
                     "rollouts_file": path.name,
@@ -70,18 +74,24 @@ def _cm(metres: float | None) -> float | None:
 
 def training_record(log: Path, loads: list[tuple[datetime, float]]) -> dict:
     text = log.read_text(errors="replace")
-    command = next((line for line in text.splitlines() if "lerobot-phantom-train" in line), None)
-    logged = [
-        {
-            "time": m.group(1),
-            "step": int(m.group(2)),
-            "loss": float(m.group(3)),
-            "update_s": float(m.group(4)),
-            "data_s": float(m.group(5)),
-        }
-        for m in LOG_LINE.finditer(text)
-    ]
-    record: dict = {"log": log.name, "command": command, "logged": logged}
+    logged = []
+    for m in LOG_LINE.finditer(text):
+        # LeRobot prints steps from 1000 on rounded ("1K"): count on from the last exact step at the log interval.
+        if m.group(2).endswith("K"):
+            interval = logged[1]["step"] - logged[0]["step"]
+            step = logged[-1]["step"] + interval
+        else:
+            step = int(m.group(2))
+        logged.append(
+            {
+                "time": m.group(1),
+                "step": step,
+                "loss": float(m.group(3)),
+                "update_s": float(m.group(4)),
+                "data_s": float(m.group(5)),
+            }
+        )
+    record: dict = {"log": log.name, "logged": logged}
     if logged:
         start = datetime.fromisoformat(logged[0]["time"])
         end = datetime.fromisoformat(logged[-1]["time"])
