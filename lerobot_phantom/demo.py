@@ -47,13 +47,14 @@ class DemoConfig:
     action_noise: float = 0.3
     image_size: int = 96
     vlm_size: str = "small"
-    clean_steps: int = 400
+    clean_steps: int = 500
     phantom_steps: int = 50
     batch_size: int = 32
     learning_rate: float = 3e-4
     chunk_size: int = 10
-    n_action_steps: int = 5
-    eval_episodes: int = 12
+    # Replanning after every action: the chunk's later actions were fitted to noisy demonstrations (docs/recipe)
+    n_action_steps: int = 1
+    eval_episodes: int = 6
     # A trained clean policy (e.g. `lerobot-phantom-study`'s, or a run of configs/smolvla_goal_cpu.json): step 3
     # then evaluates and fine-tunes it instead of the policy trained here in a few minutes, which cannot solve the
     # tasks yet (docs/recipe/README.md)

@@ -1,7 +1,7 @@
 """Learning curves of the CPU recipe experiments: checkpoint TSRs (from recipe_rollouts.py) + training logs -> docs.
 
     python scripts/recipe_curve.py --rollouts A.json B.json ... --train-log A=DIR/A.log --train-log B=DIR/B.log
-        [--load-log load.log] --out docs/recipe
+        [--start-step C=1500] [--load-log load.log] --out docs/recipe
 
 Writes ``learning_curve.csv`` (one row per experiment, checkpoint and readout: TSR, 95 % Wilson interval, the
 first-close grasp breakdown), ``training.json`` (per experiment: the training command, loss and seconds per step at
@@ -20,7 +20,8 @@ from datetime import datetime
 from pathlib import Path
 
 LOG_LINE = re.compile(
-    r"INFO (\d{4}-\d\d-\d\d \d\d:\d\d:\d\d) .*? step:(\d+) .*?loss:([\d.]+) .*?updt_s:([\d.]+) data_s:([\d.]+)"
+    r"INFO (\d{4}-\d\d-\d\d \d\d:\d\d:\d\d) .*? step:([\d.]+K?) .*?loss:([\d.]+) .*?updt_s:([\d.]+) "
+    r"data_s:([\d.]+)"
 )
 
 
@@ -30,7 +31,7 @@ def checkpoint_name(path: str) -> tuple[str, int]:
     return parts[index - 1], int(parts[index + 1])
 
 
-def curve_rows(rollout_files: list[Path]) -> list[dict]:
+def curve_rows(rollout_files: list[Path], start_steps: dict[str, int]) -> list[dict]:
     rows = []
     for path in rollout_files:
         for summary in json.loads(path.read_text()):
@@ -40,6 +41,8 @@ def curve_rows(rollout_files: list[Path]) -> list[dict]:
                 {
                     "experiment": experiment,
                     "step": step,
+                    # steps including those of the checkpoint a fine-tuning run started from
+                    "total_step": start_steps.get(experiment, 0) + step,
                     "readout": f"replan{summary['replan']}"
                     + ("_zero_noise" if summary["zero_noise"] else ""),
                     "episodes": summary["episodes"],
@@ -56,6 +59,9 @@ def curve_rows(rollout_files: list[Path]) -> list[dict]:
                     "median_dz_cm_hit": _cm(grasp["median_dz_m_hit"]),
                     "max_closes_in_an_episode": grasp["max_closes_in_an_episode"],
                     "median_action_err_vs_expert": summary["median_action_err_vs_expert"],
+                    "per_task_successes": " ".join(
+                        f"{task}:{v['successes']}/{v['episodes']}" for task, v in summary["per_task"].items()
+                    ),
                     "eval_seconds": summary["seconds"],
                     "eval_load_average_1min": round(summary["load_average"][0], 2),
                     "rollouts_file": path.name,
@@ -70,18 +76,24 @@ def _cm(metres: float | None) -> float | None:
 
 def training_record(log: Path, loads: list[tuple[datetime, float]]) -> dict:
     text = log.read_text(errors="replace")
-    command = next((line for line in text.splitlines() if "lerobot-phantom-train" in line), None)
-    logged = [
-        {
-            "time": m.group(1),
-            "step": int(m.group(2)),
-            "loss": float(m.group(3)),
-            "update_s": float(m.group(4)),
-            "data_s": float(m.group(5)),
-        }
-        for m in LOG_LINE.finditer(text)
-    ]
-    record: dict = {"log": log.name, "command": command, "logged": logged}
+    logged = []
+    for m in LOG_LINE.finditer(text):
+        # LeRobot prints steps from 1000 on rounded ("1K"): count on from the last exact step at the log interval.
+        if m.group(2).endswith("K"):
+            interval = logged[1]["step"] - logged[0]["step"]
+            step = logged[-1]["step"] + interval
+        else:
+            step = int(m.group(2))
+        logged.append(
+            {
+                "time": m.group(1),
+                "step": step,
+                "loss": float(m.group(3)),
+                "update_s": float(m.group(4)),
+                "data_s": float(m.group(5)),
+            }
+        )
+    record: dict = {"log": log.name, "logged": logged}
     if logged:
         start = datetime.fromisoformat(logged[0]["time"])
         end = datetime.fromisoformat(logged[-1]["time"])
@@ -119,14 +131,22 @@ def plot(rows: list[dict], out: Path) -> None:
     figure, axis = plt.subplots(figsize=(7, 4))
     for key in dict.fromkeys((r["experiment"], r["readout"]) for r in rows):
         points = [r for r in rows if (r["experiment"], r["readout"]) == key]
-        steps = [r["step"] for r in points]
+        steps = [r["total_step"] for r in points]
         tsr = [100 * r["tsr"] for r in points]
         errors = [
             [100 * (r["tsr"] - r["wilson95_low"]) for r in points],
             [100 * (r["wilson95_high"] - r["tsr"]) for r in points],
         ]
-        axis.errorbar(steps, tsr, yerr=errors, marker="o", capsize=3, label=f"{key[0]} ({key[1]})")
-    axis.set_xlabel("training step (batch 32)")
+        axis.errorbar(
+            steps,
+            tsr,
+            yerr=errors,
+            marker="o",
+            linestyle="-" if len(steps) > 1 else "none",
+            capsize=3,
+            label=f"{key[0]} ({key[1]})",
+        )
+    axis.set_xlabel("training steps in total (batch 32; anneal runs: from their start checkpoint)")
     axis.set_ylabel("clean TSR on phantom_table goal (%)")
     axis.set_ylim(0, 100)
     axis.set_title(
@@ -143,10 +163,17 @@ def main() -> None:
     parser.add_argument("--rollouts", nargs="+", type=Path, required=True)
     parser.add_argument("--train-log", action="append", default=[], help="NAME=PATH of a training log")
     parser.add_argument("--load-log", type=Path)
+    parser.add_argument(
+        "--start-step",
+        action="append",
+        default=[],
+        help="NAME=STEPS: run NAME fine-tuned a STEPS-step checkpoint",
+    )
     parser.add_argument("--out", type=Path, required=True)
     args = parser.parse_args()
     args.out.mkdir(parents=True, exist_ok=True)
-    rows = curve_rows(args.rollouts)
+    start_steps = {name: int(steps) for name, _, steps in (s.partition("=") for s in args.start_step)}
+    rows = curve_rows(args.rollouts, start_steps)
     with open(args.out / "learning_curve.csv", "w", newline="") as sink:
         writer = csv.DictWriter(sink, fieldnames=list(rows[0]))
         writer.writeheader()
