@@ -179,7 +179,8 @@ class Planner:
         args = [
             f"--config_path={self.clean_config}",
             *self.dataset_args(),
-            "--policy.vlm_model_name=vlm",
+            # Absolute: the path is saved in the checkpoint, which the demo and users load from other directories.
+            f"--policy.vlm_model_name={Path(self.cfg.output_dir).resolve() / 'vlm'}",
             "--output_dir=train/clean",
             "--phantom.rate=0",
             f"--seed={t.seed}",
