@@ -1,0 +1,184 @@
+"""Identification: bootstrap intervals over items, and the rule that makes an extension a *named cause*.
+
+Every interval here is a percentile bootstrap over *items* (table rows, capture tiles, whole image pairs): items
+are drawn with replacement, the statistic is recomputed, and the ``(1 - level) / 2`` and ``(1 + level) / 2``
+quantiles of the draws bound it. Items, not values, are resampled because the values inside one item (the pixels
+of one frame) are not independent.
+
+The rule (:func:`identify`): an extension is a named cause only if
+
+1. it was selected by the stated criterion on the fit items only (forward selection by inner cross-validation);
+2. its effect size on fit data is real: the bootstrap interval of the inner cross-validated error ratio
+   (model without it / model with it, paired over the same validation items) lies above 1;
+3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
+   range, not the camera);
+4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
+   a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
+   least one such parameter excludes its null value.
+
+Otherwise it is reported as "not identified" with the reasons, and it is not part of the model that is written.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+LEVEL = 0.9  # two-sided coverage of every reported interval
+BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A point estimate with its percentile bootstrap interval."""
+
+    estimate: float
+    low: float
+    high: float
+    level: float = LEVEL
+    draws: int = 0
+
+    def excludes(self, value: float) -> bool:
+        return value < self.low or value > self.high
+
+    def as_dict(self) -> dict:
+        return {
+            "estimate": self.estimate,
+            "low": self.low,
+            "high": self.high,
+            "level": self.level,
+            "draws": self.draws,
+        }
+
+
+def percentile_interval(estimate: float, draws: Sequence[float], level: float = LEVEL) -> Interval:
+    """``estimate`` with the ``level`` percentile interval of its bootstrap ``draws`` (non-finite draws dropped)."""
+    values = np.asarray([d for d in draws if np.isfinite(d)], dtype=np.float64)
+    if len(values) == 0:
+        return Interval(float(estimate), float("nan"), float("nan"), level, 0)
+    tail = 100.0 * (1.0 - level) / 2.0
+    low, high = np.percentile(values, [tail, 100.0 - tail])
+    return Interval(float(estimate), float(low), float(high), level, len(values))
+
+
+def resample(items: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """One bootstrap draw of ``items`` (with replacement, same size, sorted)."""
+    items = np.asarray(items)
+    return np.sort(rng.choice(items, len(items), replace=True))
+
+
+def bootstrap(
+    statistic: Callable[[np.ndarray], Mapping[str, float]],
+    items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+    level: float = LEVEL,
+) -> dict[str, Interval]:
+    """Percentile intervals of every value ``statistic(items)`` returns, over ``draws`` item resamples."""
+    estimate = dict(statistic(np.asarray(items)))
+    samples: dict[str, list[float]] = {k: [] for k in estimate}
+    for _ in range(draws):
+        values = statistic(resample(items, rng))
+        for k in samples:
+            samples[k].append(float(values.get(k, np.nan)))
+    return {k: percentile_interval(estimate[k], samples[k], level) for k in estimate}
+
+
+def error_ratio(before: np.ndarray, after: np.ndarray, *, draws: int, rng: np.random.Generator) -> Interval:
+    """RMSE(before) / RMSE(after) from per-item squared-error sums, with a paired bootstrap over the items.
+
+    ``before``, ``after``: per-item sums of squared errors of two models on the same items. A ratio above 1 means ``after`` predicts better."""
+    before, after = np.asarray(before, np.float64), np.asarray(after, np.float64)
+
+    def ratio(index: np.ndarray) -> dict[str, float]:
+        return {"ratio": float(np.sqrt(before[index].sum() / max(after[index].sum(), 1e-300)))}
+
+    return bootstrap(ratio, np.arange(len(before)), draws=draws, rng=rng)["ratio"]
+
+
+def rmse_interval(
+    squared: np.ndarray, counts: np.ndarray, *, draws: int, rng: np.random.Generator
+) -> Interval:
+    """RMSE over items from per-item squared-error sums and value counts, with its item bootstrap interval."""
+    squared, counts = np.asarray(squared, np.float64), np.asarray(counts, np.float64)
+
+    def rmse(index: np.ndarray) -> dict[str, float]:
+        return {"rmse": float(np.sqrt(squared[index].sum() / max(counts[index].sum(), 1.0)))}
+
+    return bootstrap(rmse, np.arange(len(squared)), draws=draws, rng=rng)["rmse"]
+
+
+def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
+    """``"low"``/``"high"`` when ``value`` sits within ``tolerance`` x range of that bound, else None."""
+    span = max(high - low, 1e-300)
+    if value - low <= tolerance * span:
+        return "low"
+    if high - value <= tolerance * span:
+        return "high"
+    return None
+
+
+@dataclass(frozen=True)
+class Identification:
+    effect: str
+    identified: bool
+    reasons: tuple[str, ...]
+
+    def as_dict(self) -> dict:
+        return {
+            "effect": self.effect,
+            "status": "identified" if self.identified else "not identified",
+            "identified": self.identified,
+            "reasons": list(self.reasons),
+        }
+
+
+def identify(
+    effect: str,
+    *,
+    selected: bool,
+    validation_ratio: Interval | None,
+    params: Mapping[str, float],
+    bounds: Mapping[str, tuple[float, float]],
+    intervals: Mapping[str, Interval],
+    nulls: Mapping[str, float],
+) -> Identification:
+    """Apply the module's rule to one extension.
+
+    ``params``/``bounds``: the extension's own fitted parameters and their search ranges; ``intervals``: their
+    bootstrap intervals; ``nulls``: the parameter values at which the extension reduces to the model without it
+    (empty when it has none: a change of functional form); ``validation_ratio``: the paired bootstrap interval
+    of the inner cross-validated error ratio without / with the extension (None if it was never scored)."""
+    reasons = []
+    if not selected:
+        reasons.append("not selected by the inner cross-validation on the fit items")
+    if validation_ratio is None:
+        reasons.append("no inner cross-validated effect size")
+    elif not validation_ratio.low > 1.0:
+        reasons.append(
+            f"inner cross-validated error ratio {validation_ratio.estimate:.3f} "
+            f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
+            "does not exclude 1 (no gain)"
+        )
+    for name, value in params.items():
+        side = at_bound(value, *bounds[name])
+        if side is not None:
+            reasons.append(
+                f"{name} = {value:.4g} sits at its {side} bound {bounds[name][side == 'high']:.4g}"
+            )
+    if nulls:
+        excluded = [n for n, null in nulls.items() if n in intervals and intervals[n].excludes(null)]
+        if not excluded:
+            reasons.append(
+                "the interval of "
+                + ", ".join(
+                    f"{n} ({intervals[n].low:.4g}-{intervals[n].high:.4g})" for n in nulls if n in intervals
+                )
+                + " includes the null value "
+                + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
+                + " at which the extension reduces to the model without it"
+            )
+    return Identification(effect, not reasons, tuple(reasons))
