@@ -21,10 +21,13 @@ Otherwise it is reported as "not identified" with the reasons, and it is not par
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
+
+from lerobot_phantom.calibration.core import Fit, Param, Problem, Step
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
 BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
@@ -182,3 +185,91 @@ def identify(
                 + " at which the extension reduces to the model without it"
             )
     return Identification(effect, not reasons, tuple(reasons))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# applying the rule to a forward selection
+
+
+def parameter_intervals(
+    problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
+) -> dict[str, Interval]:
+    """Percentile intervals of every fitted parameter: the model is refitted on ``draws`` resamples of the fit
+    ``items``, each refit warm-started from ``fit`` (the estimate)."""
+    samples: dict[str, list[float]] = {k: [] for k in fit.params}
+    for _ in range(draws):
+        refit = problem.fit(fit.effects, resample(items, rng), start=fit)
+        for k in samples:
+            samples[k].append(float(refit.params.get(k, np.nan)))
+    return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
+
+
+def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
+    """The parameters the model with ``effects`` has and the model without ``effect`` lacks."""
+    without = {p.name for p in problem.param_specs(effects - {effect})}
+    return [p for p in problem.param_specs(effects) if p.name not in without]
+
+
+@dataclass
+class Selection:
+    """What identification leaves of a forward selection."""
+
+    selected: list[str]
+    identified: list[str]
+    results: list[dict]
+    fit: Fit  # the model with the identified effects only, fitted on the fit items
+    intervals: dict[str, Interval]  # its parameters' intervals
+
+
+def identify_selection(
+    problem: Problem,
+    steps: list[Step],
+    chain: list[Fit],
+    fit_items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+) -> Selection:
+    """Judge every extension forward selection kept by the module's rule; refit without those that fail."""
+    selected_fit = chain[-1]
+    intervals = parameter_intervals(problem, selected_fit, fit_items, draws=draws, rng=rng)
+    results, identified = [], []
+    for before, after in itertools.pairwise(steps):
+        (effect,) = set(after.effects) - set(before.effects)
+        ratio = None
+        if before.item_errors is not None and after.item_errors is not None:
+            ratio = error_ratio(before.item_errors, after.item_errors, draws=max(draws, 200), rng=rng)
+        specs = own_params(problem, selected_fit.effects, effect)
+        nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
+        outcome = identify(
+            effect,
+            selected=True,
+            validation_ratio=ratio,
+            params={p.name: selected_fit.params[p.name] for p in specs},
+            bounds={p.name: (p.low, p.high) for p in specs},
+            intervals={p.name: intervals[p.name] for p in specs},
+            nulls=nulls,
+        )
+        result = outcome.as_dict()
+        requires = next((e.requires for e in problem.candidates if e.name == effect), ())
+        missing = [r for r in requires if r not in identified]
+        if missing and outcome.identified:
+            result.update(identified=False, status="not identified")
+            result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
+        result.update(
+            validation_ratio=None if ratio is None else ratio.as_dict(),
+            params={p.name: selected_fit.params[p.name] for p in specs},
+            intervals={p.name: intervals[p.name].as_dict() for p in specs},
+            nulls=nulls,
+        )
+        results.append(result)
+        if result["identified"]:
+            identified.append(effect)
+    kept = frozenset(identified)
+    if kept == selected_fit.effects:
+        return Selection(sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals)
+    # the largest model of the chain inside the kept set starts the refit
+    start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
+    final = start if start.effects == kept else problem.fit(kept, fit_items, start)
+    final_intervals = parameter_intervals(problem, final, fit_items, draws=draws, rng=rng)
+    return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)

@@ -35,7 +35,11 @@ def test_stripe_table_names_overlap_and_offset(tmp_path):
     write_stripe_table(table, rng, row_time, offset)
     report = calibrate(
         CalibrateConfig(
-            attack="laser_color_strip", measured=str(table), out=str(tmp_path / "out"), image_height=480
+            attack="laser_color_strip",
+            measured=str(table),
+            out=str(tmp_path / "out"),
+            image_height=480,
+            exposure_unit_s=1e-4,
         )
     )
     assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
@@ -62,6 +66,20 @@ def test_colour_triples_find_additive_light(tmp_path):
     assert {"additive_light", "albedo_modulation"} <= set(report["extended"]["effects"])
     assert report["extended"]["heldout_rmse"] < 3.0
     assert report["gain"]["rmse_ratio"] >= 1.5
+
+
+def test_capture_pixel_samples_follow_the_seed(tmp_path):
+    from lerobot_phantom.calibration.captures import CaptureProblem
+
+    rng = np.random.default_rng(2)
+    kit.save(tmp_path / "laser.png", rng.uniform(0.1, 0.9, (64, 64, 3)), rng)
+    problems = [CaptureProblem(tmp_path / "laser.png", max_side=64, seed=seed) for seed in (0, 0, 1)]
+    tiles = np.arange(problems[0].n_items)
+    samples = [p.pixels(tiles, cap=500).numpy() for p in problems]
+    assert len(samples[0]) == 500 and np.array_equal(samples[0], samples[1])
+    assert not np.array_equal(samples[0], samples[2])
+    # a tile drawn twice (a bootstrap draw) counts twice
+    assert len(problems[0].pixels(np.array([3, 3]))) == 2 * len(problems[0].pixels(np.array([3])))
 
 
 @pytest.mark.slow
