@@ -1,6 +1,6 @@
 """``lerobot-phantom-calibrate``: fit an attack simulation to measured data, name what it gets wrong, extend it.
 
-    lerobot-phantom-calibrate --attack laser_color_strip --measured ../shared/measured/rolling_shutter/logitech_stripe_rows.csv --out outputs/cal/stripes
+    lerobot-phantom-calibrate --attack laser_color_strip --measured ../shared/measured/rolling_shutter/logitech_stripe_rows.csv --image-height 720 --exposure-unit-s 1e-4 --out outputs/cal/stripes
     lerobot-phantom-calibrate --attack light_projection --measured slap_stop_sign_triples.csv --out outputs/cal/stop
     lerobot-phantom-calibrate --attack laser_blinding --measured ../shared/measured/blinding --out outputs/cal/laser
     lerobot-phantom-calibrate --attack ultrasound_blur --measured my_captures/ --out outputs/cal/blur   # pairs.csv
@@ -59,10 +59,14 @@ class CalibrateConfig:
     folds: int = 4
     # Bootstrap resamples (over fit items) behind every parameter's interval; the gain's interval uses more.
     bootstrap: int = 30
-    # Stripe tables: image rows of the camera's frames.
-    image_height: int = 720
-    # Stripe tables: seconds per unit of the table's exposure setting (UVC cameras: 100 microseconds).
-    exposure_unit_s: float = 1e-4
+    # Stripe tables: image rows of the camera's frames (required unless the table has an image_height column).
+    image_height: int | None = None
+    # Stripe tables: seconds per unit of the exposure values (required unless the table states the unit, e.g. an
+    # exposure_us column or values such as "32us"; UVC cameras such as the Logitech table: 1e-4).
+    exposure_unit_s: float | None = None
+    # Stripe tables: which frames the table's means averaged: all, lit (frames with a lit row), interior (frames
+    # whose first and last rows are dark), or auto (the rule that fits the fit split best, reported).
+    stripe_frames: str = "auto"
     # Frame pairs: frames are resized so their longer side is at most this many pixels.
     max_side: int = 256
     # Laser captures: captures are resized so their longer side is at most this many pixels.
@@ -104,7 +108,9 @@ def build_problem(cfg: CalibrateConfig) -> Problem:
             f"not {cfg.attack!r}"
         )
     if kind == "stripe_table":
-        return StripeProblem(path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s)
+        return StripeProblem(
+            path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s, frames=cfg.stripe_frames
+        )
     if kind == "colour_triples":
         return TripleProblem(path)
     if kind == "laser_captures":
