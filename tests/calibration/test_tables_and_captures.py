@@ -28,29 +28,6 @@ def write_stripe_table(path, rng, row_time, offset, height=480, unit=1e-4, noise
     path.write_text("\n".join(lines) + "\n")
 
 
-def test_stripe_table_names_overlap_and_offset(tmp_path):
-    rng = np.random.default_rng(3)
-    row_time, offset = rng.uniform(5e-5, 8e-5), rng.uniform(4e-4, 9e-4)
-    table = tmp_path / "stripes.csv"
-    write_stripe_table(table, rng, row_time, offset)
-    report = calibrate(
-        CalibrateConfig(
-            attack="laser_color_strip",
-            measured=str(table),
-            out=str(tmp_path / "out"),
-            image_height=480,
-            exposure_unit_s=1e-4,
-        )
-    )
-    assert {"exposure_overlap", "integration_offset"} <= set(report["extended"]["effects"])
-    assert report["extended"]["heldout_rmse"] < 3.0
-    assert report["gain"]["rmse_ratio"] > 10
-    assert report["extended"]["params"]["row_time_s"] == pytest.approx(row_time, rel=0.05)
-    kwargs = calibrated_kwargs("laser_color_strip", tmp_path / "out")
-    assert kwargs["model"] == "rolling_shutter" and kwargs["frame_rows"] == 480
-    assert (tmp_path / "out" / "report.md").read_text().count("exposure_overlap") >= 1
-
-
 def test_colour_triples_find_additive_light(tmp_path):
     rng = np.random.default_rng(4)
     surface = rng.uniform(0.05, 0.9, (600, 3))
