@@ -593,7 +593,7 @@ def ultrasound_blur_pairs(
     arcsine-weighted toward both ends of the path), "rotation" (the paper's rotational component, 0 .. theta,
     theta = intensity * Theta, in output space: an effect the library has no name for)."""
     direction = rng.uniform(0, np.pi)
-    amplitude = amplitude_px if amplitude_px is not None else rng.uniform(5, 9)
+    amplitude = amplitude_px if amplitude_px is not None else rng.uniform(8, 14)
     unit = np.array([np.sin(direction), np.cos(direction)])
     cycles = rng.uniform(5.2, 8.8)
     pairs = []
