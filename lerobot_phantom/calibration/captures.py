@@ -185,12 +185,13 @@ class CaptureProblem(Problem):
                 # relative to a far higher peak
                 warm.pop("sigma")
                 warm.pop("log10_halo_amplitude", None)
+        refit = start is not None and start.effects == effects  # a bootstrap draw: start from the estimate
         params = fit_least_squares(
             self.param_specs(effects, self.initial_guess(items)),
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
-            starts=[{}] if warm else [],  # also from the defaults: saturated starts can stall
-            max_nfev=60,
+            starts=[{}] if warm and not refit else [],  # also from the defaults: saturated starts can stall
+            max_nfev=20 if refit else 60,
         )
         return Fit(effects, params)
 

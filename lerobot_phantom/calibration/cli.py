@@ -25,6 +25,7 @@ import pandas as pd
 from lerobot_phantom._cli import normalize_argv
 from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
 from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select, seeded_split, single_threaded
+from lerobot_phantom.calibration.example import write_example
 from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS, FrameProblem, load_pairs
 from lerobot_phantom.calibration.identify import identify_selection, parameter_intervals
 from lerobot_phantom.calibration.noise import apply_noise_finding, select_shot_noise
@@ -59,6 +60,8 @@ class CalibrateConfig:
     folds: int = 4
     # Bootstrap resamples (over fit items) behind every parameter's interval; the gain's interval uses more.
     bootstrap: int = 30
+    # Write a synthetic measured-data example into this directory, print how to calibrate it, and stop.
+    make_example: str = ""
     # Stripe tables: image rows of the camera's frames (required unless the table has an image_height column).
     image_height: int | None = None
     # Stripe tables: seconds per unit of the exposure values (required unless the table states the unit, e.g. an
@@ -177,6 +180,13 @@ def main(argv: list[str] | None = None) -> None:
     cfg = draccus.parse(
         CalibrateConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv), bare_flags=())
     )
+    if cfg.make_example:
+        path = write_example(Path(cfg.make_example), seed=cfg.seed)
+        print(
+            f"wrote {path}; calibrate it with:\n  lerobot-phantom-calibrate --attack light_projection "
+            f"--measured {path} --out {Path(cfg.make_example) / 'calibration'}"
+        )
+        return
     report = calibrate(cfg)
     print(
         f"{report['attack']}: base held-out RMSE {report['base']['heldout_rmse']:.3g} {report['units']}, "

@@ -55,7 +55,12 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
     if not additive:
         specs.append(Param("opacity", 0.3, 0.0, 1.0, scale=0.3))
     if "channel_crosstalk" in effects:
-        specs += [Param(n, 0.3 if n[-2] == n[-1] else 0.0, -5.0, 5.0, scale=0.3) for n in CROSSTALK_NAMES]
+        # a primary's own gain is >= 0 and unbounded in physics (projector power over ambient light): the range
+        # only has to be wide enough never to decide a fit; leaks between channels may be negative (colour matrix)
+        specs += [
+            Param(n, 0.3, 0.0, 50.0, scale=0.3) if n[-2] == n[-1] else Param(n, 0.0, -10.0, 10.0, scale=0.3)
+            for n in CROSSTALK_NAMES
+        ]
     elif additive:
         specs.append(Param("strength", 0.3, 0.0, 20.0, scale=0.3))
     if "albedo_modulation" in effects:

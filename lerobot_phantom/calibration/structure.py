@@ -12,7 +12,7 @@ Run on the held-out residual of the model that is written (base + identified eff
   Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
 
 Either finding also needs to matter: the structured part of the residual (eta squared, or the lag correlation,
-times the residual's mean square) must be at least ``MIN_SHARE_OF_BASE`` (2%) of the base model's held-out mean
+times the residual's mean square) must be at least ``MIN_SHARE_OF_BASE`` (0.5%) of the base model's held-out mean
 squared error - a remnant of a model that is otherwise right is not reported as a missing cause.
 
 A problem supplies its residuals through ``Problem.residual_sample`` (None: not tested). The finding names what
@@ -30,7 +30,7 @@ from lerobot_phantom.calibration.identify import bootstrap
 BINS = 8
 MIN_EXPLAINED = 0.02
 MIN_LAG_CORR = 0.25
-MIN_SHARE_OF_BASE = 0.02
+MIN_SHARE_OF_BASE = 0.005
 LAG = 3
 PERMUTATIONS = 200
 DRAWS = 200
@@ -85,7 +85,7 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
         "tested_on": "held-out residual of the written model (base + identified effects)",
         "rule": f"a variable's binned mean explains > max({MIN_EXPLAINED}, permutation 99th percentile) of the "
         f"residual variance at the low end of a 90% item-bootstrap interval; neighbours {LAG} values apart "
-        f"correlate > {MIN_LAG_CORR} at its low end; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.0f}% "
+        f"correlate > {MIN_LAG_CORR} at its low end; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% "
         "of the base model's held-out mean squared error",
         "tests": [],
         "structure_remains": False,
