@@ -241,9 +241,15 @@ class StripeProblem(Problem):
         exposure = float(np.median(self.exposure_s))
         shortest = float(np.min(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
         if "integration_offset" in effects:
-            longest = float(max(self.exposure_s.max(), (1.0 / self.frequency_hz).max()))
+            # the sensor may add up to the longest exposure setting, and cannot remove more than the shortest
             specs.append(
-                Param("integration_offset_s", 0.0, -float(self.exposure_s.min()), longest, scale=exposure)
+                Param(
+                    "integration_offset_s",
+                    0.0,
+                    -float(self.exposure_s.min()),
+                    float(self.exposure_s.max()),
+                    scale=exposure,
+                )
             )
         if "detection_threshold" in effects:
             specs.append(
@@ -299,7 +305,7 @@ class StripeProblem(Problem):
         grid = self.start_grid(specs, first)
         best = None
         # every rule starts from the nested model's values and the grid's best point(s): three for a first fit
-        n_grid = 1 if start is not None and "frames" in start.extra else 3
+        n_grid = 2 if start is not None and "frames" in start.extra else 3
         for rule in self.frame_rules:
             with torch.no_grad():
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
