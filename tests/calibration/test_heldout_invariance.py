@@ -44,7 +44,9 @@ def test_altering_heldout_frames_changes_scores_but_no_fit(tmp_path):
 
     def run(folder, name):
         return calibrate(
-            CalibrateConfig(attack="em_truncation", measured=str(folder), out=str(tmp_path / name), seed=seed)
+            CalibrateConfig(
+                attack="em_truncation", measured=str(folder), out=str(tmp_path / f"out_{name}"), seed=seed
+            )
         )
 
     original = run(measured, "original")
@@ -80,7 +82,7 @@ def test_altering_heldout_table_rows_of_the_shared_triples_changes_no_fit(tmp_pa
     def run(path, name):
         return calibrate(
             CalibrateConfig(
-                attack="light_projection", measured=str(path), out=str(tmp_path / name), seed=seed
+                attack="light_projection", measured=str(path), out=str(tmp_path / f"out_{name}"), seed=seed
             )
         )
 
