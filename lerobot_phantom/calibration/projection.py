@@ -102,7 +102,10 @@ def projection_predict(
         total = surface_lin + light
     else:
         opacity = params["opacity"] * strength
-        total = (1.0 - opacity) * surface_lin + opacity * light
+        # with cross-talk the matrix carries the projected light's scale itself: opacity x matrix would let the
+        # two trade off without bound (only their product is seen), so opacity only dims the surface
+        seen = strength * light if "channel_crosstalk" in effects else opacity * light
+        total = (1.0 - opacity) * surface_lin + seen
     if "clipping" in effects:
         total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
     if gamma:
@@ -149,7 +152,9 @@ def projection_kwargs(fit: Fit) -> dict:
     if "channel_crosstalk" in effects and not additive:
         kwargs["strength"] = p["opacity"]
     if "channel_crosstalk" in effects:
-        kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+        # the blend transform scales the matrix by its opacity: hand it the matrix per unit opacity
+        per_unit = 1.0 if additive else 1.0 / max(p["opacity"], 1e-6)
+        kwargs["crosstalk"] = [[per_unit * p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
     return kwargs
