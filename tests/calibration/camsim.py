@@ -599,6 +599,10 @@ def ultrasound_blur_pairs(
     pairs = []
     for intensity in intensities(rng, n_pairs, 0.3, 1.0):
         refl, light = scene(rng, cam)
+        # a blur is only seen on edges: a checkerboard texture over the whole scene (blocks of 4-7 px)
+        block = rng.uniform(4, 7)
+        yy, xx = np.mgrid[0 : cam.height, 0 : cam.width]
+        refl = refl * np.where((yy // block + xx // block) % 2 == 0, 1.0, 0.4)[..., None]
         clean, exposure = clean_capture(refl * light, cam, rng)
         d = intensity * amplitude
         if path == "sinusoidal":
