@@ -229,6 +229,8 @@ class Step:
     tried: dict[str, float]
     # per fit item: inner cross-validated squared error of this model (the item scored in its validation fold)
     item_errors: np.ndarray | None = None
+    # the first of an interacting pair kept together: its effect is judged with the pair (the next step)
+    paired: bool = False
 
 
 def cross_validated(
@@ -301,8 +303,10 @@ def forward_select(
         steps[-1].tried.update({"+".join(k): v[0] for k, v in pairs.items()})
         if pairs[pair][0] > (1.0 - 2.0 * margin) * current:
             break
-        first, second = sorted(pair, key=tried.__getitem__)
-        steps.append(Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2])))
+        first, second = pair
+        if second in tried and tried[second] < tried[first]:  # the better one alone is the intermediate step
+            first, second = second, first
+        steps.append(Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2]), paired=True))
         chosen = chosen | {first, second}
         current, parents, per_item = pairs[pair]
         steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))

@@ -234,8 +234,13 @@ def identify_selection(
     selected_fit = chain[-1]
     intervals = parameter_intervals(problem, selected_fit, fit_items, draws=draws, rng=rng)
     results, identified = [], []
-    for before, after in itertools.pairwise(steps):
+    for k, (before, after) in enumerate(itertools.pairwise(steps)):
         (effect,) = set(after.effects) - set(before.effects)
+        # an interacting pair (each useless alone) is judged by what the two bring together
+        if after.paired:
+            after = steps[k + 2]
+        elif before.paired:
+            before = steps[k - 1]
         ratio = None
         if before.item_errors is not None and after.item_errors is not None:
             ratio = error_ratio(before.item_errors, after.item_errors, draws=max(draws, 200), rng=rng)
