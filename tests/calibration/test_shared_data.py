@@ -81,9 +81,9 @@ def test_slap_triples(tmp_path, name):
 
 @pytest.mark.slow
 def test_laser_capture_beats_gaussian_spot(tmp_path):
-    report = run(tmp_path, "laser_blinding", "blinding/phantom_green_laser.png")
+    # all four captures: effects are shared, so one capture's halo exponent at its bound keeps halo unnamed
+    report = run(tmp_path, "laser_blinding", "blinding")
     assert report["gain"]["rmse_ratio_interval"]["low"] > 1.0
     assert_named_causes_are_identified(report)
-    capture = report["extended"]["derived"]["captures"][0]
     if "linear_light_saturation" in report["extended"]["effects"]:
-        assert capture["saturation_radius_px"] > 0
+        assert all(c["saturation_radius_px"] > 0 for c in report["extended"]["derived"]["captures"])
