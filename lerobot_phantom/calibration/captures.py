@@ -13,7 +13,8 @@ import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
-from lerobot_phantom.calibration.frames import REFERENCE_SIZE, SENSOR_GAMMA, load_rgb
+from lerobot_phantom.calibration.frame_models.common import REFERENCE_SIZE, SENSOR_GAMMA, load_rgb
+from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms import physics
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
@@ -76,44 +77,54 @@ class CaptureProblem(Problem):
         self.tile_of_pixel = ((ys // self.tile) * tiles_x + (xs // self.tile)).long().reshape(-1).numpy()
         self.n_tiles = int(self.tile_of_pixel.max()) + 1
         self.values = self.image.reshape(3, -1).T
-        self.rng = np.random.default_rng(seed)
-        self._init = self._initial_guess()
+        order = np.argsort(self.tile_of_pixel, kind="stable")
+        bounds = np.searchsorted(self.tile_of_pixel[order], np.arange(self.n_tiles + 1))
+        self.tile_pixels = [order[bounds[t] : bounds[t + 1]] for t in range(self.n_tiles)]
+        self.seed = seed
 
     @property
     def n_items(self) -> int:
         return self.n_tiles
 
     def pixels(self, items: np.ndarray, cap: int | None = None) -> torch.Tensor:
-        chosen = np.nonzero(np.isin(self.tile_of_pixel, items))[0]
+        """Pixel indices of the tiles ``items`` (a repeated tile repeats its pixels, as a bootstrap draw needs);
+        at most ``cap`` of them, a sample seeded by ``--seed`` and the tiles drawn."""
+        chosen = np.concatenate([self.tile_pixels[int(t)] for t in items]) if len(items) else np.zeros(0, int)
         if cap is not None and len(chosen) > cap:
-            chosen = np.sort(np.random.default_rng(len(chosen)).choice(chosen, cap, replace=False))
+            rng = np.random.default_rng([self.seed, len(chosen), int(np.sum(items))])
+            chosen = np.sort(rng.choice(chosen, cap, replace=False))
         return torch.as_tensor(chosen)
 
-    def _initial_guess(self) -> dict[str, float]:
-        luminance = self.values.mean(1)
-        background = self.values.median(0).values
+    def initial_guess(self, items: np.ndarray) -> dict[str, float]:
+        """Start values read from the fit tiles ``items`` only (held-out tiles never inform a fit)."""
+        pixels = self.pixels(np.unique(items))
+        values, xs, ys = self.values[pixels], self.xs[pixels], self.ys[pixels]
+        # areas measured on the fit tiles stand for the whole capture's
+        area_scale = self.n_tiles / max(len(np.unique(items)), 1)
+        luminance = values.mean(1)
+        background = values.median(0).values
         peak = float(luminance.max())
         bright = luminance >= peak - 0.05 * max(peak - float(luminance.min()), 1e-6)
         half = luminance >= 0.5 * (peak + float(luminance.median()))
-        sigma = max(1.0, float(np.sqrt(half.sum().item() / np.pi)) / 1.18)
-        guess = {"cx": float(self.xs[bright].mean()), "cy": float(self.ys[bright].mean()), "sigma": sigma}
+        sigma = max(1.0, float(np.sqrt(area_scale * half.sum().item() / np.pi)) / 1.18)
+        guess = {"cx": float(xs[bright].mean()), "cy": float(ys[bright].mean()), "sigma": sigma}
         # a saturating spot: channel c clips inside radius R_c where A_c * exp(-R_c^2 / 2 sigma^2) = 1; take the
         # weakest saturated channel's disc as ~1.5 sigma
-        saturated = [float((self.values[:, c] >= 0.98).sum()) for c in range(3)]
+        saturated = [area_scale * float((values[:, c] >= 0.98).sum()) for c in range(3)]
         radii = [float(np.sqrt(n / np.pi)) for n in saturated]
         core = min([r for r in radii if r > 0] or [sigma])
         guess["linear_sigma"] = max(core / 1.5, 1.0)
         for c, name in enumerate("rgb"):
             guess[f"background_{name}"] = float(background[c])
-            guess[f"amplitude_{name}"] = max(float(self.values[:, c].max() - background[c]), 1e-3)
+            guess[f"amplitude_{name}"] = max(float(values[:, c].max() - background[c]), 1e-3)
             log_amplitude = (
                 radii[c] ** 2 / (2 * guess["linear_sigma"] ** 2) / np.log(10) if radii[c] > 0 else -1.0
             )
             guess[f"log10_amplitude_{name}"] = float(np.clip(log_amplitude, -3.0, 6.0))
         return guess
 
-    def param_specs(self, effects: frozenset[str]) -> list[Param]:
-        g = self._init
+    def param_specs(self, effects: frozenset[str], guess: dict[str, float] | None = None) -> list[Param]:
+        g = guess if guess is not None else self.initial_guess(np.arange(self.n_tiles))
         _, height, width = self.image.shape
         size = float(max(height, width))
         linear = "linear_light_saturation" in effects
@@ -174,12 +185,13 @@ class CaptureProblem(Problem):
                 # relative to a far higher peak
                 warm.pop("sigma")
                 warm.pop("log10_halo_amplitude", None)
+        refit = start is not None and start.effects == effects  # a bootstrap draw: start from the estimate
         params = fit_least_squares(
-            self.param_specs(effects),
+            self.param_specs(effects, self.initial_guess(items)),
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
-            starts=[{}] if warm else [],  # also from the defaults: saturated starts can stall
-            max_nfev=60,
+            starts=[{}] if warm and not refit else [],  # also from the defaults: saturated starts can stall
+            max_nfev=20 if refit else 60,
         )
         return Fit(effects, params)
 
@@ -194,6 +206,14 @@ class CaptureProblem(Problem):
         r, _ = self.residual(fit, items)
         return float((r**2).sum()), r.numel()
 
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        unique, inverse = np.unique(items, return_inverse=True)
+        r, pixels = self.residual(fit, unique)
+        tiles = np.searchsorted(unique, self.tile_of_pixel[pixels])
+        sq = np.bincount(tiles, weights=(r**2).sum(1).numpy(), minlength=len(unique))
+        counts = 3.0 * np.bincount(tiles, minlength=len(unique))
+        return sq[inverse], counts[inverse]
+
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:
         r, pixels = self.residual(fit, items)
         radius = np.hypot(
@@ -205,6 +225,24 @@ class CaptureProblem(Problem):
             "channel": binned_rmse(np.broadcast_to(np.arange(3), r.shape), r),
             "measured_level": binned_rmse(self.values.numpy()[pixels] * 255, r),
         }
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
+        """Per tile: residuals against the distance from the fitted spot centre, the measured level, channel."""
+        sample = ResidualSample([], {"radius_px": [], "measured_level": [], "channel": []})
+        r, pixels = self.residual(fit, np.unique(items))
+        r = r.numpy()
+        tiles = self.tile_of_pixel[pixels]
+        radius = np.hypot(
+            self.xs.numpy()[pixels] - fit.params["cx"], self.ys.numpy()[pixels] - fit.params["cy"]
+        )
+        level = self.values.numpy()[pixels] * 255
+        for tile in np.unique(tiles):
+            mine = tiles == tile
+            sample.residual.append(r[mine].ravel())
+            sample.covariates["radius_px"].append(np.repeat(radius[mine] * self.scale_to_original, 3))
+            sample.covariates["measured_level"].append(level[mine].ravel())
+            sample.covariates["channel"].append(np.tile(np.arange(3.0), int(mine.sum())))
+        return sample
 
     def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
         analysis = self.analyse(before, items)["radius_px"]
@@ -265,6 +303,7 @@ class MultiCapture(Problem):
     candidates = CAPTURE_EFFECTS
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
+        self.item_name = f"{CaptureProblem.tile}x{CaptureProblem.tile}-pixel tiles (captures resized to at most {max_side} px)"
         self.captures = [CaptureProblem(f, max_side=max_side, seed=seed) for f in capture_files(path)]
         self.offsets = np.cumsum([0] + [c.n_items for c in self.captures])
 
@@ -297,6 +336,24 @@ class MultiCapture(Problem):
                 total, count = total + sq, count + n
         return total, count
 
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        sq, counts = np.zeros(len(items)), np.zeros(len(items))
+        items = np.asarray(items)
+        for k, capture in enumerate(self.captures):
+            mine = np.flatnonzero((items >= self.offsets[k]) & (items < self.offsets[k + 1]))
+            if len(mine):
+                sq[mine], counts[mine] = capture.item_squared_errors(
+                    fit.extra["fits"][k], items[mine] - self.offsets[k]
+                )
+        return sq, counts
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        return [
+            Param(f"{c.path.name}.{p.name}", p.init, p.low, p.high, p.scale)
+            for c in self.captures
+            for p in c.param_specs(effects)
+        ]
+
     def per_capture_rmse(self, fit: Fit, items: np.ndarray) -> dict[str, float]:
         return {
             capture.path.name: capture.rmse(fit.extra["fits"][k], chosen)
@@ -317,6 +374,16 @@ class MultiCapture(Problem):
             f"{capture.path.name}: {capture.evidence(effect, before.extra['fits'][k], after.extra['fits'][k], chosen)}"
             for k, capture, chosen in self.local(items)
         )
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
+        sample = ResidualSample([], {"radius_px": [], "measured_level": [], "channel": []})
+        for k, capture, chosen in self.local(items):
+            if len(chosen):
+                part = capture.residual_sample(fit.extra["fits"][k], chosen, rng)
+                sample.residual += part.residual
+                for name in sample.covariates:
+                    sample.covariates[name] += part.covariates[name]
+        return sample
 
     def derived(self, fit: Fit) -> dict:
         per_capture = [c.derived(f) for c, f in zip(self.captures, fit.extra["fits"], strict=True)]

@@ -1,6 +1,6 @@
 """``lerobot-phantom-calibrate``: fit an attack simulation to measured data, name what it gets wrong, extend it.
 
-    lerobot-phantom-calibrate --attack laser_color_strip --measured ../shared/measured/rolling_shutter/logitech_stripe_rows.csv --out outputs/cal/stripes
+    lerobot-phantom-calibrate --attack laser_color_strip --measured ../shared/measured/rolling_shutter/logitech_stripe_rows.csv --image-height 720 --exposure-unit-s 1e-4 --out outputs/cal/stripes
     lerobot-phantom-calibrate --attack light_projection --measured slap_stop_sign_triples.csv --out outputs/cal/stop
     lerobot-phantom-calibrate --attack laser_blinding --measured ../shared/measured/blinding --out outputs/cal/laser
     lerobot-phantom-calibrate --attack ultrasound_blur --measured my_captures/ --out outputs/cal/blur   # pairs.csv
@@ -19,24 +19,26 @@ import sys
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
+from lerobot_phantom._cli import normalize_argv
 from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
 from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select, seeded_split, single_threaded
-from lerobot_phantom.calibration.frames import FRAME_PROBLEMS, FrameProblem, load_pairs
+from lerobot_phantom.calibration.example import write_example
+from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS, FrameProblem, load_pairs
+from lerobot_phantom.calibration.identify import identify_selection, parameter_intervals
 from lerobot_phantom.calibration.noise import apply_noise_finding, select_shot_noise
 from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
 from lerobot_phantom.calibration.report import build_report, write_outputs
-from lerobot_phantom.calibration.row_frames import ROW_FRAME_PROBLEMS
 from lerobot_phantom.calibration.stripes import StripeProblem, is_stripe_table
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
-ALL_FRAME_PROBLEMS = {**FRAME_PROBLEMS, **ROW_FRAME_PROBLEMS}
 SUPPORTED = {
     "stripe_table": ("laser_color_strip",),
     "colour_triples": ("light_projection",),
     "laser_captures": ("laser_blinding",),
-    "frame_pairs": tuple(ALL_FRAME_PROBLEMS),
+    "frame_pairs": tuple(FRAME_PROBLEMS),
 }
 
 
@@ -56,10 +58,18 @@ class CalibrateConfig:
     margin: float = 0.05
     # Inner cross-validation folds for selection.
     folds: int = 4
-    # Stripe tables: image rows of the camera's frames.
-    image_height: int = 720
-    # Stripe tables: seconds per unit of the table's exposure setting (UVC cameras: 100 microseconds).
-    exposure_unit_s: float = 1e-4
+    # Bootstrap resamples (over fit items) behind every parameter's interval; the gain's interval uses more.
+    bootstrap: int = 30
+    # Write a synthetic measured-data example into this directory, print how to calibrate it, and stop.
+    make_example: str = ""
+    # Stripe tables: image rows of the camera's frames (required unless the table has an image_height column).
+    image_height: int | None = None
+    # Stripe tables: seconds per unit of the exposure values (required unless the table states the unit, e.g. an
+    # exposure_us column or values such as "32us"; UVC cameras such as the Logitech table: 1e-4).
+    exposure_unit_s: float | None = None
+    # Stripe tables: which frames the table's means averaged: all, lit (frames with a lit row), interior (frames
+    # whose first and last rows are dark), or auto (the rule that fits the fit split best, reported).
+    stripe_frames: str = "auto"
     # Frame pairs: frames are resized so their longer side is at most this many pixels.
     max_side: int = 256
     # Laser captures: captures are resized so their longer side is at most this many pixels.
@@ -101,12 +111,14 @@ def build_problem(cfg: CalibrateConfig) -> Problem:
             f"not {cfg.attack!r}"
         )
     if kind == "stripe_table":
-        return StripeProblem(path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s)
+        return StripeProblem(
+            path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s, frames=cfg.stripe_frames
+        )
     if kind == "colour_triples":
         return TripleProblem(path)
     if kind == "laser_captures":
         return MultiCapture(path, max_side=cfg.capture_max_side, seed=cfg.seed)
-    return ALL_FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
+    return FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
 
 
 def calibrate(cfg: CalibrateConfig) -> dict:
@@ -120,24 +132,37 @@ def calibrate(cfg: CalibrateConfig) -> dict:
         )
     if not 0.0 <= cfg.margin < 1.0:
         raise ValueError(f"--margin must lie in [0, 1), got {cfg.margin}")
+    if cfg.bootstrap < 2:
+        raise ValueError(f"--bootstrap must be at least 2 resamples, got {cfg.bootstrap}")
     with single_threaded():
         problem = build_problem(cfg)
         fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
-        _effects, steps = forward_select(
+        # selection, fits and parameter intervals see the fit items only; each stage has its own stream, so
+        # nothing about the held-out items can change what is fitted or selected
+        _selected, steps = forward_select(
             problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
         )
         chain = fit_chain(problem, steps, fit_items)
-        base, extended = chain[0], chain[-1]
+        selection = identify_selection(
+            problem, steps, chain, fit_items, draws=cfg.bootstrap, rng=np.random.default_rng([cfg.seed, 1])
+        )
+        base, extended = chain[0], selection.fit
+        base_intervals = parameter_intervals(
+            problem, base, fit_items, draws=cfg.bootstrap, rng=np.random.default_rng([cfg.seed, 2])
+        )
         report = build_report(
             problem,
             input_path=Path(cfg.measured),
             fit_items=fit_items,
             heldout_items=heldout_items,
-            chain=chain,
+            base=base,
+            base_intervals=base_intervals,
+            selection=selection,
             steps=steps,
             seed=cfg.seed,
             margin=cfg.margin,
             folds=cfg.folds,
+            draws=cfg.bootstrap,
         )
         if isinstance(problem, FrameProblem):
             # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)
@@ -149,24 +174,22 @@ def calibrate(cfg: CalibrateConfig) -> dict:
     return report
 
 
-def normalize_argv(argv: list[str]) -> list[str]:
-    """Accept dashed option names (``--image-height``) for draccus's underscored fields."""
-    out = []
-    for arg in argv:
-        if arg.startswith("--"):
-            name, sep, value = arg[2:].partition("=")
-            arg = "--" + name.replace("-", "_") + sep + value
-        out.append(arg)
-    return out
-
-
 def main(argv: list[str] | None = None) -> None:
     from lerobot_phantom import register
 
     register()  # the LeRobot registrations (attacks as image transforms, env and policy types)
     import draccus
 
-    cfg = draccus.parse(CalibrateConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv)))
+    cfg = draccus.parse(
+        CalibrateConfig, args=normalize_argv(sys.argv[1:] if argv is None else list(argv), bare_flags=())
+    )
+    if cfg.make_example:
+        path = write_example(Path(cfg.make_example), seed=cfg.seed)
+        print(
+            f"wrote {path}; calibrate it with:\n  lerobot-phantom-calibrate --attack light_projection "
+            f"--measured {path} --out {Path(cfg.make_example) / 'calibration'}"
+        )
+        return
     report = calibrate(cfg)
     print(
         f"{report['attack']}: base held-out RMSE {report['base']['heldout_rmse']:.3g} {report['units']}, "

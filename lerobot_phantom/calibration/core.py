@@ -8,10 +8,7 @@ lowers the inner cross-validated RMSE is kept if it lowers it by a clear relativ
 
 from __future__ import annotations
 
-import ctypes
-import glob
 import math
-import os
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -19,26 +16,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import torch
 from scipy.optimize import least_squares
-
-
-def _openblas_libraries() -> list[tuple[ctypes.CDLL, str, str]]:
-    """The OpenBLAS builds numpy and scipy bundle (wheels), with their get/set thread-count symbols."""
-    import scipy
-
-    found = []
-    for package in (np, scipy):
-        folder = os.path.join(os.path.dirname(os.path.dirname(package.__file__)), f"{package.__name__}.libs")
-        for path in glob.glob(os.path.join(folder, "libscipy_openblas*.so")):
-            lib = ctypes.CDLL(path)
-            for suffix in ("64_", ""):
-                getter, setter = (
-                    f"scipy_openblas_get_num_threads{suffix}",
-                    f"scipy_openblas_set_num_threads{suffix}",
-                )
-                if hasattr(lib, getter) and hasattr(lib, setter):
-                    found.append((lib, getter, setter))
-                    break
-    return found
+from threadpoolctl import threadpool_limits
 
 
 @contextmanager
@@ -46,17 +24,12 @@ def single_threaded() -> Iterator[None]:
     """Run fits on one thread: the many small dense products of least squares slow down badly when BLAS and
     torch spread them over cores that other processes also use (measured: 6x on a loaded 2-core machine)."""
     torch_threads = torch.get_num_threads()
-    libraries = _openblas_libraries()
-    previous = [getattr(lib, getter)() for lib, getter, _ in libraries]
     torch.set_num_threads(1)
-    for lib, _, setter in libraries:
-        getattr(lib, setter)(1)
     try:
-        yield
+        with threadpool_limits(limits=1):
+            yield
     finally:
         torch.set_num_threads(torch_threads)
-        for (lib, _, setter), value in zip(libraries, previous, strict=True):
-            getattr(lib, setter)(value)
 
 
 @dataclass(frozen=True)
@@ -154,6 +127,10 @@ class Problem:
     base_model: str = ""
     extended_model: str = ""
     candidates: tuple[Effect, ...] = ()
+    item_name: str = "items"  # what one item is, for the report ("table rows", "whole image pairs")
+    heldout_definition: str = (
+        "RMSE of the model fitted on the fit items, predicting the held-out items from their inputs alone"
+    )
 
     @property
     def n_items(self) -> int:
@@ -170,6 +147,33 @@ class Problem:
     def rmse(self, fit: Fit, items: np.ndarray) -> float:
         total, count = self.squared_errors(fit, items)
         return math.sqrt(total / max(count, 1))
+
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per-item sums of squared errors and value counts (what item bootstraps resample)."""
+        pairs = [self.squared_errors(fit, np.array([i])) for i in items]
+        return np.array([p[0] for p in pairs], np.float64), np.array([p[1] for p in pairs], np.float64)
+
+    def registered_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+        """Problems with a per-item latent (``latent`` set): per-item squared errors with the latent fitted on each
+        item itself - a registration figure reported next to the predictive one, never used to choose a model."""
+        return None
+
+    # a per-item quantity the attacker does not report and physics cannot predict (a pulse phase); when set,
+    # ``squared_errors`` must score it predictively (marginalised over its fitted prior), never fit it per item
+    latent: str | None = None
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator):
+        """Residuals over ``items`` with the variables they may depend on (``structure.ResidualSample``), or
+        None when this input offers nothing to test."""
+        return None
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        """The fitted parameters of the model with ``effects`` (names and search bounds)."""
+        return []
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        """Parameter values at which ``effect`` reduces to the model without it ({} for a change of form)."""
+        return {}
 
     def analyse(self, fit: Fit, items: np.ndarray) -> dict[str, dict[str, list[float]]]:
         """Residual RMSE binned by the variables that could explain it: ``{variable: {"x": [...], "rmse": [...]}}``."""
@@ -223,18 +227,24 @@ class Step:
     effects: list[str]
     validation_rmse: float
     tried: dict[str, float]
+    # per fit item: inner cross-validated squared error of this model (the item scored in its validation fold)
+    item_errors: np.ndarray | None = None
+    # the first of an interacting pair kept together: its effect is judged with the pair (the next step)
+    paired: bool = False
 
 
 def cross_validated(
     problem: Problem, effects: frozenset[str], splits, parents: list[Fit] | None
-) -> tuple[float, list[Fit]]:
-    total, count, fits = 0.0, 0, []
+) -> tuple[float, list[Fit], dict[int, float]]:
+    """Validation RMSE over the folds, the fold fits, and each validation item's squared error."""
+    total, count, fits, per_item = 0.0, 0, [], {}
     for k, (train, val) in enumerate(splits):
         fit = problem.fit(effects, train, None if parents is None else parents[k])
-        sq, n = problem.squared_errors(fit, val)
-        total, count = total + sq, count + n
+        sq, n = problem.item_squared_errors(fit, val)
+        per_item.update({int(i): float(e) for i, e in zip(val, sq, strict=True)})
+        total, count = total + float(sq.sum()), count + float(n.sum())
         fits.append(fit)
-    return math.sqrt(total / max(count, 1)), fits
+    return math.sqrt(total / max(count, 1)), fits, per_item
 
 
 def forward_select(
@@ -246,32 +256,37 @@ def forward_select(
     folds: int = 4,
     max_train_items: int = 2500,
 ) -> tuple[frozenset[str], list[Step]]:
-    """Forward selection of extensions by inner k-fold validation RMSE, each step needing a ``margin`` gain."""
+    """Forward selection of extensions by inner k-fold validation RMSE, each step needing a ``margin`` gain.
+
+    Only ``fit_items`` are used. Every step keeps each fit item's validation squared error, so the effect size of
+    a step can be bootstrapped over items (``identify.error_ratio``)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
+
+    def aligned(per_item: dict[int, float]) -> np.ndarray:
+        return np.array([per_item[int(i)] for i in fit_items], np.float64)
+
     chosen: frozenset[str] = frozenset()
-    current, parents = cross_validated(problem, chosen, splits, None)
-    steps = [Step([], current, {})]
+    current, parents, per_item = cross_validated(problem, chosen, splits, None)
+    steps = [Step([], current, {}, aligned(per_item))]
     while True:
-        tried: dict[str, float] = {}
-        fits: dict[str, list[Fit]] = {}
+        scored: dict[str, tuple[float, list[Fit], dict[int, float]]] = {}
         for effect in problem.candidates:
             if effect.name in chosen or not set(effect.requires) <= chosen:
                 continue
-            tried[effect.name], fits[effect.name] = cross_validated(
-                problem, chosen | {effect.name}, splits, parents
-            )
-        if not tried:
+            scored[effect.name] = cross_validated(problem, chosen | {effect.name}, splits, parents)
+        if not scored:
             break
+        tried = {k: v[0] for k, v in scored.items()}
         best = min(tried, key=tried.__getitem__)
         steps[-1].tried = tried
         if tried[best] <= (1.0 - margin) * current:
             chosen = chosen | {best}
-            current, parents = tried[best], fits[best]
-            steps.append(Step(sorted(chosen), current, {}))
+            current, parents, per_item = scored[best]
+            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
             continue
         # Interacting effects can each be useless alone (a halo is invisible while the model cannot saturate):
         # before stopping, try pairs, which must then bring twice the margin.
-        pairs: dict[tuple[str, str], tuple[float, list[Fit]]] = {}
+        pairs: dict[tuple[str, str], tuple[float, list[Fit], dict[int, float]]] = {}
         for first in tried:
             for effect in problem.candidates:
                 second = effect.name
@@ -280,7 +295,7 @@ def forward_select(
                 if not set(effect.requires) <= chosen | {first}:
                     continue
                 pairs[(first, second)] = cross_validated(
-                    problem, chosen | {first, second}, splits, fits[first]
+                    problem, chosen | {first, second}, splits, scored[first][1]
                 )
         if not pairs:
             break
@@ -288,11 +303,13 @@ def forward_select(
         steps[-1].tried.update({"+".join(k): v[0] for k, v in pairs.items()})
         if pairs[pair][0] > (1.0 - 2.0 * margin) * current:
             break
-        first, second = sorted(pair, key=tried.__getitem__)
-        steps.append(Step(sorted(chosen | {first}), tried[first], {}))
+        first, second = pair
+        if second in tried and tried[second] < tried[first]:  # the better one alone is the intermediate step
+            first, second = second, first
+        steps.append(Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2]), paired=True))
         chosen = chosen | {first, second}
-        current, parents = pairs[pair]
-        steps.append(Step(sorted(chosen), current, {}))
+        current, parents, per_item = pairs[pair]
+        steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
     return chosen, steps
 
 

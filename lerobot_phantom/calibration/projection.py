@@ -14,6 +14,7 @@ import pandas as pd
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.structure import ResidualSample
 
 TRIPLE_COLUMNS = tuple(f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb")
 
@@ -54,7 +55,12 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
     if not additive:
         specs.append(Param("opacity", 0.3, 0.0, 1.0, scale=0.3))
     if "channel_crosstalk" in effects:
-        specs += [Param(n, 0.3 if n[-2] == n[-1] else 0.0, -5.0, 5.0, scale=0.3) for n in CROSSTALK_NAMES]
+        # a primary's own gain is >= 0 and unbounded in physics (projector power over ambient light): the range
+        # only has to be wide enough never to decide a fit; leaks between channels may be negative (colour matrix)
+        specs += [
+            Param(n, 0.3, 0.0, 50.0, scale=0.3) if n[-2] == n[-1] else Param(n, 0.0, -10.0, 10.0, scale=0.3)
+            for n in CROSSTALK_NAMES
+        ]
     elif additive:
         specs.append(Param("strength", 0.3, 0.0, 20.0, scale=0.3))
     if "albedo_modulation" in effects:
@@ -64,6 +70,17 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
     if "sensor_gamma" in effects:
         specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
     return specs
+
+
+def projection_nulls(effect: str) -> dict[str, float]:
+    """Values at which an effect reduces to the model without it (none for a change of form)."""
+    if effect == "channel_crosstalk":  # no camera channel picks up another projected channel
+        return {n: 0.0 for n in CROSSTALK_NAMES if n[-2] != n[-1]}
+    if effect == "clipping":
+        return {"white": 1.0}
+    if effect == "sensor_gamma":
+        return {"gamma": 1.0}
+    return {}
 
 
 def projection_predict(
@@ -85,7 +102,10 @@ def projection_predict(
         total = surface_lin + light
     else:
         opacity = params["opacity"] * strength
-        total = (1.0 - opacity) * surface_lin + opacity * light
+        # with cross-talk the matrix carries the projected light's scale itself: opacity x matrix would let the
+        # two trade off without bound (only their product is seen), so opacity only dims the surface
+        seen = strength * light if "channel_crosstalk" in effects else opacity * light
+        total = (1.0 - opacity) * surface_lin + seen
     if "clipping" in effects:
         total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
     if gamma:
@@ -132,7 +152,9 @@ def projection_kwargs(fit: Fit) -> dict:
     if "channel_crosstalk" in effects and not additive:
         kwargs["strength"] = p["opacity"]
     if "channel_crosstalk" in effects:
-        kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+        # the blend transform scales the matrix by its opacity: hand it the matrix per unit opacity
+        per_unit = 1.0 if additive else 1.0 / max(p["opacity"], 1e-6)
+        kwargs["crosstalk"] = [[per_unit * p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
     return kwargs
@@ -149,6 +171,7 @@ class TripleProblem(Problem):
     base_model = "alpha blend of surface and projected colour (the paper's light projection)"
     extended_model = "additive projector light"
     candidates = EFFECTS
+    item_name = "table rows"
 
     def __init__(self, path: Path) -> None:
         table = pd.read_csv(path)
@@ -194,6 +217,33 @@ class TripleProblem(Problem):
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
         r = self.residual(fit, items)
         return float(np.sum(r**2)), r.size
+
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return (self.residual(fit, items) ** 2).sum(1), np.full(len(items), 3.0)
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        return projection_specs(effects)
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        return projection_nulls(effect)
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
+        """Per row: the three channels' residuals against channel, surface and projected level."""
+        r = self.residual(fit, items)
+        index = torch.as_tensor(items)
+        surface = self.surface[index].numpy() * 255
+        projected = self.projected[index].numpy() * 255
+        channel = np.broadcast_to(np.arange(3.0), r.shape)
+        brightness = np.repeat(projected.sum(1, keepdims=True), 3, 1)
+        return ResidualSample(
+            list(r),
+            {
+                "channel": list(channel),
+                "surface_level": list(surface),
+                "projected_level": list(projected),
+                "projected_brightness": list(brightness),
+            },
+        )
 
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:
         r = self.residual(fit, items)

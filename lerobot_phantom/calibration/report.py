@@ -1,8 +1,27 @@
-"""Writing the calibration's outputs: report.json, report.md (+ figures) and calibrated.json."""
+"""Writing the calibration's outputs: report.json, report.md (+ figures) and calibrated.json.
+
+report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percentile bootstrap over items):
+
+- ``attack``, ``input`` {path, kind}, ``units``, ``n_fit``, ``n_heldout``, ``split`` {seed, items};
+- ``heldout_scoring`` {definition, latent}: how held-out items are scored; ``latent`` names the per-frame
+  quantity nobody can know in advance (None for inputs without one);
+- ``base`` / ``extended``: {model, params, param_intervals, heldout_rmse (predictive), heldout_rmse_interval,
+  [heldout_registered_rmse, heldout_expected_rmse] (latent inputs only)}; ``extended`` also has ``effects`` (the
+  identified ones only: what calibrated.json carries) and ``derived``;
+- ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
+  [, noise_scale_ratio]};
+- ``selection`` {criterion, selected (forward selection on fit items), steps, rejected};
+- ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
+  validation_ratio (interval, fit items only), params, intervals, nulls} (rule: ``calibration/identify.py``);
+- ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
+- ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
+  interval, significant, where, ...}]} (``calibration/structure.py``);
+- ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs);
+  ``per_capture_heldout_rmse`` (laser captures).
+"""
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from pathlib import Path
@@ -10,6 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from lerobot_phantom.calibration.core import Fit, Problem, Step
+from lerobot_phantom.calibration.identify import Interval, Selection, error_ratio, rmse_interval
+from lerobot_phantom.calibration.structure import residual_structure
 
 CALIBRATED_FILE = "calibrated.json"
 CALIBRATED_FORMAT = 1
@@ -28,63 +49,116 @@ def _clean(value):
     return value
 
 
+def heldout_scores(
+    problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng
+) -> tuple[dict, np.ndarray]:
+    """Held-out RMSE (predictive), its item-bootstrap interval, and for latent problems the registered RMSE."""
+    squared, counts = problem.item_squared_errors(fit, items)
+    scores = {
+        "heldout_rmse": math.sqrt(float(squared.sum()) / max(float(counts.sum()), 1.0)),
+        "heldout_rmse_interval": rmse_interval(squared, counts, draws=draws, rng=rng).as_dict(),
+    }
+    registered = problem.registered_squared_errors(fit, items)
+    if registered is not None:
+        expected = problem.expected_squared_errors(fit, items)
+        for name, (sq, n) in (("registered", registered), ("expected", expected)):
+            scores[f"heldout_{name}_rmse"] = math.sqrt(float(sq.sum()) / max(float(n.sum()), 1.0))
+    return scores, squared
+
+
 def build_report(
     problem: Problem,
     *,
     input_path: Path,
     fit_items: np.ndarray,
     heldout_items: np.ndarray,
-    chain: list[Fit],
+    base: Fit,
+    base_intervals: dict[str, Interval],
+    selection: Selection,
     steps: list[Step],
     seed: int,
     margin: float,
     folds: int,
+    draws: int,
 ) -> dict:
-    base, extended = chain[0], chain[-1]
-    base_rmse = problem.rmse(base, heldout_items)
-    extended_rmse = problem.rmse(extended, heldout_items)
+    """The report (schema in the module docstring)."""
+    extended = selection.fit
+    rng = np.random.default_rng([seed, 3])  # held-out statistics only: never feeds a fit
+    base_scores, base_squared = heldout_scores(problem, base, heldout_items, draws=max(draws, 200), rng=rng)
+    ext_scores, ext_squared = heldout_scores(problem, extended, heldout_items, draws=max(draws, 200), rng=rng)
+    ratio = error_ratio(base_squared, ext_squared, draws=max(draws, 200), rng=rng)
+    causes = {e.name: e.cause for e in problem.candidates}
     findings = []
-    for k, (before_step, after_step) in enumerate(itertools.pairwise(steps)):
-        (effect,) = set(after_step.effects) - set(before_step.effects)
-        previous, after = chain[k], chain[k + 1]
-        cause = next(e.cause for e in problem.candidates if e.name == effect)
+    for result in selection.results:
+        if not result["identified"]:
+            continue
+        effect = result["effect"]
+        step = next(s for s in steps if effect in s.effects)
+        before = steps[steps.index(step) - 1]
+        interval = result["validation_ratio"]
         evidence = (
-            f"inner validation RMSE {before_step.validation_rmse:.3g} -> {after_step.validation_rmse:.3g} "
-            f"{problem.units} ({100 * (1 - after_step.validation_rmse / before_step.validation_rmse):.1f}% lower); "
-            + problem.evidence(effect, previous, after, fit_items)
+            f"inner validation RMSE {before.validation_rmse:.3g} -> {step.validation_rmse:.3g} {problem.units} "
+            f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
+            f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
         )
-        findings.append({"effect": effect, "cause": cause, "evidence": evidence})
-    rejected = steps[-1].tried
+        if result["intervals"]:
+            evidence += "; " + ", ".join(
+                f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
+                for k, v in result["intervals"].items()
+            )
+        detail = problem.evidence(effect, base, extended, fit_items)  # the base's residual on the fit items
+        if detail:
+            evidence += "; " + detail
+        findings.append({"effect": effect, "cause": causes[effect], "evidence": evidence})
     report = {
         "attack": problem.attack,
         "input": {"path": str(input_path), "kind": problem.input_kind},
         "units": problem.units,
         "n_fit": len(fit_items),
         "n_heldout": len(heldout_items),
-        "split": {"seed": seed, "items": _item_name(problem)},
-        "base": {"model": problem.base_model, "params": base.params, "heldout_rmse": base_rmse},
+        "split": {"seed": seed, "items": problem.item_name},
+        "heldout_scoring": {"definition": problem.heldout_definition, "latent": problem.latent},
+        "base": {
+            "model": problem.base_model,
+            "params": base.params,
+            "param_intervals": {k: v.as_dict() for k, v in base_intervals.items()},
+            **base_scores,
+        },
         "findings": findings,
+        "identification": selection.results,
         "extended": {
             "model": problem.extended_model if extended.effects else problem.base_model,
-            "effects": [s for s in steps[-1].effects],
+            "effects": sorted(extended.effects),
             "params": extended.params,
-            "heldout_rmse": extended_rmse,
+            "param_intervals": {k: v.as_dict() for k, v in selection.intervals.items()},
+            **ext_scores,
             "derived": problem.derived(extended),
         },
         "gain": {
-            "rmse_ratio": base_rmse / max(extended_rmse, 1e-12),
-            "rmse_reduction": 1.0 - extended_rmse / max(base_rmse, 1e-12),
+            "rmse_ratio": base_scores["heldout_rmse"] / max(ext_scores["heldout_rmse"], 1e-12),
+            "rmse_ratio_interval": ratio.as_dict(),
+            "rmse_reduction": 1.0 - ext_scores["heldout_rmse"] / max(base_scores["heldout_rmse"], 1e-12),
             "selection_margin": margin,
         },
         "selection": {
-            "criterion": f"forward selection on the fit split by {folds}-fold cross-validated RMSE; each kept "
+            "criterion": f"forward selection on the fit items by {folds}-fold cross-validated RMSE; each kept "
             f"extension must lower it by >= {100 * margin:.0f}% (a pair of interacting extensions by "
-            f">= {200 * margin:.0f}%)",
+            f">= {200 * margin:.0f}%); then each kept extension must pass the identification rule "
+            "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
+            "bound, an interval excluding its null value",
+            "selected": selection.selected,
             "steps": [
                 {"effects": s.effects, "validation_rmse": s.validation_rmse, "tried": s.tried} for s in steps
             ],
-            "rejected": {k: v for k, v in rejected.items()},
+            "rejected": dict(steps[-1].tried),
         },
+        "unexplained_structure": residual_structure(
+            problem,
+            extended,
+            heldout_items,
+            base_mse=base_scores["heldout_rmse"] ** 2,
+            rng=np.random.default_rng([seed, 4]),
+        ),
         "residual_analysis": {
             "base": problem.analyse(base, heldout_items),
             "extended": problem.analyse(extended, heldout_items),
@@ -96,15 +170,6 @@ def build_report(
             "extended": problem.per_capture_rmse(extended, heldout_items),
         }
     return _clean(report)
-
-
-def _item_name(problem: Problem) -> str:
-    return {
-        "stripe_table": "table rows",
-        "colour_triples": "table rows",
-        "laser_captures": "8x8-pixel tiles (captures resized to at most 128 px)",
-        "frame_pairs": "whole image pairs",
-    }.get(problem.input_kind, "items")
 
 
 def calibrated_payload(problem: Problem, extended: Fit, report: dict) -> dict:
@@ -164,28 +229,53 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         "## What the simulation gets wrong",
         "",
         f"The paper's simulation ({base['model']}) fitted by least squares errs by **{base['heldout_rmse']:.3g}** "
-        f"{units} on held-out data.",
+        f"{_interval(base['heldout_rmse_interval'])} {units} on held-out data.",
+        "",
+        f"Held-out scoring: {report['heldout_scoring']['definition']}."
+        + (
+            f" Per-frame latent: {report['heldout_scoring']['latent']}. Registered (latent fitted on each held-out "
+            f"frame, for comparison only): base {base['heldout_registered_rmse']:.3g}, extended "
+            f"{ext['heldout_registered_rmse']:.3g}; expected over the latent's prior (a point prediction made "
+            f"without the frame): base {base['heldout_expected_rmse']:.3g}, extended "
+            f"{ext['heldout_expected_rmse']:.3g}."
+            if report["heldout_scoring"]["latent"]
+            else ""
+        ),
         "",
     ]
     if report["findings"]:
-        lines.append("Named causes, in the order forward selection kept them:")
+        lines.append("Named causes (selected on the fit items and identified by the rule below):")
         lines.append("")
         for finding in report["findings"]:
             lines.append(f"- **`{finding['effect']}`**: {finding['cause']}. Evidence: {finding['evidence']}.")
     else:
-        lines.append(
-            "No extension lowered the validation error by the required margin: the base model is kept "
-            "(its residual is noise the library cannot explain)."
-        )
+        lines.append("No extension was both selected and identified: the base model is kept.")
+    not_identified = [r for r in report["identification"] if not r["identified"]]
+    if not_identified:
+        lines += ["", "Selected but **not identified** (not a named cause, not in the written model):", ""]
+        lines += [f"- `{r['effect']}`: " + "; ".join(r["reasons"]) for r in not_identified]
+    structure = report["unexplained_structure"]
+    lines += [
+        "",
+        "## Unexplained structure",
+        "",
+        structure["summary"] + ".",
+        "",
+        f"Rule: {structure['rule']}.",
+    ]
     lines += [
         "",
         "## Extended model and gain",
         "",
         f"Extended model: {ext['model']} with effects {', '.join(f'`{e}`' for e in ext['effects']) or '(none)'}.",
-        f"Held-out RMSE **{ext['heldout_rmse']:.3g}** {units} vs **{base['heldout_rmse']:.3g}** for the base: "
-        f"ratio {gain['rmse_ratio']:.2f} ({100 * gain['rmse_reduction']:.0f}% lower).",
+        f"Held-out RMSE **{ext['heldout_rmse']:.3g}** {_interval(ext['heldout_rmse_interval'])} {units} vs "
+        f"**{base['heldout_rmse']:.3g}** for the base: ratio {gain['rmse_ratio']:.2f} "
+        f"{_interval(gain['rmse_ratio_interval'])} ({100 * gain['rmse_reduction']:.0f}% lower).",
         "",
-        "Fitted parameters: " + ", ".join(f"`{k}` = {_fmt(v)}" for k, v in ext["params"].items()),
+        "Fitted parameters (90% item-bootstrap intervals): "
+        + ", ".join(
+            f"`{k}` = {_fmt(v)} {_interval(ext['param_intervals'].get(k))}" for k, v in ext["params"].items()
+        ),
         "",
     ]
     derived = {k: v for k, v in ext.get("derived", {}).items() if k != "captures"}
@@ -239,6 +329,12 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
     lines += [f"![{name}]({name})" for name in figures]
     lines.append("")
     path.write_text("\n".join(lines))
+
+
+def _interval(interval: dict | None) -> str:
+    if not interval or interval.get("low") is None:
+        return ""
+    return f"[{interval['low']:.4g}, {interval['high']:.4g}]"
 
 
 def _fmt(value) -> str:

@@ -1,7 +1,14 @@
 """Stripe tables -> ``laser_color_strip``: how many rows a pulsed laser lights in a rolling-shutter camera.
 
 Base (the paper): a fixed band of rows whatever the laser and exposure settings (fitted height; the paper uses
-H/3). Extensions follow the rolling shutter: a row is lit when its exposure window overlaps a laser pulse.
+H/3). Extensions follow the rolling shutter term by term (``physics.rolling_shutter_rows_lit`` documents each):
+row readout time, the pulse/exposure overlap, the sensor's extra integration time, the detection threshold that
+drops partly lit rows, and blooming at stripe edges. Every prediction is the mean over a uniformly random pulse
+phase (the phase of one frame cannot be known in advance), so no held-out row informs its own prediction.
+
+Units and geometry come from the table when it says them (``exposure_us``/``exposure_ms``/``exposure_s`` columns
+or values such as ``32us``; an ``image_height``/``image_rows`` column); otherwise ``--exposure-unit-s`` and
+``--image-height`` are required. A ``camera`` column is only checked to hold one camera: names never imply units.
 """
 
 from __future__ import annotations
@@ -14,48 +21,179 @@ import pandas as pd
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
-from lerobot_phantom.transforms.physics import rolling_shutter_rows_lit
+from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutter_rows_lit
 
 STRIPE_COLUMNS = ("frequency", "exposure", "duty_cycle", "affected_rows_mean")
+EXPOSURE_COLUMN_UNITS = {"exposure_s": 1.0, "exposure_ms": 1e-3, "exposure_us": 1e-6}
+HEIGHT_COLUMNS = ("image_height", "image_rows")
+# unit suffixes a value may carry (case-insensitive); "u" and the micro sign both mean microseconds
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9}
+FREQUENCY_UNITS = {"hz": 1.0, "khz": 1e3, "mhz": 1e6}
+FRAME_RULE_CHOICES = ("auto", *STRIPE_FRAME_RULES)
 
+# The kernel's blooming term (spread_rows) is not a candidate: for one stripe per frame it adds the same rows as
+# integration_offset, so the two cannot be told apart from stripe tables.
 EFFECTS = (
     Effect(
         "exposure_overlap",
-        "a rolling shutter exposes rows one after another; a row is lit when its exposure window overlaps a laser "
-        "pulse, so the stripe spans (pulse on-time + exposure time) / row time rows instead of a fixed band",
+        "a rolling shutter exposes rows one after another (one row time apart); a row is lit when its exposure "
+        "window overlaps a laser pulse, so each stripe spans (pulse on-time + exposure) / row time rows, stripes "
+        "repeat every laser period, and the mean over a random pulse phase replaces a fixed band",
     ),
     Effect(
         "integration_offset",
-        "the sensor integrates light a little longer than the nominal exposure setting (a constant extra "
-        "integration time per row), widening every stripe by the same number of rows",
+        "the sensor integrates light a constant time longer (or shorter) than the nominal exposure setting, "
+        "widening every stripe by the same number of rows",
         requires=("exposure_overlap",),
     ),
     Effect(
-        "stripe_period",
-        "when the laser period is shorter than the frame readout, stripes repeat every 1 / (frequency x row "
-        "time) rows, so the lit share of the frame saturates",
+        "detection_threshold",
+        "a row counts as lit only when it collects a minimum on-time of laser light: rows at a stripe's edges, "
+        "lit for part of their exposure, drop out, and nothing is seen once pulse and exposure are both shorter",
         requires=("exposure_overlap",),
     ),
     Effect(
-        "edge_ramp",
-        "rows at a stripe's edges catch only part of a pulse (a ramp of brightness); rows below the detection "
-        "threshold are not counted, shrinking stripes by a share of the shorter of pulse and exposure",
-        requires=("exposure_overlap",),
+        "detection_noise",
+        "read noise makes the threshold soft: rows whose collected light is near it are lit in some frames and "
+        "not in others, so conditions at the edge of visibility still light a share of rows",
+        requires=("detection_threshold",),
     ),
 )
 
 
-def _number(value, what: str) -> float:
+def _value_and_unit(value, what: str) -> tuple[float, str]:
     if isinstance(value, int | float | np.number):
-        return float(value)
-    match = re.search(r"[-+]?\d*\.?\d+(?:[eE][-+]?\d+)?", str(value))
+        return float(value), ""
+    match = re.search(r"([-+]?\d*\.?\d+(?:[eE][-+]?\d+)?)\s*([A-Za-zµμ]*)\s*$", str(value).strip())
     if match is None:
         raise ValueError(f"cannot read a number from {what} value {value!r}")
-    return float(match.group())
+    return float(match.group(1)), match.group(2)
+
+
+def _frequencies_hz(values) -> np.ndarray:
+    out = []
+    for value in values:
+        number, unit = _value_and_unit(value, "frequency")
+        if unit and unit.lower() not in FREQUENCY_UNITS:
+            raise ValueError(
+                f"frequency {value!r}: unknown unit {unit!r}; valid: Hz, kHz, MHz or a plain number (Hz)"
+            )
+        out.append(number * FREQUENCY_UNITS.get(unit.lower(), 1.0))
+    return np.array(out)
+
+
+def _exposures(values) -> tuple[np.ndarray, float | None]:
+    """Exposure numbers and, if every value names a time unit, that unit in seconds (else None)."""
+    numbers, units = [], set()
+    for value in values:
+        number, unit = _value_and_unit(value, "exposure")
+        numbers.append(number)
+        units.add(unit)
+    known = {u for u in units if u.lower() in TIME_UNITS or u in TIME_UNITS}
+    if len(units) == 1 and known:
+        (unit,) = known
+        return np.array(numbers), TIME_UNITS.get(unit, TIME_UNITS.get(unit.lower()))
+    if known and len(units) > 1:
+        raise ValueError(f"exposure values mix units {sorted(units)}; give every value in one unit")
+    return np.array(numbers), None
 
 
 def is_stripe_table(columns) -> bool:
-    return set(STRIPE_COLUMNS) <= set(columns)
+    columns = set(columns)
+    has_exposure = "exposure" in columns or bool(columns & set(EXPOSURE_COLUMN_UNITS))
+    return has_exposure and {"frequency", "duty_cycle", "affected_rows_mean"} <= columns
+
+
+def read_stripe_table(
+    path: Path, *, image_height: int | None, exposure_unit_s: float | None
+) -> tuple[pd.DataFrame, dict]:
+    """The table plus its units and geometry, read from the data where it states them, else from the flags.
+
+    Returns ``(table, meta)`` with ``meta`` holding ``frequency_hz``, ``duty``, ``exposure_s`` (arrays),
+    ``image_height`` and ``sources`` (where each unit came from, for the report).
+    """
+    table = pd.read_csv(path)
+    if not is_stripe_table(table.columns):
+        raise ValueError(
+            f"{path}: stripe table needs columns frequency, exposure (or exposure_s / exposure_ms / exposure_us), "
+            f"duty_cycle, affected_rows_mean; has {list(table.columns)}"
+        )
+    if "camera" in table.columns and table["camera"].nunique() > 1:
+        raise ValueError(
+            f"{path}: the table mixes cameras {sorted(map(str, table['camera'].unique()))}; camera parameters "
+            "(row time, threshold) differ per camera, so calibrate one camera per table"
+        )
+    sources = {}
+    named = [c for c in EXPOSURE_COLUMN_UNITS if c in table.columns]
+    found = [*named, *(["exposure"] if "exposure" in table.columns else [])]
+    if len(found) > 1:
+        raise ValueError(f"{path}: several exposure columns {found}; keep one")
+    if named:
+        exposure, data_unit = _exposures(table[named[0]])
+        column_unit = EXPOSURE_COLUMN_UNITS[named[0]]
+        if data_unit is not None and data_unit != column_unit:
+            raise ValueError(f"{path}: column {named[0]} holds values in another unit")
+        data_unit, sources["exposure"] = column_unit, f"column {named[0]}"
+    else:
+        exposure, data_unit = _exposures(table["exposure"])
+        sources["exposure"] = "units written in the exposure values"
+    if data_unit is None:
+        if exposure_unit_s is None:
+            example = table[named[0] if named else "exposure"].iloc[0]
+            raise ValueError(
+                f"{path}: exposure values such as {example!r} carry no unit; give --exposure-unit-s (seconds per "
+                "unit: 1e-4 for UVC cameras such as the Logitech table, 1e-6 for microseconds, 1e-3 for "
+                "milliseconds) or name the column exposure_s / exposure_ms / exposure_us"
+            )
+        if exposure_unit_s <= 0:
+            raise ValueError(f"--exposure-unit-s must be positive, got {exposure_unit_s}")
+        data_unit, sources["exposure"] = float(exposure_unit_s), "--exposure-unit-s"
+    elif exposure_unit_s is not None and not np.isclose(exposure_unit_s, data_unit):
+        raise ValueError(
+            f"{path}: --exposure-unit-s {exposure_unit_s} contradicts the table ({sources['exposure']}: "
+            f"{data_unit} s per unit); drop the flag"
+        )
+    heights = [c for c in HEIGHT_COLUMNS if c in table.columns]
+    if heights:
+        values = table[heights[0]].unique()
+        if len(values) != 1:
+            raise ValueError(
+                f"{path}: column {heights[0]} holds several heights {sorted(values)}; one per table"
+            )
+        data_height = int(values[0])
+        if image_height is not None and image_height != data_height:
+            raise ValueError(
+                f"{path}: --image-height {image_height} contradicts column {heights[0]} ({data_height}); drop the flag"
+            )
+        image_height, sources["image_height"] = data_height, f"column {heights[0]}"
+    elif image_height is None:
+        raise ValueError(
+            f"{path}: the table does not give the frame height; give --image-height (rows of the camera's frames, "
+            "e.g. 720 for the Logitech table) or add an image_height column"
+        )
+    else:
+        sources["image_height"] = "--image-height"
+    if image_height <= 0:
+        raise ValueError(f"--image-height must be positive, got {image_height}")
+    frequency_hz = _frequencies_hz(table["frequency"])
+    duty = np.array([_value_and_unit(v, "duty_cycle")[0] for v in table["duty_cycle"]]) / 100.0
+    sources["frequency"] = "Hz (unit written in the values, or plain numbers read as Hz)"
+    sources["duty_cycle"] = "percent of the laser period"
+    rows = table["affected_rows_mean"].to_numpy(dtype=np.float64)
+    if (frequency_hz <= 0).any() or not np.isfinite(rows).all() or ((duty <= 0) | (duty > 1)).any():
+        raise ValueError(
+            f"{path}: frequencies must be positive, duty cycles in (0, 100] and row counts finite"
+        )
+    meta = {
+        "frequency_hz": frequency_hz,
+        "duty": duty,
+        "exposure_s": exposure * data_unit,
+        "exposure_setting": exposure,
+        "rows": rows,
+        "image_height": int(image_height),
+        "sources": sources,
+    }
+    return table, meta
 
 
 class StripeProblem(Problem):
@@ -63,26 +201,29 @@ class StripeProblem(Problem):
     input_kind = "stripe_table"
     units = "rows"
     base_model = "fixed band of rows (the paper's laser color strip, band height fitted)"
-    extended_model = "rolling-shutter pulse/exposure overlap"
+    extended_model = "rolling shutter: phase-averaged pulse/exposure overlap over the row readout"
     candidates = EFFECTS
 
-    def __init__(self, path: Path, *, image_height: int, exposure_unit_s: float) -> None:
-        table = pd.read_csv(path)
-        missing = [c for c in STRIPE_COLUMNS if c not in table.columns]
-        if missing:
-            raise ValueError(f"{path}: stripe table lacks columns {missing}; needs {list(STRIPE_COLUMNS)}")
-        if image_height <= 0 or exposure_unit_s <= 0:
-            raise ValueError("--image-height and --exposure-unit-s must be positive")
+    def __init__(
+        self,
+        path: Path,
+        *,
+        image_height: int | None,
+        exposure_unit_s: float | None,
+        frames: str = "auto",
+    ) -> None:
+        if frames not in FRAME_RULE_CHOICES:
+            raise ValueError(f"--stripe-frames {frames!r} unknown; valid: {', '.join(FRAME_RULE_CHOICES)}")
+        _table, meta = read_stripe_table(path, image_height=image_height, exposure_unit_s=exposure_unit_s)
         self.path = path
-        self.image_height = int(image_height)
-        self.exposure_unit_s = float(exposure_unit_s)
-        self.frequency_hz = np.array([_number(v, "frequency") for v in table["frequency"]])
-        self.exposure_setting = np.array([_number(v, "exposure") for v in table["exposure"]])
-        self.duty = np.array([_number(v, "duty_cycle") for v in table["duty_cycle"]]) / 100.0
-        self.rows = table["affected_rows_mean"].to_numpy(dtype=np.float64)
-        if (self.frequency_hz <= 0).any() or not np.isfinite(self.rows).all():
-            raise ValueError(f"{path}: frequencies must be positive and row counts finite")
-        self.exposure_s = self.exposure_setting * self.exposure_unit_s
+        self.frame_rules = STRIPE_FRAME_RULES if frames == "auto" else (frames,)
+        self.image_height = meta["image_height"]
+        self.sources = meta["sources"]
+        self.frequency_hz = meta["frequency_hz"]
+        self.duty = meta["duty"]
+        self.exposure_s = meta["exposure_s"]
+        self.exposure_setting = meta["exposure_setting"]
+        self.rows = meta["rows"]
 
     @property
     def n_items(self) -> int:
@@ -93,16 +234,38 @@ class StripeProblem(Problem):
         height = self.image_height
         if "exposure_overlap" not in effects:
             return [Param("band_rows", height / 3.0, 0.0, float(height), scale=height / 3.0)]
-        # a full-frame readout in ~1/30 s is typical; the bounds allow 1 us .. 10 ms per row
+        # start: a full-frame readout in 1/30 s (other readouts are tried as further starts, see fit); bounds: a
+        # video camera reads a frame out in 0.1 ms .. 200 ms
         row_time = 1.0 / (30.0 * height)
-        specs = [Param("row_time_s", row_time, 1e-6, 1e-2, scale=row_time)]
+        specs = [Param("row_time_s", row_time, 1e-4 / height, 0.2 / height, scale=row_time)]
+        exposure = float(np.median(self.exposure_s))
+        shortest = float(np.min(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
         if "integration_offset" in effects:
-            specs.append(Param("integration_offset_s", 0.0, -0.05, 0.05, scale=1e-3))
-        if "edge_ramp" in effects:
-            specs.append(Param("edge_threshold", 0.1, 0.0, 0.5, scale=0.1))
+            # the sensor may add up to the longest exposure setting, and cannot remove more than the shortest
+            specs.append(
+                Param(
+                    "integration_offset_s",
+                    0.0,
+                    -float(self.exposure_s.min()),
+                    float(self.exposure_s.max()),
+                    scale=exposure,
+                )
+            )
+        if "detection_threshold" in effects:
+            specs.append(
+                Param("threshold_s", 0.1 * shortest, 0.0, exposure + shortest, scale=max(shortest, 1e-7))
+            )
+        if "detection_noise" in effects:
+            specs.append(
+                Param("noise_s", 0.3 * shortest, 0.0, exposure + shortest, scale=max(shortest, 1e-7))
+            )
+        if "edge_spread" in effects:
+            specs.append(Param("spread_rows", 1.0, 0.0, height / 4.0, scale=5.0))
         return specs
 
-    def predict(self, effects: frozenset[str], params: dict, items: np.ndarray) -> torch.Tensor:
+    def predict(
+        self, effects: frozenset[str], params: dict, items: np.ndarray, frames: str = "lit"
+    ) -> torch.Tensor:
         if "exposure_overlap" not in effects:
             return torch.as_tensor(params["band_rows"], dtype=torch.float64).expand(len(items))
         return rolling_shutter_rows_lit(
@@ -112,21 +275,90 @@ class StripeProblem(Problem):
             params["row_time_s"],
             image_rows=self.image_height,
             integration_offset_s=params.get("integration_offset_s", 0.0),
-            edge_threshold=params.get("edge_threshold", 0.0),
-            periodic="stripe_period" in effects,
+            threshold_s=params.get("threshold_s", 0.0),
+            spread_rows=params.get("spread_rows", 0.0),
+            noise_s=params.get("noise_s"),
+            frames=frames,
         )
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        """Least squares per frame rule (which frames the table averaged; see ``rolling_shutter_rows_lit``),
+        keeping the rule with the lower fit error; row time is started from several frame readouts."""
         target = torch.as_tensor(self.rows[items])
-        params = fit_least_squares(
-            self.param_specs(effects),
-            lambda p: self.predict(effects, p, items) - target,
-            warm=None if start is None else start.params,
-        )
-        return Fit(effects, params)
+        specs = self.param_specs(effects)
+        if "exposure_overlap" not in effects:
+            params = fit_least_squares(specs, lambda p: self.predict(effects, p, items) - target)
+            return Fit(effects, params)
+        if start is not None and start.effects == effects and "frames" in start.extra:
+            # a refit of the same model (bootstrap): keep its frame rule and start from its values
+            rule = start.extra["frames"]
+            params = fit_least_squares(
+                specs, lambda p: self.predict(effects, p, items, rule) - target, warm=start.params
+            )
+            return Fit(effects, params, {"frames": rule})
+        # the error surface has a local minimum per stripe-count regime (row time) and per threshold regime:
+        # each rule's fit starts from the best points of a grid (evaluated in one batched call) and from the
+        # nested model's values
+        first = {p.name: p.init for p in specs}
+        if start is not None:
+            first.update({k: v for k, v in start.params.items() if k in first})
+        grid = self.start_grid(specs, first)
+        best = None
+        # every rule starts from the nested model's values and the grid's best point(s): three for a first fit
+        n_grid = 2 if start is not None and "frames" in start.extra else 3
+        for rule in self.frame_rules:
+            with torch.no_grad():
+                batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
+                sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
+            order = torch.argsort(torch.nan_to_num(sse, nan=float("inf")))
+            tries = [first] + [{k: float(v[i]) for k, v in grid.items()} for i in order[:n_grid].tolist()]
+            for initial in tries:
+                params = fit_least_squares(
+                    specs, lambda p, rule=rule: self.predict(effects, p, items, rule) - target, warm=initial
+                )
+                with torch.no_grad():
+                    values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+                    error = float(torch.sum((self.predict(effects, values, items, rule) - target) ** 2))
+                if best is None or error < best[0]:
+                    best = (error, params, rule)
+        assert best is not None
+        return Fit(effects, best[1], {"frames": best[2]})
+
+    def start_grid(self, specs: list[Param], first: dict[str, float]) -> dict[str, np.ndarray]:
+        """Starting points: frame readouts 0.1 ms .. 200 ms (log grid) x offsets and thresholds in proportion to
+        the table's exposures and pulse widths x spreads of 0 and 2 rows, for the parameters the model has."""
+        exposure = float(np.median(self.exposure_s))
+        shorter = float(np.median(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
+        axes = {
+            "row_time_s": np.geomspace(specs[0].low, specs[0].high, 20)[1:-1],
+            "integration_offset_s": exposure * np.array([0.0, 0.3, 1.0]),
+            "threshold_s": shorter * np.array([0.03, 0.2, 1.0]),
+            "noise_s": shorter * np.array([0.03, 0.3]),
+            "spread_rows": np.array([0.0, 2.0]),
+        }
+        names = [p.name for p in specs]
+        bounds = {p.name: (p.low, p.high) for p in specs}
+        mesh = np.meshgrid(*(axes[n] for n in names), indexing="ij")
+        grid = {n: np.clip(m.ravel(), *bounds[n]) for n, m in zip(names, mesh, strict=True)}
+        return grid
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        """Parameter values at which an extension reduces to the model without it ({} = a change of form)."""
+        return {
+            "integration_offset": {"integration_offset_s": 0.0},
+            "detection_threshold": {"threshold_s": 0.0},
+            "detection_noise": {"noise_s": 0.0},
+            "edge_spread": {"spread_rows": 0.0},
+        }.get(effect, {})
+
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        return self.residual(fit, items) ** 2, np.ones(len(items))
+
+    def predict_fit(self, fit: Fit, items: np.ndarray) -> np.ndarray:
+        return self.predict(fit.effects, fit.params, items, fit.extra.get("frames", "lit")).numpy()
 
     def residual(self, fit: Fit, items: np.ndarray) -> np.ndarray:
-        return self.predict(fit.effects, fit.params, items).numpy() - self.rows[items]
+        return self.predict_fit(fit, items) - self.rows[items]
 
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
         residual = self.residual(fit, items)
@@ -135,23 +367,28 @@ class StripeProblem(Problem):
     # -- reporting -----------------------------------------------------------------------------------------
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:
         residual = self.residual(fit, items)
+        on = self.duty[items] / self.frequency_hz[items]
         return {
             "exposure_s": binned_rmse(self.exposure_s[items], residual),
             "duty": binned_rmse(self.duty[items], residual),
             "frequency_hz": binned_rmse(self.frequency_hz[items], residual),
             "signed_residual_vs_on_plus_exposure_s": {
-                "x": (self.duty[items] / self.frequency_hz[items] + self.exposure_s[items]).tolist(),
+                "x": (on + self.exposure_s[items]).tolist(),
                 "residual": residual.tolist(),
             },
         }
 
     def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
         res = self.residual(before, items)
+        on = self.duty[items] / self.frequency_hz[items]
+        row_time = before.params.get("row_time_s", after.params.get("row_time_s", 1.0))
         drivers = {
-            "exposure_overlap": self.duty[items] / self.frequency_hz[items] + self.exposure_s[items],
+            "exposure_overlap": on + self.exposure_s[items],
             "integration_offset": self.exposure_s[items],
-            "stripe_period": self.duty[items],
-            "edge_ramp": np.minimum(self.duty[items] / self.frequency_hz[items], self.exposure_s[items]),
+            "detection_threshold": np.minimum(on, self.exposure_s[items]),
+            "detection_noise": np.minimum(on, self.exposure_s[items]),
+            # stripes per frame: each brings two spread edges
+            "edge_spread": self.image_height * row_time * self.frequency_hz[items],
         }
         driver = drivers[effect]
         corr = float(np.corrcoef(driver, res)[0, 1]) if np.std(driver) > 0 and np.std(res) > 0 else 0.0
@@ -161,13 +398,24 @@ class StripeProblem(Problem):
         )
 
     def derived(self, fit: Fit) -> dict:
+        units = {f"unit_source_{k}": v for k, v in self.sources.items()}
         if "row_time_s" not in fit.params:
-            return {"band_fraction": fit.params["band_rows"] / self.image_height}
+            return {
+                "band_fraction": fit.params["band_rows"] / self.image_height,
+                "image_height": self.image_height,
+                **units,
+            }
         row_time = fit.params["row_time_s"]
         return {
             "row_time_us": row_time * 1e6,
             "frame_readout_ms": row_time * self.image_height * 1e3,
             "integration_offset_us": fit.params.get("integration_offset_s", 0.0) * 1e6,
+            "threshold_us": fit.params.get("threshold_s", 0.0) * 1e6,
+            "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
+            "spread_rows": fit.params.get("spread_rows", 0.0),
+            "frames_averaged": fit.extra.get("frames", "lit"),
+            "image_height": self.image_height,
+            **units,
         }
 
     def transform_kwargs(self, fit: Fit) -> dict:
@@ -179,7 +427,6 @@ class StripeProblem(Problem):
             "row_time_s": fit.params["row_time_s"],
             "frame_rows": self.image_height,
             "integration_offset_s": fit.params.get("integration_offset_s", 0.0),
-            "edge_threshold": fit.params.get("edge_threshold", 0.0),
         }
 
     def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir: Path) -> list[str]:
@@ -188,25 +435,20 @@ class StripeProblem(Problem):
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
 
-        everything = np.arange(self.n_items)
-        x = self.duty[everything] * 100
+        x = self.duty * 100
         fig, axes = plt.subplots(1, 2, figsize=(11, 4))
-        for exposure in np.unique(self.exposure_setting):
-            sel = np.where(self.exposure_setting == exposure)[0]
+        groups = {(e, f) for e, f in zip(self.exposure_setting, self.frequency_hz, strict=True)}
+        for exposure, frequency in sorted(groups)[:12]:
+            sel = np.where((self.exposure_setting == exposure) & (self.frequency_hz == frequency))[0]
             sel = sel[np.argsort(x[sel])]
-            line = axes[0].plot(x[sel], self.rows[sel], "o", ms=4, label=f"exposure {exposure:g}")[0]
-            axes[0].plot(
-                x[sel],
-                self.predict(extended.effects, extended.params, sel).numpy(),
-                "-",
-                color=line.get_color(),
-            )
+            label = f"exp {exposure:g}, {frequency:g} Hz"
+            line = axes[0].plot(x[sel], self.rows[sel], "o", ms=4, label=label)[0]
+            axes[0].plot(x[sel], self.predict_fit(extended, sel), "-", color=line.get_color())
         axes[0].axhline(base.params.get("band_rows", np.nan), color="k", ls="--", label="base (fixed band)")
         axes[0].set(xlabel="duty cycle (%)", ylabel="rows lit", title="measured (dots) vs extended (lines)")
-        axes[0].legend(fontsize=7)
+        axes[0].legend(fontsize=6)
         for fit, label in ((base, "base"), (extended, "extended")):
-            res = self.residual(fit, items)
-            axes[1].plot(self.duty[items] * 100, res, "o", label=label)
+            axes[1].plot(self.duty[items] * 100, self.residual(fit, items), "o", label=label)
         axes[1].axhline(0, color="k", lw=0.5)
         axes[1].set(xlabel="duty cycle (%)", ylabel="residual (rows), held-out", title="held-out residuals")
         axes[1].legend()

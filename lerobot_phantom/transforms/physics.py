@@ -258,32 +258,134 @@ def rolling_shutter_row_light(
     return (lit / torch.minimum(on, window).clamp(min=1e-12)).clamp(0.0, 1.0)
 
 
+STRIPE_FRAME_RULES = ("all", "lit", "interior")
+
+
+def pulse_overlap_lit_time(
+    period_s: torch.Tensor,
+    on_s: torch.Tensor,
+    window_s: torch.Tensor,
+    threshold_s: float | torch.Tensor = 0.0,
+    noise_s: float | torch.Tensor | None = None,
+) -> torch.Tensor:
+    """Length of the set of row start times, within one laser period, whose exposure collects more than
+    ``threshold_s`` seconds of pulse -> same shape as the inputs (broadcast).
+
+    A row starting at ``t`` integrates ``L(t) = on-time of the pulse train inside [t, t + window]``. ``L`` is
+    periodic and piecewise linear with kinks where a window edge meets a pulse edge (``t = 0, on, -window,
+    on - window`` modulo the period), so the time above the threshold is exact segment by segment. Threshold 0
+    gives ``on + window`` (capped at the period): the pulse/exposure overlap; a threshold shortens it by twice
+    the threshold while it is below ``min(on, window)`` (the partly lit rows at both edges of a stripe are not
+    counted) and nothing is lit once it exceeds the most a window can collect. With ``noise_s`` (the sensor's
+    read noise in seconds of laser light) the threshold is soft: the expected time a row reads above it.
+    """
+    period, on, window, threshold = torch.broadcast_tensors(
+        *(
+            torch.as_tensor(v, dtype=torch.float64) if not torch.is_tensor(v) else v
+            for v in (period_s, on_s, window_s, threshold_s)
+        )
+    )
+    zero = torch.zeros_like(period)
+    kinks = torch.stack([zero, on, -window, on - window], dim=-1)
+    kinks = torch.remainder(kinks, period.unsqueeze(-1))
+    knots = torch.cat([zero.unsqueeze(-1), torch.sort(kinks, dim=-1).values, period.unsqueeze(-1)], dim=-1)
+    light = cumulative_on_time(knots + window.unsqueeze(-1), period.unsqueeze(-1), on.unsqueeze(-1))
+    light = light - cumulative_on_time(knots, period.unsqueeze(-1), on.unsqueeze(-1))
+    lengths = knots[..., 1:] - knots[..., :-1]
+    if noise_s is None:
+        high = torch.maximum(light[..., 1:], light[..., :-1])
+        low = torch.minimum(light[..., 1:], light[..., :-1])
+        share = ((high - threshold.unsqueeze(-1)) / (high - low).clamp(min=1e-15)).clamp(0.0, 1.0)
+        return (share * lengths).sum(-1)
+    # read noise: a row is lit with probability Phi((L - threshold) / noise); along a linear piece of L the
+    # integral of Phi(z) is G(z) = z Phi(z) + phi(z) over the slope
+    noise = torch.as_tensor(noise_s, dtype=light.dtype).clamp(min=1e-15).unsqueeze(-1)
+    z = (light - threshold.unsqueeze(-1)) / noise
+    z0, z1 = z[..., :-1], z[..., 1:]
+
+    def antiderivative(v):
+        return v * torch.special.ndtr(v) + torch.exp(-0.5 * v * v) / math.sqrt(2.0 * math.pi)
+
+    flat = (z1 - z0).abs() < 1e-6
+    slope = torch.where(flat, torch.ones_like(z0), z1 - z0)
+    share = torch.where(
+        flat, torch.special.ndtr(0.5 * (z0 + z1)), (antiderivative(z1) - antiderivative(z0)) / slope
+    )
+    return (share * lengths).sum(-1)
+
+
 def rolling_shutter_rows_lit(
     frequency_hz: torch.Tensor,
     duty: torch.Tensor,
     exposure_s: torch.Tensor,
     row_time_s: float | torch.Tensor,
     *,
-    image_rows: int,
+    image_rows: int | torch.Tensor,
     integration_offset_s: float | torch.Tensor = 0.0,
-    edge_threshold: float | torch.Tensor = 0.0,
-    periodic: bool = False,
+    threshold_s: float | torch.Tensor = 0.0,
+    spread_rows: float | torch.Tensor = 0.0,
+    noise_s: float | torch.Tensor | None = None,
+    frames: str = "lit",
 ) -> torch.Tensor:
-    """Expected number of rows a pulsed laser lights (averaged over the pulse phase), vectorised over conditions.
+    """Mean number of rows a pulsed laser lights per counted frame, over a uniformly random pulse phase.
 
-    One stripe spans ``(on_time + exposure + offset) / row_time`` rows (the pulse/exposure overlap), minus the
-    two edge ramps' parts below ``edge_threshold`` (fraction of the peak); with ``periodic`` a stripe repeats
-    every ``1 / (frequency * row_time)`` rows, so the lit fraction of the frame saturates at 1.
+    Terms (each a camera or measurement property; the laser sets ``frequency_hz`` and ``duty``):
+
+    - readout: row ``r`` starts exposing ``r * row_time_s`` after row 0 (rolling shutter), so one period of the
+      laser spans ``1 / (frequency * row_time)`` rows and a frame of ``image_rows`` rows sees
+      ``image_rows * row_time * frequency`` periods (several stripes when the laser is faster than the readout).
+    - exposure window: each row integrates for ``exposure + integration_offset_s`` (the sensor's true
+      integration time differs from the nominal setting by a constant).
+    - pulse width vs exposure: a row is lit when the pulse train's on-time inside its window exceeds
+      ``threshold_s`` (the detection threshold, as seconds of laser light; ``pulse_overlap_lit_time``), so one
+      stripe covers ``on + window - 2 threshold`` of start time while the threshold is below the shorter of the
+      two; rows at the stripe's edges, lit only in part, drop out first. Read noise (``noise_s``, seconds of
+      laser light) makes that detection probabilistic near the threshold (a soft threshold).
+    - edge spread: blooming and the optics' glare widen every stripe by ``spread_rows`` at each edge.
+    - phase and aliasing: the pulse phase relative to the frame is unknowable per frame (it drifts when the laser
+      and frame rates beat), so the prediction is the expectation over a uniform phase. Which frames the
+      measurement averaged over matters at low frequency, where many frames catch no pulse:
+      ``frames="all"`` every frame (``rows * lit share``); ``"lit"`` frames with at least one lit row (a frame
+      catches a pulse with probability ``((rows - 1) min(lit, row_time) + lit) / period``, capped at 1);
+      ``"interior"`` only frames whose first and last rows are dark (cameras with dead lines: every stripe fully
+      visible; the count is the stripe width times the mean number of whole stripes that fit).
     """
-    on = duty.clamp(0.0, 1.0) / frequency_hz
-    window = (exposure_s + integration_offset_s).clamp(min=0.0)
-    width = (on + window - 2.0 * edge_threshold * torch.minimum(on, window)) / row_time_s
-    width = width.clamp(min=0.0)
-    if periodic:
-        period_rows = 1.0 / (frequency_hz * row_time_s)
-        many = image_rows * torch.clamp(width / period_rows, max=1.0)
-        return torch.where(period_rows < image_rows, many, width.clamp(max=image_rows))
-    return width.clamp(max=image_rows)
+    if frames not in STRIPE_FRAME_RULES:
+        raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
+    frequency_hz = torch.as_tensor(frequency_hz, dtype=torch.float64)
+    period = 1.0 / frequency_hz
+    on = torch.as_tensor(duty, dtype=torch.float64).clamp(0.0, 1.0) * period
+    window = (torch.as_tensor(exposure_s, dtype=torch.float64) + integration_offset_s).clamp(min=0.0)
+    row_time = torch.as_tensor(row_time_s, dtype=torch.float64)
+    height = torch.as_tensor(image_rows, dtype=torch.float64)
+    lit_time = pulse_overlap_lit_time(period, on, window, threshold_s, noise_s)
+    # blooming widens stripes that exist; it lights nothing where no row reaches the threshold
+    spread = torch.where(lit_time > 0, 2.0 * spread_rows * row_time, torch.zeros_like(lit_time))
+    lit_time = (lit_time + spread).clamp(max=period)
+    share = lit_time / period
+    if frames == "all":
+        return height * share
+    catch = ((height - 1.0) * torch.minimum(lit_time, row_time) + lit_time) / period
+    lit_frames = height * share / catch.clamp(min=1e-12, max=1.0)
+    lit_frames = torch.where(lit_time > 0, lit_frames, torch.zeros_like(lit_frames))
+    if frames == "lit":
+        return lit_frames
+    # interior: in rows, with period p and stripe width w; given row 0 dark, the first stripe starts c rows in,
+    # c uniform on (0, p - w]; with c' = H - c the last row is dark when c' mod p >= w and ceil(c'/p) stripes fit
+    p, w = period / row_time, lit_time / row_time
+    lowest = height - p + w
+    total = torch.zeros_like(p)
+    weighted = torch.zeros_like(p)
+    first = torch.floor(lowest / p)
+    for j in (first, first + 1.0):
+        start = torch.maximum(torch.maximum(j * p + w, lowest), torch.zeros_like(p))
+        stop = torch.minimum((j + 1.0) * p, height)
+        length = (stop - start).clamp(min=0.0)
+        total = total + length
+        weighted = weighted + length * (j + 1.0)
+    interior = w * weighted / total.clamp(min=1e-12)
+    possible = (total > 0) & (w < p)
+    return torch.where(possible, interior, lit_frames)
 
 
 # ---------------------------------------------------------------------------------------------------------------

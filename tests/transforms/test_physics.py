@@ -88,16 +88,20 @@ def test_projected_light_on_black_surface_vanishes_with_albedo():
 
 def test_rolling_shutter_rows_match_overlap_formula():
     f, duty, exposure, row_time = torch.tensor([30.0]), torch.tensor([0.1]), torch.tensor([0.002]), 5e-5
-    rows = physics.rolling_shutter_rows_lit(f, duty, exposure, row_time, image_rows=720)
+    # whole stripes only ("interior" frames, one stripe per frame): (on time + exposure) / row time
+    rows = physics.rolling_shutter_rows_lit(f, duty, exposure, row_time, image_rows=480, frames="interior")
     assert float(rows) == pytest.approx((0.1 / 30 + 0.002) / 5e-5)
     offset = physics.rolling_shutter_rows_lit(
-        f, duty, exposure, row_time, image_rows=720, integration_offset_s=5e-4
+        f, duty, exposure, row_time, image_rows=480, integration_offset_s=5e-4, frames="interior"
     )
     assert float(offset - rows) == pytest.approx(10.0)
+    # every frame averaged: the lit share of a random phase, whatever the row time
+    every = physics.rolling_shutter_rows_lit(f, duty, exposure, row_time, image_rows=720, frames="all")
+    assert float(every) == pytest.approx(720 * (0.1 / 30 + 0.002) * 30)
     many = physics.rolling_shutter_rows_lit(
-        torch.tensor([1000.0]), torch.tensor([0.5]), exposure, row_time, image_rows=720, periodic=True
+        torch.tensor([1000.0]), torch.tensor([0.5]), exposure, row_time, image_rows=720
     )
-    assert float(many) == pytest.approx(720.0)  # stripes repeat faster than they are wide: the frame is lit
+    assert float(many) == pytest.approx(720.0)  # the window always holds part of a pulse: the frame is lit
 
 
 def test_rolling_shutter_row_light_counts_stripes():

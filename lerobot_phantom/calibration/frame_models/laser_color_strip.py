@@ -1,10 +1,4 @@
-"""Frame pairs for the row-structured attacks: EM truncation and the laser color strip.
-
-Both attacks act on whole sensor rows, and where in the frame they act is set by timing the attacker does not
-report (when the interference hits the frame buffer, the laser's pulse phase). As for the EM color strip, that
-placement is estimated from each frame itself, also for held-out frames; the fitted parameters are what the
-frames share (colour gains, stripe geometry).
-"""
+"""Laser color strip frame pairs: the rows a pulsed laser lights in a rolling-shutter camera."""
 
 from __future__ import annotations
 
@@ -14,116 +8,9 @@ import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
-from lerobot_phantom.calibration.frames import FrameProblem, Pair
+from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.laser_color_strip import band_rows, strip_profile
-
-# ---------------------------------------------------------------------------------------------------------------
-# EM truncation
-
-TRUNCATION_EFFECTS = (
-    Effect(
-        "free_band_position",
-        "the interference corrupts the frame-buffer address at a moment set by the attacker's signal timing, not "
-        "by how many rows are lost: the deleted band starts anywhere in the frame instead of at int(h * r)",
-    ),
-)
-
-
-def truncation_source_rows(height: int, num: int, start: int) -> np.ndarray:
-    """Source row of every output row when rows ``[start, start + num)`` are deleted and the tail is repeated."""
-    rows = np.arange(height)
-    shifted = (rows >= start) & (rows < height - num)
-    return np.where(shifted, rows + num, rows)
-
-
-def paper_start(height: int, num: int) -> int:
-    """The paper's band start ``int(h r) = num``, clamped so the band never overlaps the appended tail (as
-    ``transforms.em_truncation``)."""
-    return max(0, min(num, height - 2 * num))
-
-
-class TruncationFrames(FrameProblem):
-    """Which rows were lost is read from each frame by an exhaustive search over integer row counts (and, with
-    ``free_band_position``, band starts): the squared error of every (output row, source row) match is computed
-    once per pair, so the search is exact and costs no fitting."""
-
-    attack = "em_truncation"
-    base_model = (
-        "rows [int(h r), 2 int(h r)) deleted and the last int(h r) rows appended (the paper's EM truncation; the "
-        "ratio r read from each frame by a search over integer row counts)"
-    )
-    extended_model = "EM truncation with a free band position"
-    candidates = TRUNCATION_EFFECTS
-
-    def __init__(self, pairs: list[Pair], seed: int) -> None:
-        super().__init__(pairs, seed)
-        self._placements: dict[tuple[bool, int], tuple[int, int]] = {}
-
-    @staticmethod
-    def match_costs(pair: Pair) -> np.ndarray:
-        """``costs[i, j]``: squared error of predicting attacked row ``i`` by clean row ``j``."""
-        attacked = pair.attacked.permute(1, 0, 2).reshape(pair.height, -1)
-        clean = pair.clean.permute(1, 0, 2).reshape(pair.height, -1)
-        return (torch.cdist(attacked, clean) ** 2).numpy()
-
-    def placement(self, free_start: bool, index: int) -> tuple[int, int]:
-        """(rows lost, band start) that best explain pair ``index``."""
-        key = (free_start, index)
-        if key not in self._placements:
-            costs = self.match_costs(self.pairs[index])
-            height = len(costs)
-            rows = np.arange(height)
-            same = np.concatenate([[0.0], np.cumsum(np.diag(costs))])  # rows kept in place
-            best = (float(same[-1]), 0, 0)  # nothing lost
-            for num in range(1, height // 2 + 1):
-                moved = np.concatenate(
-                    [[0.0], np.cumsum(costs[rows[: height - num], rows[: height - num] + num])]
-                )
-                starts = (
-                    np.arange(0, height - 2 * num + 1) if free_start else np.array([paper_start(height, num)])
-                )
-                # rows < start stay, rows [start, h - num) move up by num, the last num rows repeat the tail
-                total = same[starts] + (moved[height - num] - moved[starts]) + (same[-1] - same[height - num])
-                k = int(np.argmin(total))
-                if total[k] < best[0]:
-                    best = (float(total[k]), num, int(starts[k]))
-            self._placements[key] = (best[1], best[2])
-        return self._placements[key]
-
-    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
-        num, start = self.placement("free_band_position" in fit.effects, index)
-        pair = self.pairs[index]
-        return pair.clean[:, torch.as_tensor(truncation_source_rows(pair.height, num, start))]
-
-    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
-        free = "free_band_position" in effects
-        ratios, starts, strengths = [], [], []
-        for i in items:
-            num, band_start = self.placement(free, int(i))
-            ratios.append(num / self.pairs[int(i)].height)
-            starts.append(band_start / self.pairs[int(i)].height)
-            strengths.append(self.pairs[int(i)].intensity)
-        s, r = np.asarray(strengths), np.asarray(ratios)
-        # the shared part: the ratio per unit of attack intensity (least squares through the origin)
-        params = {
-            "ratio_per_intensity": float((s * r).sum() / max((s * s).sum(), 1e-12)),
-            "mean_ratio": float(r.mean()),
-        }
-        if free:
-            params["mean_band_start_share"] = float(np.mean(starts))
-        return Fit(effects, params)
-
-    def transform_kwargs(self, fit: Fit) -> dict:
-        """``EMTruncation`` keeps its intensity -> ratio table; a free band position is reported, not simulated."""
-        return {}
-
-    def derived(self, fit: Fit) -> dict:
-        return {"ratio_at_intensity_1": fit.params["ratio_per_intensity"]}
-
-
-# ---------------------------------------------------------------------------------------------------------------
-# laser color strip
 
 STRIP_EFFECTS = (
     Effect(
@@ -143,16 +30,29 @@ SINGLE_PULSE_PERIOD = 4.0  # frame heights: a pulse train this slow puts at most
 PHASE_STEP_ROWS = 1.0
 
 
-class StripFrames(FrameProblem):
+class StripFrames(LatentFrameProblem):
     """Base: the paper's band (rows h//3 .. 2 (h//3), Gaussian-weighted), colour gains fitted. With
     ``exposure_overlap``: ``physics.rolling_shutter_row_light`` in units of frame heights (row time = 1 / h), the
-    pulse's on-time and the exposure fitted, its phase read from each frame; ``stripe_period`` fits the pulse
-    period too. Light scales with the pair's intensity."""
+    pulse's on-time and the exposure fitted; ``stripe_period`` fits the pulse period too. Light scales with the
+    pair's intensity. The laser is not synchronised with the camera, so the pulse phase is registered on fit
+    frames and, for held-out frames, marginalised over a uniform prior (every stripe position)."""
 
     attack = "laser_color_strip"
     base_model = "the paper's fixed Gaussian-weighted band (rows h/3 to 2h/3), per-channel strength fitted"
     extended_model = "rolling-shutter stripe (rows lit by pulse/exposure overlap)"
     candidates = STRIP_EFFECTS
+    latent = "pulse phase of each frame (the laser is not synchronised with the camera)"
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        if "exposure_overlap" not in effects:
+            return [Param(f"strength_{c}", 500.0, 0.0, 20000.0, scale=500.0) for c in "rgb"]
+        specs = [Param(f"peak_{c}", 0.3, 0.0, 4.0, scale=0.3) for c in "rgb"] + [
+            Param("on_share", 0.1, 1e-3, 1.0, scale=0.1),
+            Param("exposure_share", 0.05, 0.0, 1.0, scale=0.1),
+        ]
+        if "stripe_period" in effects:
+            specs.append(Param("period_share", 0.5, 0.05, 2.0, scale=0.3))
+        return specs
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
         super().__init__(pairs, seed)
@@ -197,8 +97,8 @@ class StripFrames(FrameProblem):
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
         return (pair.clean + added).clamp(0.0, 1.0)
 
-    def best_phase(self, params, index: int) -> float:
-        """The pulse phase (rows) that best explains pair ``index``: a grid search over every stripe position."""
+    def phase_costs(self, params, index: int) -> tuple[torch.Tensor, np.ndarray]:
+        """(pulse phases in rows, SSE of pair ``index`` for each): every stripe position, a row apart."""
         pair = self.pairs[index]
         height = pair.height
         if "period_share" in params:
@@ -212,9 +112,22 @@ class StripFrames(FrameProblem):
             gains = pair.intensity * self.stripe_gains(params).reshape(1, 3, 1, 1)
             predicted = (pair.clean.unsqueeze(0) + gains * light[:, None, :, None]).clamp(0.0, 1.0)
             cost = ((predicted - pair.attacked.unsqueeze(0)) ** 2).sum(dim=(1, 2, 3))
-        return float(phases[int(torch.argmin(cost))])
+        return phases, cost.numpy()
 
-    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+    def best_phase(self, params, index: int) -> float:
+        """The pulse phase (rows) that best explains pair ``index`` (registration)."""
+        phases, cost = self.phase_costs(params, index)
+        return float(phases[int(np.argmin(cost))])
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        if "exposure_overlap" not in fit.effects:  # the paper's band sits at a fixed place: nothing unknown
+            pair = self.pairs[index]
+            sse = float(((self.predict_registered(fit, index) - pair.attacked) ** 2).sum())
+            return np.array([sse]), np.ones(1)
+        _, cost = self.phase_costs(fit.params, index)
+        return cost, np.full(len(cost), 1.0 / len(cost))
+
+    def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
         with torch.no_grad():
             if "exposure_overlap" not in fit.effects:
                 params = {k: torch.as_tensor(v, dtype=torch.float64) for k, v in fit.params.items()}
@@ -242,28 +155,29 @@ class StripFrames(FrameProblem):
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         if "exposure_overlap" not in effects:
-            band = [Param(f"strength_{c}", 500.0, 0.0, 20000.0, scale=500.0) for c in "rgb"]
             params = fit_least_squares(
-                band,
+                self.param_specs(effects),
                 lambda p: torch.cat(
                     [(self.predict_band(p, int(i)) - self.pairs[int(i)].attacked).ravel() for i in items]
                 ),
             )
-            return Fit(effects, params)
-        specs = [Param(f"peak_{c}", 0.3, 0.0, 4.0, scale=0.3) for c in "rgb"] + [
-            Param("on_share", 0.1, 1e-3, 1.0, scale=0.1),
-            Param("exposure_share", 0.05, 0.0, 1.0, scale=0.1),
-        ]
+            return self.with_noise(Fit(effects, params), items)
+        specs = self.param_specs(effects)
         starts = [self.initial_stripe(items)]
         if "stripe_period" in effects:
-            specs.append(Param("period_share", 0.5, 0.05, 2.0, scale=0.3))
             shares = (0.25, 0.4, 0.6)
             starts = [{**starts[0], "period_share": share} for share in shares]
         if start is not None and "exposure_overlap" in start.effects:
             starts.insert(0, {**starts[0], **start.params})
+        rounds = 2
+        if start is not None and start.effects == effects:
+            starts, rounds = (
+                [start.params],
+                1,
+            )  # a refit of the same model (bootstrap draws): from its estimate
         best: tuple[float, dict] | None = None
         for params in starts:
-            for _ in range(2):  # alternate: phases given the stripe, stripe given the phases
+            for _ in range(rounds):  # alternate: phases given the stripe, stripe given the phases
                 phases = {int(i): self.best_phase(params, int(i)) for i in items}
 
                 def residuals(p, phases=phases):
@@ -292,7 +206,11 @@ class StripFrames(FrameProblem):
             if best is None or cost < best[0]:
                 best = (cost, params)
         assert best is not None
-        return Fit(effects, best[1])
+        return self.with_noise(Fit(effects, best[1]), items)
+
+    def with_noise(self, fit: Fit, items: np.ndarray) -> Fit:
+        fit.extra["noise_variance"] = self.noise_variance(fit, items)
+        return fit
 
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserColorStrip`` options: the colour split of the fitted light; with ``exposure_overlap`` the
@@ -326,6 +244,3 @@ class StripFrames(FrameProblem):
         if "period_share" in p:
             out["stripe_period_share"] = p["period_share"]
         return out
-
-
-ROW_FRAME_PROBLEMS = {"em_truncation": TruncationFrames, "laser_color_strip": StripFrames}

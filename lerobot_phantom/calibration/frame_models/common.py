@@ -1,0 +1,375 @@
+"""Frame pairs -> any camera attack: the shared part (loading ``pairs.csv``, per-pair scoring, residuals).
+
+A folder holds ``pairs.csv`` (clean, attacked[, pattern][, intensity], ...). Items are whole image pairs (held-out
+pairs are never seen while fitting). Frames are resized so that their longer side is at most ``max_side`` pixels
+(area averaging); pixel-sized parameters are reported on the package's 256-pixel reference scale. Each attack's
+frame model lives in its own module of this package.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import torch
+from PIL import Image
+from scipy.special import logsumexp
+
+from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.structure import LAG, ResidualSample
+
+REFERENCE_SIZE = 256
+
+SENSOR_GAMMA = Effect(
+    "sensor_gamma",
+    "the camera composes light in linear irradiance but stores gamma-encoded values, so effects that add or "
+    "average light are wrong when applied to the encoded pixel values",
+)
+
+
+def load_rgb(path: Path, size: tuple[int, int] | None = None, max_side: int | None = None) -> torch.Tensor:
+    """An image file -> float64 (3, H, W) in [0, 1] (alpha dropped), resized to ``size`` (W, H) or ``max_side``."""
+    if not path.is_file():
+        raise FileNotFoundError(f"image not found: {path}")
+    image = Image.open(path).convert("RGB")
+    if size is None and max_side is not None and max(image.size) > max_side:
+        factor = max_side / max(image.size)
+        size = (max(1, round(image.size[0] * factor)), max(1, round(image.size[1] * factor)))
+    if size is not None and image.size != tuple(size):
+        image = image.resize(tuple(size), Image.Resampling.BOX)
+    return torch.from_numpy(np.asarray(image, dtype=np.float64) / 255.0).permute(2, 0, 1).contiguous()
+
+
+@dataclass
+class Pair:
+    name: str
+    clean: torch.Tensor
+    attacked: torch.Tensor
+    pattern: torch.Tensor | None
+    intensity: float
+    settings: dict = field(default_factory=dict)
+    original_size: tuple[int, int] = (0, 0)  # (W, H) before resizing
+
+    @property
+    def height(self) -> int:
+        return self.clean.shape[1]
+
+    @property
+    def width(self) -> int:
+        return self.clean.shape[2]
+
+    @property
+    def to_reference(self) -> float:
+        """Pixels at this working size -> pixels at the 256-pixel reference scale."""
+        return REFERENCE_SIZE / max(self.height, self.width)
+
+
+def load_pairs(folder: Path, *, max_side: int) -> list[Pair]:
+    table_path = folder / "pairs.csv"
+    if not table_path.is_file():
+        raise FileNotFoundError(
+            f"{folder} has no pairs.csv (columns clean,attacked[,pattern][,intensity],...)"
+        )
+    table = pd.read_csv(table_path)
+    for column in ("clean", "attacked"):
+        if column not in table.columns:
+            raise ValueError(
+                f"{table_path} lacks column {column!r}; needs clean,attacked[,pattern][,intensity]"
+            )
+    pairs = []
+    for i, row in table.iterrows():
+        clean_path = folder / str(row["clean"])
+        with Image.open(clean_path) as probe:
+            original = probe.size
+        clean = load_rgb(clean_path, max_side=max_side)
+        size = (clean.shape[2], clean.shape[1])
+        with Image.open(folder / str(row["attacked"])) as probe:
+            if probe.size != original:
+                raise ValueError(
+                    f"pair {i}: clean {row['clean']} is {original} but attacked {row['attacked']} is {probe.size}"
+                )
+        attacked = load_rgb(folder / str(row["attacked"]), size=size)
+        pattern = None
+        if "pattern" in table.columns and isinstance(row["pattern"], str) and row["pattern"]:
+            pattern = load_rgb(folder / row["pattern"], size=size)
+        intensity = 1.0
+        if "intensity" in table.columns and not pd.isna(row["intensity"]):
+            intensity = float(row["intensity"])
+            if not 0.0 <= intensity <= 1.0:
+                raise ValueError(f"pair {i}: intensity must lie in [0, 1], got {intensity}")
+        extra = {k: row[k] for k in table.columns if k not in ("clean", "attacked", "pattern", "intensity")}
+        pairs.append(Pair(str(row["attacked"]), clean, attacked, pattern, intensity, extra, original))
+    if len(pairs) < 2:
+        raise ValueError(
+            f"{table_path}: need at least 2 pairs (one to fit, one to hold out), got {len(pairs)}"
+        )
+    return pairs
+
+
+class FrameProblem(Problem):
+    """Shared machinery: per-pair prediction, squared errors, residual analysis and figures."""
+
+    input_kind = "frame_pairs"
+    units = "grey levels (0-255)"
+    item_name = "whole image pairs"
+    structure_values_per_pair = 4000
+
+    def __init__(self, pairs: list[Pair], seed: int) -> None:
+        self.pairs = pairs
+        self.seed = seed
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
+        """Held-out residuals (grey levels) on a seeded sample of values per pair, against row and column
+        position, the clean pixel's level, the channel and the pair's intensity; neighbours ``LAG`` pixels apart
+        along rows and columns of the channel-mean residual."""
+        sample = ResidualSample([], {k: [] for k in ("row", "column", "clean_level", "channel", "intensity")})
+        sample.neighbours = {"neighbours_along_rows": [], "neighbours_along_columns": []}
+        for i in items:
+            pair = self.pairs[int(i)]
+            with torch.no_grad():
+                residual = (255.0 * (self.predict_pair(fit, int(i)) - pair.attacked)).numpy()
+            _, height, width = residual.shape
+            take = rng.choice(
+                residual.size, min(self.structure_values_per_pair, residual.size), replace=False
+            )
+            c, y, x = np.unravel_index(take, residual.shape)
+            sample.residual.append(residual[c, y, x])
+            sample.covariates["row"].append(y / max(height - 1, 1))
+            sample.covariates["column"].append(x / max(width - 1, 1))
+            sample.covariates["clean_level"].append(255.0 * pair.clean.numpy()[c, y, x])
+            sample.covariates["channel"].append(c.astype(np.float64))
+            sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
+            mean = residual.mean(0)
+            for name, (a, b) in {
+                "neighbours_along_rows": (mean[:, :-LAG], mean[:, LAG:]),
+                "neighbours_along_columns": (mean[:-LAG], mean[LAG:]),
+            }.items():
+                pick = rng.choice(a.size, min(self.structure_values_per_pair, a.size), replace=False)
+                sample.neighbours[name].append((a.ravel()[pick], b.ravel()[pick]))
+        return sample
+
+    @property
+    def n_items(self) -> int:
+        return len(self.pairs)
+
+    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+        raise NotImplementedError
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        total, count = 0.0, 0
+        for i in items:
+            residual = 255.0 * (self.predict_pair(fit, int(i)) - self.pairs[int(i)].attacked)
+            total += float((residual**2).sum())
+            count += residual.numel()
+        return total, count
+
+    def analyse(self, fit: Fit, items: np.ndarray) -> dict:
+        per_pair_s, per_pair_rmse = [], []
+        channel, row, radius, brightness, res_all = [], [], [], [], []
+        spectrum_r, spectrum_p = [], []
+        for i in items:
+            pair = self.pairs[int(i)]
+            residual = (255.0 * (self.predict_pair(fit, int(i)) - pair.attacked)).numpy()
+            per_pair_s.append(pair.intensity)
+            per_pair_rmse.append(float(np.sqrt(np.mean(residual**2))))
+            _, height, width = residual.shape
+            ys, xs = np.meshgrid(np.arange(height), np.arange(width), indexing="ij")
+            channel.append(np.broadcast_to(np.arange(3)[:, None, None], residual.shape).ravel())
+            row.append(np.broadcast_to(ys / max(height - 1, 1), residual.shape).ravel())
+            centre = self.centre(int(i))
+            r = np.hypot(xs - centre[0], ys - centre[1]) * pair.to_reference
+            radius.append(np.broadcast_to(r, residual.shape).ravel())
+            brightness.append(pair.clean.numpy().ravel() * 255)
+            res_all.append(residual.ravel())
+            power = np.abs(np.fft.fft2(residual.mean(0))) ** 2
+            fy = np.fft.fftfreq(height)[:, None]
+            fx = np.fft.fftfreq(width)[None, :]
+            spectrum_r.append(np.hypot(fx, fy).ravel())
+            spectrum_p.append(power.ravel() / power.size)
+        res = np.concatenate(res_all)
+        freq = np.concatenate(spectrum_r)
+        power = np.concatenate(spectrum_p)
+        edges = np.array([0, 0.02, 0.05, 0.1, 0.2, 0.35, 0.75])
+        band = np.clip(np.searchsorted(edges, freq, side="right") - 1, 0, len(edges) - 2)
+        return {
+            "intensity": {"x": per_pair_s, "rmse": per_pair_rmse},
+            "channel": binned_rmse(np.concatenate(channel), res),
+            "row_position": binned_rmse(np.concatenate(row), res),
+            "radius_ref_px": binned_rmse(np.concatenate(radius), res),
+            "clean_brightness": binned_rmse(np.concatenate(brightness), res),
+            "spatial_frequency": {
+                "x": [float(0.5 * (edges[k] + edges[k + 1])) for k in range(len(edges) - 1)],
+                "rmse": [
+                    float(np.sqrt(power[band == k].sum() / max(len(items), 1))) for k in range(len(edges) - 1)
+                ],
+            },
+        }
+
+    def centre(self, index: int) -> tuple[float, float]:
+        pair = self.pairs[index]
+        return (pair.width - 1) / 2.0, (pair.height - 1) / 2.0
+
+    def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
+        b = math.sqrt(self.squared_errors(before, items)[0] / max(self.squared_errors(before, items)[1], 1))
+        a = math.sqrt(self.squared_errors(after, items)[0] / max(self.squared_errors(after, items)[1], 1))
+        return f"on the fitting pairs adding {effect} takes the RMSE from {b:.2f} to {a:.2f} grey levels"
+
+    def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir: Path) -> list[str]:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+
+        index = int(items[0])
+        pair = self.pairs[index]
+        panels = [
+            ("clean", pair.clean),
+            ("measured attacked", pair.attacked),
+            ("base prediction", self.predict_pair(base, index)),
+            ("extended prediction", self.predict_pair(extended, index)),
+        ]
+        fig, axes = plt.subplots(2, 3, figsize=(12, 7))
+        for ax, (title, image) in zip(axes.ravel()[:4], panels, strict=True):
+            ax.imshow(image.permute(1, 2, 0).clamp(0, 1).numpy())
+            ax.set_title(title)
+        for ax, (title, fit) in zip(axes.ravel()[4:], (("base", base), ("extended", extended)), strict=True):
+            residual = (255.0 * (self.predict_pair(fit, index) - pair.attacked)).abs().mean(0).numpy()
+            shown = ax.imshow(residual, cmap="magma", vmin=0)
+            ax.set_title(f"|{title} residual| (grey levels), RMSE {np.sqrt(np.mean(residual**2)):.1f}")
+            fig.colorbar(shown, ax=ax, fraction=0.046)
+        for ax in axes.ravel():
+            ax.axis("off")
+        fig.suptitle(f"held-out pair {pair.name}")
+        fig.tight_layout()
+        path = out_dir / "residual_maps.png"
+        fig.savefig(path, dpi=90)
+        plt.close(fig)
+        return [path.name]
+
+
+def _pixel_sample(pair: Pair, count: int, rng: np.random.Generator) -> np.ndarray:
+    n = pair.height * pair.width
+    return np.sort(rng.choice(n, min(count, n), replace=False))
+
+
+class PixelProblem(FrameProblem):
+    """Attacks that act pixel by pixel given per-pixel features; fits use a seeded sample of pixels per pair."""
+
+    pixels_per_pair = 800
+
+    def __init__(self, pairs: list[Pair], seed: int) -> None:
+        super().__init__(pairs, seed)
+        rng = np.random.default_rng(seed)
+        self.samples = [torch.as_tensor(_pixel_sample(p, self.pixels_per_pair, rng)) for p in pairs]
+
+    def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
+        raise NotImplementedError
+
+    def predict_features(self, effects, params, feats: dict[str, torch.Tensor]) -> torch.Tensor:
+        raise NotImplementedError
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        raise NotImplementedError
+
+    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+        pair = self.pairs[index]
+        with torch.no_grad():
+            flat = self.predict_features(fit.effects, fit.params, self.features(index, None))
+        return flat.T.reshape(3, pair.height, pair.width)
+
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        feats = [self.features(int(i), self.samples[int(i)]) for i in items]
+        stacked = {k: torch.cat([f[k] for f in feats]) for k in feats[0]}
+        target = torch.cat(
+            [self.pairs[int(i)].attacked.reshape(3, -1)[:, self.samples[int(i)]].T for i in items]
+        )
+        params = fit_least_squares(
+            self.param_specs(effects),
+            lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
+            warm=self.warm(start, effects),
+            starts=[{}] if start is not None else [],  # also from the defaults: saturated starts can stall
+        )
+        return Fit(effects, params)
+
+    def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
+        return None if start is None else start.params
+
+
+def flat_pixels(image: torch.Tensor, pixels: torch.Tensor | None) -> torch.Tensor:
+    flat = image.reshape(3, -1)
+    return (flat if pixels is None else flat[:, pixels]).T
+
+
+class LatentFrameProblem(FrameProblem):
+    """Attacks whose placement in each frame is set by timing nobody reports (a pulse phase, the moment the
+    interference hits): a per-frame *latent*. Fits may register it on the fit frames (they are fit data). A held-out
+    frame is scored by the likelihood of its pixels with the latent *marginalised* over the prior the fitted model
+    gives it (``latent_candidates``: the possible values and their prior weights), never fitted on that frame:
+
+        effective SSE = -2 s^2 log sum_k w_k exp(-SSE_k / (2 s^2)),
+
+    with ``s^2`` the per-value residual variance of the fit frames (registered). It is the frame's Gaussian
+    negative log-likelihood in squared-error units: the registered SSE plus the price of not knowing the latent
+    (at most ``2 s^2 log K`` for K equally likely values), and exactly the SSE when the latent is known. The
+    "registered" figure (latent fitted on each held-out frame) is reported next to it, for comparison only."""
+
+    heldout_definition = (
+        "predictive: each held-out frame's per-frame latent is marginalised over the prior of the model fitted on "
+        "the fit frames (Gaussian likelihood with the fit frames' residual variance, expressed as an RMSE); the "
+        "'registered' RMSE fits the latent on each held-out frame itself and is reported for comparison only"
+    )
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """(SSE of pair ``index`` in [0, 1] units for every latent value the model allows, prior weights)."""
+        raise NotImplementedError
+
+    def registered_sse(self, fit: Fit, index: int) -> float:
+        """SSE of pair ``index`` ([0, 1] units) with the latent fitted on the pair itself."""
+        return float(self.latent_candidates(fit, index)[0].min())
+
+    def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
+        """The prediction with the latent fitted on the pair itself (figures, residual structure, noise)."""
+        raise NotImplementedError
+
+    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+        return self.predict_registered(fit, index)
+
+    def noise_variance(self, fit: Fit, items: np.ndarray) -> float:
+        """Per-value residual variance of the registered fit on ``items`` (fit frames)."""
+        total, count = 0.0, 0
+        for i in items:
+            total += self.registered_sse(fit, int(i))
+            count += 3 * self.pairs[int(i)].height * self.pairs[int(i)].width
+        return max(total / max(count, 1), 1e-8)
+
+    def effective_sse(self, fit: Fit, index: int) -> float:
+        sse, weight = self.latent_candidates(fit, index)
+        variance = fit.extra["noise_variance"]
+        keep = weight > 0
+        return float(-2.0 * variance * logsumexp(np.log(weight[keep]) - sse[keep] / (2.0 * variance)))
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        sq, counts = self.item_squared_errors(fit, items)
+        return float(sq.sum()), int(counts.sum())
+
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        sq = np.array([255.0**2 * self.effective_sse(fit, int(i)) for i in items])
+        counts = np.array([3.0 * self.pairs[int(i)].height * self.pairs[int(i)].width for i in items])
+        return sq, counts
+
+    def expected_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Per-item squared error expected over the latent's prior (a point prediction made without the frame)."""
+        sq = []
+        for i in items:
+            sse, weight = self.latent_candidates(fit, int(i))
+            sq.append(255.0**2 * float(np.sum(weight * sse) / np.sum(weight)))
+        counts = np.array([3.0 * self.pairs[int(i)].height * self.pairs[int(i)].width for i in items])
+        return np.array(sq), counts
+
+    def registered_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        sq = np.array([255.0**2 * self.registered_sse(fit, int(i)) for i in items])
+        counts = np.array([3.0 * self.pairs[int(i)].height * self.pairs[int(i)].width for i in items])
+        return sq, counts

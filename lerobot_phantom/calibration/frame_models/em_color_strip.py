@@ -1,0 +1,171 @@
+"""EM color strip frame pairs: rows decoded through the wrong colour map by electromagnetic interference."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
+from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem
+from lerobot_phantom.transforms import physics
+
+EM_EFFECTS = (
+    Effect(
+        "bayer_phase_flip",
+        "interference drops an odd number of rows from the video stream; every later row is then demosaiced with "
+        "the colour-filter phase off by one, so the wrong colours run from that row to the frame's end instead "
+        "of alternating in periodic bands",
+    ),
+)
+
+
+class EMStripFrames(LatentFrameProblem):
+    """Rows are either decoded correctly or through the wrong colour map. Where they go wrong (the bands' phase,
+    the flip row) is set by when the interference hits: registered on fit frames, and for held-out frames
+    marginalised over a uniform prior (every phase of the fitted period, every flip row)."""
+
+    attack = "em_color_strip"
+    base_model = (
+        "periodic bands of mis-decoded colour (the paper's EM color strip; period, phase, colour fitted)"
+    )
+    extended_model = "Bayer phase flip"
+    candidates = EM_EFFECTS
+    periods = tuple(np.linspace(0.04, 1.0, 49))  # band period as a share of the frame height
+    latent = "band phase or flip row of each frame (when the interference hits)"
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        specs = [Param("gain", 2.5, 0.0, 10.0), Param("offset", 50.0 / 255.0, -1.0, 1.0, 0.1)]
+        if "bayer_phase_flip" not in effects:
+            specs.append(Param("period", 0.25, self.periods[0], self.periods[-1]))
+        return specs
+
+    @staticmethod
+    def band_phase_costs(keep, swap, period_rows: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(phases, SSE for each, prior weight of each): one phase inside every interval of phases over which
+        the band mask stays the same (its edges cross a row at ``r mod P`` and ``(r - P/2) mod P``), weighted
+        by the interval's share of the period - every distinct band placement, exactly, under a uniform phase."""
+        rows = np.arange(len(keep))
+        edges = np.unique(
+            np.concatenate([rows % period_rows, (rows - 0.5 * period_rows) % period_rows, [0.0]])
+        )
+        bounds = np.append(edges, period_rows)
+        phases = 0.5 * (bounds[:-1] + bounds[1:])
+        weights = np.diff(bounds) / period_rows
+        masks = np.remainder(rows[None, :] - phases[:, None], period_rows) < 0.5 * period_rows
+        return phases, np.where(masks, swap[None, :], keep[None, :]).sum(1), weights
+
+    @staticmethod
+    def flip_row_costs(keep, swap) -> np.ndarray:
+        """SSE when rows from ``start`` on are flipped, for every start 0..h."""
+        return np.concatenate([[0.0], np.cumsum(keep)]) + np.concatenate([np.cumsum(swap[::-1])[::-1], [0.0]])
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        keep, swap = self.row_costs(fit.params, index)
+        if "bayer_phase_flip" in fit.effects:
+            sse = self.flip_row_costs(keep, swap)
+        else:
+            _, sse, weights = self.band_phase_costs(
+                keep, swap, fit.params["period"] * self.pairs[index].height
+            )
+            return sse, weights
+        return sse, np.full(len(sse), 1.0 / len(sse))
+
+    def row_costs(self, params, index: int) -> tuple[np.ndarray, np.ndarray]:
+        pair = self.pairs[index]
+        mapped = physics.em_color_map(pair.clean.unsqueeze(0), params["gain"], params["offset"])[0]
+        keep = ((pair.attacked - pair.clean) ** 2).sum(dim=(0, 2)).numpy()
+        swap = ((pair.attacked - mapped) ** 2).sum(dim=(0, 2)).numpy()
+        return keep, swap
+
+    @classmethod
+    def best_band_phase(cls, keep, swap, period_rows: float) -> tuple[float, float]:
+        phases, costs, _ = cls.band_phase_costs(keep, swap, period_rows)
+        k = int(np.argmin(costs))
+        return float(costs[k]), float(phases[k])
+
+    @classmethod
+    def best_flip_row(cls, keep, swap) -> tuple[float, int]:
+        costs = cls.flip_row_costs(keep, swap)
+        start = int(np.argmin(costs))
+        return float(costs[start]), start
+
+    def placements(self, effects, params, items) -> dict[int, tuple[str, float]]:
+        """Per-frame placement (band phase or flip row) registered on each frame: fit frames, figures."""
+        out = {}
+        for i in items:
+            keep, swap = self.row_costs(params, int(i))
+            if "bayer_phase_flip" in effects:
+                out[int(i)] = ("flip", float(self.best_flip_row(keep, swap)[1]))
+            else:
+                period = params["period"] * self.pairs[int(i)].height
+                out[int(i)] = ("bands", self.best_band_phase(keep, swap, period)[1])
+        return out
+
+    def mask(self, effects, params, index: int, placement) -> torch.Tensor:
+        height = self.pairs[index].height
+        kind, value = placement
+        if kind == "flip":
+            return physics.bayer_flip_mask(height, value)[0].double()
+        return physics.periodic_band_mask(height, params["period"] * height, value)[0].double()
+
+    def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
+        placement = self.placements(fit.effects, fit.params, [index])[index]
+        pair = self.pairs[index]
+        mask = self.mask(fit.effects, fit.params, index, placement)
+        mapped = physics.em_color_map(pair.clean.unsqueeze(0), fit.params["gain"], fit.params["offset"])[0]
+        return mask * mapped + (1 - mask) * pair.clean
+
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        params = {"gain": 2.5, "offset": 50.0 / 255.0, "period": 0.25}
+        rounds = 3  # alternate: placement given the colour map, colour map given the placement
+        if start is not None and start.effects == effects:
+            params, rounds = dict(start.params), 1  # a refit of the same model (bootstrap draws)
+        for _ in range(rounds):
+            if "bayer_phase_flip" not in effects:
+                row_costs = [self.row_costs(params, int(i)) for i in items]
+
+                def total(period, row_costs=row_costs):
+                    return sum(
+                        self.best_band_phase(keep, swap, period * self.pairs[int(i)].height)[0]
+                        for i, (keep, swap) in zip(items, row_costs, strict=True)
+                    )
+
+                coarse = min(self.periods, key=total)
+                step = self.periods[1] - self.periods[0]
+                fine = np.linspace(
+                    max(coarse - step, self.periods[0]), min(coarse + step, self.periods[-1]), 11
+                )
+                params["period"] = float(min(fine, key=total))
+            placement = self.placements(effects, params, items)
+            masks = {
+                int(i): self.mask(effects, params, int(i), placement[int(i)])[0, :, 0].bool() for i in items
+            }
+
+            def residuals(p, masks=masks):
+                parts = []
+                for i in items:
+                    pair = self.pairs[int(i)]
+                    rows = masks[int(i)]
+                    if rows.any():
+                        mapped = physics.em_color_map(
+                            pair.clean[:, rows].unsqueeze(0), p["gain"], p["offset"]
+                        )[0]
+                        parts.append((mapped - pair.attacked[:, rows]).ravel())
+                return torch.cat(parts) if parts else torch.zeros(1, dtype=torch.float64)
+
+            colour = fit_least_squares(
+                [Param("gain", params["gain"], 0.0, 10.0), Param("offset", params["offset"], -1.0, 1.0, 0.1)],
+                residuals,
+            )
+            params.update(colour)
+        if "bayer_phase_flip" in effects:
+            params.pop("period", None)
+        fit = Fit(effects, params)
+        fit.extra["noise_variance"] = self.noise_variance(fit, items)
+        return fit
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        """``EMColorStrip`` options: the Bayer-flip model with the fitted colour map (the paper's bands: none)."""
+        if "bayer_phase_flip" in fit.effects:
+            return {"model": "bayer_phase_flip", "gain": fit.params["gain"], "offset": fit.params["offset"]}
+        return {}

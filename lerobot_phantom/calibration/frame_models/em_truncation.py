@@ -1,0 +1,148 @@
+"""EM truncation frame pairs: a band of rows lost from the frame buffer, the tail repeated."""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from lerobot_phantom.calibration.core import Effect, Fit, Param
+from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
+
+TRUNCATION_EFFECTS = (
+    Effect(
+        "free_band_position",
+        "the interference corrupts the frame-buffer address at a moment set by the attacker's signal timing, not "
+        "by how many rows are lost: the deleted band starts anywhere in the frame instead of at int(h * r)",
+    ),
+)
+
+
+def truncation_source_rows(height: int, num: int, start: int) -> np.ndarray:
+    """Source row of every output row when rows ``[start, start + num)`` are deleted and the tail is repeated."""
+    rows = np.arange(height)
+    shifted = (rows >= start) & (rows < height - num)
+    return np.where(shifted, rows + num, rows)
+
+
+def paper_start(height: int, num: int) -> int:
+    """The paper's band start ``int(h r) = num``, clamped so the band never overlaps the appended tail (as
+    ``transforms.em_truncation``)."""
+    return max(0, min(num, height - 2 * num))
+
+
+class TruncationFrames(LatentFrameProblem):
+    """The fitted model predicts how many rows a frame loses from its intensity (``ratio_per_intensity``, with
+    the scatter of the fit frames' ratios about that line as its prior); where the band starts is the paper's
+    ``int(h r)``, or with ``free_band_position`` unknowable in advance (uniform over every possible start). Fit
+    frames are registered by an exhaustive search over row counts and starts (the squared error of every
+    (output row, source row) match is computed once per pair); held-out frames are scored with the latent
+    marginalised (``LatentFrameProblem``)."""
+
+    attack = "em_truncation"
+    base_model = (
+        "rows [int(h r), 2 int(h r)) deleted and the last int(h r) rows appended (the paper's EM truncation; the "
+        "ratio r predicted from the attack intensity by a fitted line)"
+    )
+    extended_model = "EM truncation with a free band position"
+    candidates = TRUNCATION_EFFECTS
+    latent = "rows lost and band start of each frame (timing of the interference)"
+
+    def __init__(self, pairs: list[Pair], seed: int) -> None:
+        super().__init__(pairs, seed)
+        self._costs: dict[int, np.ndarray] = {}
+        self._placements: dict[tuple[bool, int], tuple[int, int]] = {}
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        return [Param("ratio_per_intensity", 0.2, 0.0, 0.5), Param("ratio_spread", 0.0, 0.0, 0.5)]
+
+    def match_costs(self, index: int) -> np.ndarray:
+        """``costs[i, j]``: squared error of predicting attacked row ``i`` by clean row ``j`` (cached)."""
+        if index not in self._costs:
+            pair = self.pairs[index]
+            attacked = pair.attacked.permute(1, 0, 2).reshape(pair.height, -1)
+            clean = pair.clean.permute(1, 0, 2).reshape(pair.height, -1)
+            self._costs[index] = (torch.cdist(attacked, clean) ** 2).numpy()
+        return self._costs[index]
+
+    def band_costs(self, index: int, num: int, starts: np.ndarray) -> np.ndarray:
+        """SSE of pair ``index`` when ``num`` rows from each of ``starts`` are lost (the tail repeated)."""
+        costs = self.match_costs(index)
+        height = len(costs)
+        rows = np.arange(height)
+        same = np.concatenate([[0.0], np.cumsum(np.diag(costs))])  # rows kept in place
+        if num == 0:
+            return np.full(len(starts), same[-1])
+        moved = np.concatenate([[0.0], np.cumsum(costs[rows[: height - num], rows[: height - num] + num])])
+        # rows < start stay, rows [start, h - num) move up by num, the last num rows repeat the tail
+        return same[starts] + (moved[height - num] - moved[starts]) + (same[-1] - same[height - num])
+
+    def starts(self, free: bool, height: int, num: int) -> np.ndarray:
+        return np.arange(0, height - 2 * num + 1) if free else np.array([paper_start(height, num)])
+
+    def placement(self, free: bool, index: int) -> tuple[int, int]:
+        """(rows lost, band start) that best explain pair ``index`` (registration: fit frames, or reporting)."""
+        key = (free, index)
+        if key not in self._placements:
+            height = self.pairs[index].height
+            best = (np.inf, 0, 0)
+            for num in range(0, height // 2 + 1):
+                starts = self.starts(free, height, num)
+                total = self.band_costs(index, num, starts)
+                k = int(np.argmin(total))
+                if total[k] < best[0]:
+                    best = (float(total[k]), num, int(starts[k]))
+            self._placements[key] = (best[1], best[2])
+        return self._placements[key]
+
+    def predicted_counts(self, fit: Fit, index: int) -> np.ndarray:
+        """Rows lost the fitted model expects for pair ``index``: its intensity on the fitted line, plus each fit
+        frame's scatter about the line (the prior; equally likely)."""
+        pair = self.pairs[index]
+        ratios = fit.params["ratio_per_intensity"] * pair.intensity + np.asarray(fit.extra["ratio_scatter"])
+        return np.clip(np.round(ratios * pair.height).astype(int), 0, pair.height // 2)
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        free = "free_band_position" in fit.effects
+        height = self.pairs[index].height
+        counts, weights = np.unique(self.predicted_counts(fit, index), return_counts=True)
+        sse, prior = [], []
+        for num, weight in zip(counts, weights / weights.sum(), strict=True):
+            starts = self.starts(free, height, int(num))
+            sse.append(self.band_costs(index, int(num), starts))
+            prior.append(np.full(len(starts), weight / len(starts)))
+        return np.concatenate(sse), np.concatenate(prior)
+
+    def registered_sse(self, fit: Fit, index: int) -> float:
+        num, start = self.placement("free_band_position" in fit.effects, index)
+        return float(self.band_costs(index, num, np.array([start]))[0])
+
+    def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
+        num, start = self.placement("free_band_position" in fit.effects, index)
+        pair = self.pairs[index]
+        return pair.clean[:, torch.as_tensor(truncation_source_rows(pair.height, num, start))]
+
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        free = "free_band_position" in effects
+        ratios, strengths = [], []
+        for i in items:
+            num, _ = self.placement(free, int(i))
+            ratios.append(num / self.pairs[int(i)].height)
+            strengths.append(self.pairs[int(i)].intensity)
+        s, r = np.asarray(strengths), np.asarray(ratios)
+        # the shared part: the ratio per unit of attack intensity (least squares through the origin)
+        slope = float((s * r).sum() / max((s * s).sum(), 1e-12))
+        scatter = r - slope * s
+        fit = Fit(
+            effects,
+            {"ratio_per_intensity": slope, "ratio_spread": float(np.sqrt(np.mean(scatter**2)))},
+            {"ratio_scatter": scatter.tolist()},
+        )
+        fit.extra["noise_variance"] = self.noise_variance(fit, items)
+        return fit
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        """``EMTruncation`` keeps its intensity -> ratio table; a free band position is reported, not simulated."""
+        return {}
+
+    def derived(self, fit: Fit) -> dict:
+        return {"ratio_at_intensity_1": fit.params["ratio_per_intensity"]}

@@ -1,0 +1,56 @@
+"""Light projection frame pairs: the scene, the projected image and the captured frame, pixel by pixel."""
+
+from __future__ import annotations
+
+import torch
+
+from lerobot_phantom.calibration.core import Fit
+from lerobot_phantom.calibration.frame_models.common import Pair, PixelProblem, flat_pixels
+from lerobot_phantom.calibration.projection import (
+    EFFECTS as PROJECTION_EFFECTS,
+)
+from lerobot_phantom.calibration.projection import (
+    projection_kwargs,
+    projection_nulls,
+    projection_predict,
+    projection_specs,
+    projection_warm,
+)
+
+
+class ProjectionFrames(PixelProblem):
+    attack = "light_projection"
+    base_model = "alpha blend of the scene and the projected image (the paper's light projection)"
+    extended_model = "additive projector light"
+    candidates = PROJECTION_EFFECTS
+
+    def __init__(self, pairs: list[Pair], seed: int) -> None:
+        if any(p.pattern is None for p in pairs):
+            raise ValueError(
+                "light_projection frame pairs need a 'pattern' column: the image the attacker projected"
+            )
+        super().__init__(pairs, seed)
+
+    def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
+        pair = self.pairs[index]
+        surface = flat_pixels(pair.clean, pixels)
+        return {
+            "surface": surface,
+            "projected": flat_pixels(pair.pattern, pixels),
+            "strength": torch.full((len(surface), 1), pair.intensity, dtype=torch.float64),
+        }
+
+    def predict_features(self, effects, params, feats):
+        return projection_predict(feats["surface"], feats["projected"], feats["strength"], effects, params)
+
+    def param_specs(self, effects):
+        return projection_specs(effects)
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        return projection_nulls(effect)
+
+    def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
+        return projection_warm(start, effects)
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        return projection_kwargs(fit)

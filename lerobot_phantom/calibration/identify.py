@@ -1,0 +1,280 @@
+"""Identification: bootstrap intervals over items, and the rule that makes an extension a *named cause*.
+
+Every interval here is a percentile bootstrap over *items* (table rows, capture tiles, whole image pairs): items
+are drawn with replacement, the statistic is recomputed, and the ``(1 - level) / 2`` and ``(1 + level) / 2``
+quantiles of the draws bound it. Items, not values, are resampled because the values inside one item (the pixels
+of one frame) are not independent.
+
+The rule (:func:`identify`): an extension is a named cause only if
+
+1. it was selected by the stated criterion on the fit items only (forward selection by inner cross-validation);
+2. its effect size on fit data is real: the bootstrap interval of the inner cross-validated error ratio
+   (model without it / model with it, paired over the same validation items) lies above 1;
+3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
+   range, not the camera);
+4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
+   a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
+   least one such parameter excludes its null value.
+
+Otherwise it is reported as "not identified" with the reasons, and it is not part of the model that is written.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from lerobot_phantom.calibration.core import Fit, Param, Problem, Step
+
+LEVEL = 0.9  # two-sided coverage of every reported interval
+BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
+
+
+@dataclass(frozen=True)
+class Interval:
+    """A point estimate with its percentile bootstrap interval."""
+
+    estimate: float
+    low: float
+    high: float
+    level: float = LEVEL
+    draws: int = 0
+
+    def excludes(self, value: float) -> bool:
+        return value < self.low or value > self.high
+
+    def as_dict(self) -> dict:
+        return {
+            "estimate": self.estimate,
+            "low": self.low,
+            "high": self.high,
+            "level": self.level,
+            "draws": self.draws,
+        }
+
+
+def percentile_interval(estimate: float, draws: Sequence[float], level: float = LEVEL) -> Interval:
+    """``estimate`` with the ``level`` percentile interval of its bootstrap ``draws`` (non-finite draws dropped)."""
+    values = np.asarray([d for d in draws if np.isfinite(d)], dtype=np.float64)
+    if len(values) == 0:
+        return Interval(float(estimate), float("nan"), float("nan"), level, 0)
+    tail = 100.0 * (1.0 - level) / 2.0
+    low, high = np.percentile(values, [tail, 100.0 - tail])
+    return Interval(float(estimate), float(low), float(high), level, len(values))
+
+
+def resample(items: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """One bootstrap draw of ``items`` (with replacement, same size, sorted)."""
+    items = np.asarray(items)
+    return np.sort(rng.choice(items, len(items), replace=True))
+
+
+def bootstrap(
+    statistic: Callable[[np.ndarray], Mapping[str, float]],
+    items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+    level: float = LEVEL,
+) -> dict[str, Interval]:
+    """Percentile intervals of every value ``statistic(items)`` returns, over ``draws`` item resamples."""
+    estimate = dict(statistic(np.asarray(items)))
+    samples: dict[str, list[float]] = {k: [] for k in estimate}
+    for _ in range(draws):
+        values = statistic(resample(items, rng))
+        for k in samples:
+            samples[k].append(float(values.get(k, np.nan)))
+    return {k: percentile_interval(estimate[k], samples[k], level) for k in estimate}
+
+
+def error_ratio(before: np.ndarray, after: np.ndarray, *, draws: int, rng: np.random.Generator) -> Interval:
+    """RMSE(before) / RMSE(after) from per-item squared-error sums, with a paired bootstrap over the items.
+
+    ``before``, ``after``: per-item sums of squared errors of two models on the same items. A ratio above 1 means ``after`` predicts better."""
+    before, after = np.asarray(before, np.float64), np.asarray(after, np.float64)
+
+    def ratio(index: np.ndarray) -> dict[str, float]:
+        return {"ratio": float(np.sqrt(before[index].sum() / max(after[index].sum(), 1e-300)))}
+
+    return bootstrap(ratio, np.arange(len(before)), draws=draws, rng=rng)["ratio"]
+
+
+def rmse_interval(
+    squared: np.ndarray, counts: np.ndarray, *, draws: int, rng: np.random.Generator
+) -> Interval:
+    """RMSE over items from per-item squared-error sums and value counts, with its item bootstrap interval."""
+    squared, counts = np.asarray(squared, np.float64), np.asarray(counts, np.float64)
+
+    def rmse(index: np.ndarray) -> dict[str, float]:
+        return {"rmse": float(np.sqrt(squared[index].sum() / max(counts[index].sum(), 1.0)))}
+
+    return bootstrap(rmse, np.arange(len(squared)), draws=draws, rng=rng)["rmse"]
+
+
+def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
+    """``"low"``/``"high"`` when ``value`` sits within ``tolerance`` x range of that bound, else None."""
+    span = max(high - low, 1e-300)
+    if value - low <= tolerance * span:
+        return "low"
+    if high - value <= tolerance * span:
+        return "high"
+    return None
+
+
+@dataclass(frozen=True)
+class Identification:
+    effect: str
+    identified: bool
+    reasons: tuple[str, ...]
+
+    def as_dict(self) -> dict:
+        return {
+            "effect": self.effect,
+            "status": "identified" if self.identified else "not identified",
+            "identified": self.identified,
+            "reasons": list(self.reasons),
+        }
+
+
+def identify(
+    effect: str,
+    *,
+    selected: bool,
+    validation_ratio: Interval | None,
+    params: Mapping[str, float],
+    bounds: Mapping[str, tuple[float, float]],
+    intervals: Mapping[str, Interval],
+    nulls: Mapping[str, float],
+) -> Identification:
+    """Apply the module's rule to one extension.
+
+    ``params``/``bounds``: the extension's own fitted parameters and their search ranges; ``intervals``: their
+    bootstrap intervals; ``nulls``: the parameter values at which the extension reduces to the model without it
+    (empty when it has none: a change of functional form); ``validation_ratio``: the paired bootstrap interval
+    of the inner cross-validated error ratio without / with the extension (None if it was never scored)."""
+    reasons = []
+    if not selected:
+        reasons.append("not selected by the inner cross-validation on the fit items")
+    if validation_ratio is None:
+        reasons.append("no inner cross-validated effect size")
+    elif not validation_ratio.low > 1.0:
+        reasons.append(
+            f"inner cross-validated error ratio {validation_ratio.estimate:.3f} "
+            f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
+            "does not exclude 1 (no gain)"
+        )
+    for name, value in params.items():
+        side = at_bound(value, *bounds[name])
+        if side is not None:
+            reasons.append(
+                f"{name} = {value:.4g} sits at its {side} bound {bounds[name][side == 'high']:.4g}"
+            )
+    if nulls:
+        excluded = [n for n, null in nulls.items() if n in intervals and intervals[n].excludes(null)]
+        if not excluded:
+            reasons.append(
+                "the interval of "
+                + ", ".join(
+                    f"{n} ({intervals[n].low:.4g}-{intervals[n].high:.4g})" for n in nulls if n in intervals
+                )
+                + " includes the null value "
+                + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
+                + " at which the extension reduces to the model without it"
+            )
+    return Identification(effect, not reasons, tuple(reasons))
+
+
+# ---------------------------------------------------------------------------------------------------------------
+# applying the rule to a forward selection
+
+
+def parameter_intervals(
+    problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
+) -> dict[str, Interval]:
+    """Percentile intervals of every fitted parameter: the model is refitted on ``draws`` resamples of the fit
+    ``items``, each refit warm-started from ``fit`` (the estimate)."""
+    samples: dict[str, list[float]] = {k: [] for k in fit.params}
+    for _ in range(draws):
+        refit = problem.fit(fit.effects, resample(items, rng), start=fit)
+        for k in samples:
+            samples[k].append(float(refit.params.get(k, np.nan)))
+    return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
+
+
+def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
+    """The parameters the model with ``effects`` has and the model without ``effect`` lacks."""
+    without = {p.name for p in problem.param_specs(effects - {effect})}
+    return [p for p in problem.param_specs(effects) if p.name not in without]
+
+
+@dataclass
+class Selection:
+    """What identification leaves of a forward selection."""
+
+    selected: list[str]
+    identified: list[str]
+    results: list[dict]
+    fit: Fit  # the model with the identified effects only, fitted on the fit items
+    intervals: dict[str, Interval]  # its parameters' intervals
+
+
+def identify_selection(
+    problem: Problem,
+    steps: list[Step],
+    chain: list[Fit],
+    fit_items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+) -> Selection:
+    """Judge every extension forward selection kept by the module's rule; refit without those that fail."""
+    selected_fit = chain[-1]
+    intervals = parameter_intervals(problem, selected_fit, fit_items, draws=draws, rng=rng)
+    results, identified = [], []
+    for k, (before, after) in enumerate(itertools.pairwise(steps)):
+        (effect,) = set(after.effects) - set(before.effects)
+        # an interacting pair (each useless alone) is judged by what the two bring together
+        if after.paired:
+            after = steps[k + 2]
+        elif before.paired:
+            before = steps[k - 1]
+        ratio = None
+        if before.item_errors is not None and after.item_errors is not None:
+            ratio = error_ratio(before.item_errors, after.item_errors, draws=max(draws, 200), rng=rng)
+        specs = own_params(problem, selected_fit.effects, effect)
+        nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
+        outcome = identify(
+            effect,
+            selected=True,
+            validation_ratio=ratio,
+            params={p.name: selected_fit.params[p.name] for p in specs},
+            bounds={p.name: (p.low, p.high) for p in specs},
+            intervals={p.name: intervals[p.name] for p in specs},
+            nulls=nulls,
+        )
+        result = outcome.as_dict()
+        requires = next((e.requires for e in problem.candidates if e.name == effect), ())
+        missing = [r for r in requires if r not in identified]
+        if missing and outcome.identified:
+            result.update(identified=False, status="not identified")
+            result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
+        result.update(
+            validation_ratio=None if ratio is None else ratio.as_dict(),
+            params={p.name: selected_fit.params[p.name] for p in specs},
+            intervals={p.name: intervals[p.name].as_dict() for p in specs},
+            nulls=nulls,
+        )
+        results.append(result)
+        if result["identified"]:
+            identified.append(effect)
+    kept = frozenset(identified)
+    if kept == selected_fit.effects:
+        return Selection(sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals)
+    # the largest model of the chain inside the kept set starts the refit
+    start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
+    final = start if start.effects == kept else problem.fit(kept, fit_items, start)
+    final_intervals = parameter_intervals(problem, final, fit_items, draws=draws, rng=rng)
+    return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)

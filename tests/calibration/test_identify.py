@@ -1,0 +1,116 @@
+"""The identification rule and the item bootstrap (``calibration/identify.py``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lerobot_phantom.calibration.identify import (
+    Interval,
+    at_bound,
+    bootstrap,
+    error_ratio,
+    identify,
+    percentile_interval,
+    resample,
+    rmse_interval,
+)
+
+CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
+
+
+def test_resample_draws_items_with_replacement_from_the_given_ones():
+    rng = np.random.default_rng(0)
+    items = np.array([3, 7, 11, 19])
+    draws = [resample(items, rng) for _ in range(50)]
+    assert all(len(d) == 4 and set(d) <= set(items) for d in draws)
+    assert any(len(set(d)) < 4 for d in draws)  # repeats happen
+
+
+def test_bootstrap_interval_of_a_mean_has_the_normal_width():
+    rng = np.random.default_rng(1)
+    values = rng.normal(5.0, 1.0, 400)
+    interval = bootstrap(
+        lambda index: {"mean": float(values[index].mean())}, np.arange(400), draws=300, rng=rng
+    )["mean"]
+    standard_error = 1.0 / np.sqrt(400)
+    assert (
+        interval.estimate == pytest.approx(values.mean()) and interval.low < interval.estimate < interval.high
+    )
+    # a 90% interval spans about 2 x 1.645 standard errors
+    assert 2.5 * standard_error < interval.high - interval.low < 4.2 * standard_error
+
+
+def test_percentile_interval_drops_failed_draws():
+    interval = percentile_interval(1.0, [np.nan, 0.0, 1.0, 2.0, np.inf], level=0.5)
+    assert interval.draws == 3 and interval.low == pytest.approx(0.5) and interval.high == pytest.approx(1.5)
+
+
+def test_error_ratio_is_paired_and_seeded():
+    rng = np.random.default_rng(2)
+    base = rng.uniform(1.0, 100.0, 30)  # items differ a lot, the ratio per item is constant
+    ratio = error_ratio(base * 4.0, base, draws=200, rng=np.random.default_rng(3))
+    assert ratio.estimate == pytest.approx(2.0) and ratio.low == pytest.approx(2.0) == ratio.high
+    again = error_ratio(base * 4.0 * rng.uniform(0.5, 1.5, 30), base, draws=50, rng=np.random.default_rng(3))
+    same = error_ratio(again_before := base * 4.0, base, draws=50, rng=np.random.default_rng(3))
+    assert same.as_dict() == error_ratio(again_before, base, draws=50, rng=np.random.default_rng(3)).as_dict()
+    assert again.low < again.estimate < again.high
+
+
+def test_rmse_interval_pools_values_not_items():
+    squared, counts = np.array([4.0, 400.0]), np.array([1, 100])
+    assert rmse_interval(squared, counts, draws=10, rng=np.random.default_rng(0)).estimate == pytest.approx(
+        np.sqrt(404 / 101)
+    )
+
+
+def test_at_bound():
+    assert at_bound(8.0, 0.2, 8.0) == "high"
+    assert at_bound(0.2001, 0.2, 8.0) == "low"
+    assert at_bound(3.0, 0.2, 8.0) is None
+
+
+def identified(**overrides):
+    arguments = {
+        "selected": True,
+        "validation_ratio": CLEAR_GAIN,
+        "params": {"halo_amplitude": 0.5, "halo_exponent": 2.5},
+        "bounds": {"halo_amplitude": (0.0, 50.0), "halo_exponent": (0.2, 8.0)},
+        "intervals": {"halo_amplitude": Interval(0.5, 0.3, 0.7), "halo_exponent": Interval(2.5, 2.0, 3.0)},
+        "nulls": {"halo_amplitude": 0.0},
+    }
+    arguments.update(overrides)
+    return identify("halo_power_law", **arguments)
+
+
+def test_an_extension_meeting_every_condition_is_identified():
+    result = identified()
+    assert result.identified and result.reasons == ()
+    assert result.as_dict()["status"] == "identified"
+
+
+@pytest.mark.parametrize(
+    ("override", "reason"),
+    [
+        ({"selected": False}, "not selected"),
+        ({"validation_ratio": Interval(1.1, 0.95, 1.3)}, "does not exclude 1"),
+        ({"validation_ratio": None}, "no inner cross-validated effect size"),
+        (
+            {"params": {"halo_amplitude": 0.5, "halo_exponent": 8.0}},
+            "halo_exponent = 8 sits at its high bound",
+        ),
+        (
+            {"intervals": {"halo_amplitude": Interval(0.5, -0.1, 0.9), "halo_exponent": Interval(2.5, 2, 3)}},
+            "includes the null value halo_amplitude = 0",
+        ),
+    ],
+)
+def test_each_condition_alone_makes_it_not_identified(override, reason):
+    result = identified(**override)
+    assert not result.identified
+    assert result.as_dict()["status"] == "not identified"
+    assert any(reason in r for r in result.reasons), result.reasons
+
+
+def test_a_change_of_functional_form_needs_no_null_value():
+    assert identified(nulls={}).identified

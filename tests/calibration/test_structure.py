@@ -1,0 +1,72 @@
+"""``calibration/structure.py``: structure left in a residual is reported with what and where; noise is not."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from lerobot_phantom.calibration.structure import ResidualSample, residual_structure
+
+
+class FakeProblem:
+    """Residual maps per item: noise, plus an optional ramp along the rows."""
+
+    def __init__(self, ramp: float, smooth: bool = False, items: int = 6, seed: int = 0) -> None:
+        rng = np.random.default_rng(seed)
+        self.maps = []
+        for _ in range(items):
+            noise = rng.normal(0.0, 1.0, (40, 50))
+            if smooth:  # a residual image, not noise: a running mean over 9 columns
+                noise = np.apply_along_axis(lambda r: np.convolve(r, np.ones(9) / 3.0, "same"), 1, noise)
+            rows = np.linspace(0.0, 1.0, 40)[:, None] * np.ones((1, 50))
+            self.maps.append(noise + ramp * (rows - 0.5))
+
+    def residual_sample(self, fit, items, rng):
+        sample = ResidualSample([], {"row": [], "column": []}, {"neighbours_along_rows": []})
+        for i in items:
+            residual = self.maps[int(i)]
+            ys, xs = np.mgrid[0:40, 0:50] / np.array([39.0, 49.0])[:, None, None]
+            sample.residual.append(residual.ravel())
+            sample.covariates["row"].append(ys.ravel())
+            sample.covariates["column"].append(xs.ravel())
+            sample.neighbours["neighbours_along_rows"].append(
+                (residual[:, :-3].ravel(), residual[:, 3:].ravel())
+            )
+        return sample
+
+
+def run(problem, base_mse=1.0):
+    return residual_structure(
+        problem, None, np.arange(len(problem.maps)), base_mse=base_mse, rng=np.random.default_rng(0)
+    )
+
+
+def test_noise_leaves_no_structure():
+    result = run(FakeProblem(ramp=0.0))
+    assert not result["structure_remains"], result["summary"]
+    assert {t["variable"] for t in result["tests"]} == {"row", "column", "neighbours_along_rows"}
+
+
+def test_a_row_ramp_is_reported_with_its_variable_and_place():
+    result = run(FakeProblem(ramp=3.0))
+    assert result["structure_remains"]
+    flagged = {t["variable"] for t in result["tests"] if t["significant"]}
+    assert "row" in flagged and "column" not in flagged  # a row ramp also makes neighbours in a row alike
+    assert "depends on row" in result["summary"] and "r = +" in result["summary"]
+
+
+def test_smooth_residual_is_reported_as_neighbour_correlation():
+    result = run(FakeProblem(ramp=0.0, smooth=True))
+    assert [t["variable"] for t in result["tests"] if t["significant"]] == ["neighbours_along_rows"]
+
+
+def test_structure_too_small_against_the_base_error_is_not_reported():
+    assert not run(FakeProblem(ramp=3.0), base_mse=1e4)["structure_remains"]
+
+
+def test_problems_without_a_residual_sample_are_not_tested():
+    class Table:
+        def residual_sample(self, fit, items, rng):
+            return None
+
+    result = residual_structure(Table(), None, np.arange(3), base_mse=1.0, rng=np.random.default_rng(0))
+    assert not result["structure_remains"] and result["summary"].startswith("not tested")
