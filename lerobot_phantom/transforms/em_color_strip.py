@@ -236,17 +236,6 @@ def em_color_strip_rgb(
     return _corrupt_rows_gathered(out, weights)
 
 
-def em_color_strip_float(
-    x: torch.Tensor,
-    num_stripes: float | torch.Tensor,
-    band_fraction: float | torch.Tensor = 1.0,
-    next_num_stripes: float | torch.Tensor | None = None,
-    mix: float | torch.Tensor = 0.0,
-) -> torch.Tensor:
-    """``em_color_strip`` on float RGB ``(B, 3, H, W)`` in [0, 1] (kept for callers of the float kernel)."""
-    return em_color_strip_rgb(x, num_stripes, band_fraction, next_num_stripes, mix)
-
-
 def em_color_strip(
     image: torch.Tensor,
     num_stripes: float | torch.Tensor,
