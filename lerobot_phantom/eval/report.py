@@ -344,7 +344,6 @@ def per_task_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
                 cells.append("-")
                 continue
             successes, n = sum(outcomes), len(outcomes)
-            low, high = wilson_interval(successes, n)
             cells.append(percent(successes / n))
             records.append(
                 {
@@ -353,11 +352,7 @@ def per_task_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
                     "task_index": task[0],
                     "task": task[1],
                     "condition": condition,
-                    "successes": successes,
-                    "episodes": n,
-                    "tsr": successes / n,
-                    "ci95_low": low,
-                    "ci95_high": high,
+                    **rate_fields(successes, n),
                 }
             )
         rows.append((condition, cells))
@@ -366,6 +361,12 @@ def per_task_table(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
         groups=groups, columns=[f"{suite}: {task[1]}" for _, suite, task in columns], rows=rows, notes=(note,)
     )
     return table, records
+
+
+def rate_fields(successes: int, n: int) -> dict[str, Any]:
+    """A success count as the record fields every results file shares: counts, TSR and its 95% Wilson interval."""
+    low, high = wilson_interval(successes, n)
+    return {"successes": successes, "episodes": n, "tsr": successes / n, "ci95_low": low, "ci95_high": high}
 
 
 def results_rows(runs: list[EvalRun]) -> list[dict[str, Any]]:
@@ -379,16 +380,11 @@ def results_rows(runs: list[EvalRun]) -> list[dict[str, Any]]:
                 if not episodes:
                     continue
                 successes, n = sum(episodes.values()), len(episodes)
-                low, high = wilson_interval(successes, n)
                 row = {
                     "label": run.label,
                     "suite": suite,
                     "condition": condition,
-                    "successes": successes,
-                    "episodes": n,
-                    "tsr": successes / n,
-                    "ci95_low": low,
-                    "ci95_high": high,
+                    **rate_fields(successes, n),
                     "delta_vs_clean": None,
                     "p_vs_clean": None,
                 }
