@@ -33,6 +33,8 @@ import lerobot_phantom
 from lerobot_phantom.study.config import StudyConfig
 from lerobot_phantom.study.stages import (
     EVAL_FILE,
+    PRETRAINED,
+    REPORT,
     RESUME,
     RUN,
     SKIP,
@@ -254,6 +256,46 @@ class Study:
         return self.manifest
 
 
+def publish(study_dir: Path, destination: Path) -> list[Path]:
+    """Copy what a reader of the study needs to ``destination`` (logs, configs, evaluations, report; no data, VLM or
+    weights); returns the files written.
+
+    The copy keeps the study's layout, so every path in ``study.json`` (``results``, ``report``, ``log``) stays valid
+    relative to ``destination``. Only finished stages are copied: a sweep still running is left out, and the copied
+    manifest lists what was published. The study directory itself is never written to.
+    """
+    study_dir, destination = study_dir.resolve(), destination.resolve()
+    manifest = read_manifest(study_dir)
+    if not manifest:
+        raise FileNotFoundError(f"{study_dir} holds no {MANIFEST}: nothing to publish")
+    if destination == study_dir or study_dir in destination.parents:
+        raise ValueError(f"--publish_to must lie outside the study directory {study_dir}, got {destination}")
+    if destination.is_dir() and any(destination.iterdir()) and not (destination / MANIFEST).is_file():
+        raise FileExistsError(
+            f"{destination} is not empty and holds no {MANIFEST} of an earlier publication; choose another directory"
+        )
+    done = {name: r for name, r in manifest.get("stages", {}).items() if r.get("status") == "done"}
+    sources = [Path(CONFIG_FILE)]
+    for name, record in done.items():
+        output = Path(record["output"])
+        sources.append(Path(record["log"]))
+        if name.startswith(f"{SWEEP}_") or name == REPORT:
+            sources += [
+                p.relative_to(study_dir) for p in sorted((study_dir / output).rglob("*")) if p.is_file()
+            ]
+        elif (study_dir / output / PRETRAINED / "train_config.json").is_file():
+            sources.append(output / PRETRAINED / "train_config.json")
+    written = []
+    for relative in sources:
+        target = destination / relative
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(study_dir / relative, target)
+        written.append(target)
+    published = {**manifest, "published": {"from": str(study_dir), "stages": sorted(done)}}
+    write_manifest(destination, published)
+    return [*written, destination / MANIFEST]
+
+
 def run_study(
     cfg: StudyConfig, invocation: list[str] | None = None, runner: Callable | None = None
 ) -> dict[str, Any]:
@@ -270,6 +312,10 @@ def main(args: list[str] | None = None) -> None:
 
     argv = sys.argv[1:] if args is None else list(args)
     cfg = draccus.parse(StudyConfig, args=argv)
+    if cfg.publish_to is not None:
+        written = publish(Path(cfg.output_dir), Path(cfg.publish_to))
+        print(f"published {len(written)} files of {cfg.output_dir} to {cfg.publish_to}")
+        return
     if cfg.dry_run:
         for name, decision in Study(cfg, ["lerobot-phantom-study", *argv]).decisions().items():
             print(f"{decision:>6}  {name}")

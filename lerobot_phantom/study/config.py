@@ -111,6 +111,9 @@ class StudyConfig:
     verbose: bool = True
     # Only print what each stage would do (skip / resume / run) and exit.
     dry_run: bool = False
+    # Copy the finished results (manifest, config, sweeps' eval.json, report, logs of sweeps and report, training
+    # configs) of the study in output_dir to this directory and exit without running anything (e.g. docs/study).
+    publish_to: str | None = None
 
     def __post_init__(self) -> None:
         self.validate()

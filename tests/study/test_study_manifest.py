@@ -135,3 +135,55 @@ def test_dry_run_prints_decisions_without_running(micro, capsys):
     main(args)
     lines = dict(reversed(line.split()) for line in capsys.readouterr().out.splitlines())
     assert lines["train_clean"] == "skip" and lines["sweep_before"] == "run" and lines["report"] == "run"
+
+
+def _tree(root):
+    return {p.relative_to(root): p.read_bytes() for p in sorted(root.rglob("*")) if p.is_file()}
+
+
+def test_publish_copies_the_finished_results_with_paths_valid_relative_to_the_copy(micro, tmp_path):
+    run_study(micro, runner=FakeRunner(micro))
+    study_dir = tmp_path / "study"
+    before = _tree(study_dir)
+    destination = tmp_path / "docs" / "study"
+    main([f"--output_dir={study_dir}", f"--publish_to={destination}"])
+
+    assert _tree(study_dir) == before  # the study itself is never written to
+    published = json.loads((destination / MANIFEST).read_text())
+    assert set(published["results"]) == {"before", "after", "control"}
+    for path in published["results"].values():
+        assert (destination / path).read_bytes() == (study_dir / path).read_bytes()
+    assert (destination / published["report"] / "summary.md").is_file()
+    for record in published["stages"].values():
+        assert (destination / record["log"]).is_file()
+    assert (destination / "train" / "clean" / PRETRAINED / "train_config.json").is_file()
+    # Data, VLM and checkpoints (weights) stay behind.
+    assert not (destination / "data").exists() and not (destination / "vlm").exists()
+    assert not (destination / "train" / "clean" / PRETRAINED / "config.json").exists()
+    assert published["published"]["stages"] == sorted(published["stages"])
+
+
+def test_publish_leaves_out_an_unfinished_sweep(micro, tmp_path):
+    with pytest.raises(KeyboardInterrupt):
+        run_study(micro, runner=FakeRunner(micro, fail="sweep_after"))
+    destination = tmp_path / "published"
+    main([f"--output_dir={tmp_path / 'study'}", f"--publish_to={destination}"])
+    published = json.loads((destination / MANIFEST).read_text())
+    assert set(published["results"]) == {"before"}
+    assert "sweep_after" not in published["published"]["stages"]
+    assert not (destination / "sweeps" / "after").exists()
+
+
+def test_publish_refuses_the_study_dir_and_a_foreign_non_empty_dir(micro, tmp_path):
+    run_study(micro, runner=FakeRunner(micro))
+    study_dir = tmp_path / "study"
+    with pytest.raises(ValueError, match="outside the study directory"):
+        main([f"--output_dir={study_dir}", f"--publish_to={study_dir / 'docs'}"])
+    foreign = tmp_path / "foreign"
+    foreign.mkdir()
+    (foreign / "notes.txt").write_text("mine")
+    with pytest.raises(FileExistsError, match="choose another directory"):
+        main([f"--output_dir={study_dir}", f"--publish_to={foreign}"])
+    assert (foreign / "notes.txt").read_text() == "mine"
+    with pytest.raises(FileNotFoundError, match="nothing to publish"):
+        main([f"--output_dir={tmp_path / 'empty'}", f"--publish_to={tmp_path / 'out'}"])
