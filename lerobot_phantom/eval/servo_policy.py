@@ -35,6 +35,7 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import cv2
 import numpy as np
 import torch
 from lerobot.configs.policies import PreTrainedConfig
@@ -56,7 +57,6 @@ POLICY_TYPE = "phantom_servo"
 FRONT_IMAGE_KEY = "observation.images.front"
 STATE_KEY = "observation.state"
 
-CONTAINERS = ("basket", "plate")
 SHAPES = ("cube", "cylinder")
 SIDES = ("left", "right")
 OBJECT_COLOURS = ("red", "green", "blue", "yellow", "orange")
@@ -220,17 +220,8 @@ MIN_VALUE = 0.25
 
 def colour_masks(image: np.ndarray) -> dict[str, np.ndarray]:
     """Boolean (H, W) masks of every colour the scene uses, from an (H, W, 3) float image in [0, 1]."""
-    r, g, b = image[..., 0], image[..., 1], image[..., 2]
-    value = image.max(-1)
-    chroma = value - image.min(-1)
-    saturation = np.where(value > 0, chroma / np.maximum(value, 1e-6), 0.0)
-    safe = np.maximum(chroma, 1e-6)
-    hue = np.select(
-        [value == r, value == g],
-        [((g - b) / safe) % 6.0, (b - r) / safe + 2.0],
-        (r - g) / safe + 4.0,
-    )
-    hue = hue * 60.0
+    # OpenCV's float HSV: hue in degrees [0, 360), saturation and value in [0, 1].
+    hue, saturation, value = np.moveaxis(cv2.cvtColor(image.astype(np.float32), cv2.COLOR_RGB2HSV), -1, 0)
     vivid = (saturation >= MIN_SATURATION) & (value >= MIN_VALUE)
     masks = {}
     for colour, ranges in HUE_RANGES.items():
@@ -238,6 +229,7 @@ def colour_masks(image: np.ndarray) -> dict[str, np.ndarray]:
         for low, high in ranges:
             in_range |= (hue >= low) & (hue < high)
         masks[colour] = vivid & in_range
+    r, b = image[..., 0], image[..., 2]
     masks["plate"] = (image.min(-1) > 0.88) & (saturation < 0.12)
     # The basket is a bluish dark grey (0.3, 0.3, 0.35); the gripper's greys are masked out separately.
     masks["basket"] = (saturation < 0.25) & (value > 0.3) & (value < 0.55) & (b >= r) & (b - r < 0.12)
@@ -245,14 +237,13 @@ def colour_masks(image: np.ndarray) -> dict[str, np.ndarray]:
 
 
 def two_clusters(points: np.ndarray, iterations: int = 10) -> list[np.ndarray]:
-    """Split (N, 2) pixel coordinates into a left and a right group (2-means seeded at the extreme columns)."""
-    centres = np.stack([points[np.argmin(points[:, 0])], points[np.argmax(points[:, 0])]]).astype(float)
-    for _ in range(iterations):
-        labels = np.argmin(((points[:, None] - centres[None]) ** 2).sum(-1), axis=1)
-        centres = np.stack(
-            [points[labels == k].mean(0) if np.any(labels == k) else centres[k] for k in range(2)]
-        )
-    labels = np.argmin(((points[:, None] - centres[None]) ** 2).sum(-1), axis=1)
+    """Split (N, 2) pixel coordinates into a left and a right group (2-means started from the extreme columns)."""
+    data = points.astype(np.float32)
+    extremes = data[[np.argmin(data[:, 0]), np.argmax(data[:, 0])]]
+    initial = np.argmin(((data[:, None] - extremes[None]) ** 2).sum(-1), axis=1).astype(np.int32)
+    criteria = (cv2.TERM_CRITERIA_MAX_ITER, iterations, 0.0)
+    _, labels, _ = cv2.kmeans(data, 2, initial[:, None], criteria, 1, cv2.KMEANS_USE_INITIAL_LABELS)
+    labels = labels.ravel()
     return [points[labels == k] for k in range(2)]
 
 
@@ -278,13 +269,7 @@ def workspace_mask(height: int, width: int) -> np.ndarray:
 
 def dilate(mask: np.ndarray) -> np.ndarray:
     """One-pixel (8-neighbour) binary dilation."""
-    padded = np.pad(mask, 1)
-    height, width = mask.shape
-    out = np.zeros_like(mask)
-    for dy in range(3):
-        for dx in range(3):
-            out |= padded[dy : dy + height, dx : dx + width]
-    return out
+    return cv2.dilate(mask.astype(np.uint8), np.ones((3, 3), np.uint8)).astype(bool)
 
 
 # Where the gripper can cover the image, relative to the TCP (metres; see scene.py): the box around the palm and
