@@ -59,8 +59,6 @@ TMP_SUFFIX = ".phantom-augment-tmp"
 RUN_FILE = "run.json"
 PROVENANCE_FILE = "meta/phantom_augment.json"
 
-logger = logging.getLogger(__name__)
-
 
 @dataclass
 class AugmentConfig:
@@ -367,59 +365,39 @@ def _prepare_tmp(cfg: AugmentConfig, tmp: Path, record: dict[str, Any]) -> None:
     run_file.write_text(json.dumps(record, indent=2, sort_keys=True))
 
 
-def augment(cfg: AugmentConfig) -> AugmentResult:
-    """Write the augmented dataset described by ``cfg``; see the module docstring."""
+def _resume_finished(output_root: Path, tmp: Path, cfg: AugmentConfig) -> AugmentResult:
+    """An existing output without --overwrite: only --resume of a run killed after its final rename is allowed."""
+    if not cfg.resume:
+        raise FileExistsError(f"the output {output_root} already exists; pass --overwrite to replace it")
+    if not tmp.exists():
+        raise FileExistsError(
+            f"--resume: {output_root} exists and there is no interrupted run ({tmp}) to continue; "
+            "it is complete already (pass --overwrite to redo it)"
+        )
+    # Killed after the final rename, before cleaning up: the output is complete.
+    shutil.rmtree(tmp)
+    summary = summarize(output_root)
+    info = json.loads((output_root / "meta" / "info.json").read_text())
+    return AugmentResult(
+        output_root, info["total_episodes"], info["total_frames"], info["total_episodes"], summary
+    )
+
+
+def _checked_source_meta(cfg: AugmentConfig, source_root: Path):
+    """The source dataset's metadata, after checking it has episodes and the cameras the attacks need."""
     from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
-    cfg.check_required()
-    cfg.phantom.validate()
-    source_root = _dataset_root(cfg.repo_id, cfg.root)
-    output_root = _dataset_root(cfg.output_repo_id, cfg.output_root)
-    _check_not_overlapping(source_root, output_root)
-    tmp = temporary_dir(output_root)
-
-    if output_root.exists() and not cfg.overwrite:
-        if not cfg.resume:
-            raise FileExistsError(f"the output {output_root} already exists; pass --overwrite to replace it")
-        if not tmp.exists():
-            raise FileExistsError(
-                f"--resume: {output_root} exists and there is no interrupted run ({tmp}) to continue; "
-                "it is complete already (pass --overwrite to redo it)"
-            )
-        # Killed after the final rename, before cleaning up: the output is complete.
-        shutil.rmtree(tmp)
-        summary = summarize(output_root)
-        info = json.loads((output_root / "meta" / "info.json").read_text())
-        return AugmentResult(
-            output_root, info["total_episodes"], info["total_frames"], info["total_episodes"], summary
-        )
-
-    source = LeRobotDataset(cfg.repo_id, root=source_root)
-    meta = source.meta
+    meta = LeRobotDataset(cfg.repo_id, root=source_root).meta
     if meta.total_episodes == 0:
         raise ValueError(f"{cfg.repo_id} ({source_root}) has no episodes to augment")
     if not meta.camera_keys and cfg.phantom.camera_attacks and cfg.phantom.rate > 0:
         raise ValueError(f"{cfg.repo_id} has no camera keys to attack with {cfg.phantom.camera_attacks}")
-    if meta.camera_keys:
-        cfg.phantom.resolve_cameras(
-            list(meta.camera_keys)
-        )  # unknown keys fail now, naming the dataset's keys
-    features = _output_features(meta, cfg.phantom)
-    record = _run_record(cfg, source_root, meta)
-    _prepare_tmp(cfg, tmp, record)
+    if meta.camera_keys:  # unknown keys fail now, naming the dataset's keys
+        cfg.phantom.resolve_cameras(list(meta.camera_keys))
+    return meta
 
-    plan = _Plan(
-        source_repo_id=cfg.repo_id,
-        source_root=str(source_root),
-        phantom=cfg.phantom,
-        unit=cfg.unit,
-        features=features,
-        fps=int(meta.fps),
-        robot_type=meta.robot_type,
-        use_videos=len(meta.video_keys) > 0,
-        vcodec=cfg.vcodec,
-        parallel_encoding=cfg.num_workers == 0,
-    )
+
+def _episode_jobs(cfg: AugmentConfig, meta, tmp: Path) -> list[_EpisodeJob]:
     jobs = []
     for position in range(meta.total_episodes):
         episode_index, start, stop = compat.episode_frame_range(meta, position)
@@ -433,11 +411,13 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
                 repo_id=f"{cfg.output_repo_id}-episode-{episode_index:06d}",
             )
         )
-    for leftover in (tmp / "episodes").glob("*.partial"):
-        shutil.rmtree(leftover)
-    todo = [job for job in jobs if not Path(job.staging_root).exists()]
-    reused = len(jobs) - len(todo)
+    return jobs
 
+
+def _write_episodes(
+    cfg: AugmentConfig, plan: _Plan, jobs: list[_EpisodeJob], todo: list[_EpisodeJob]
+) -> None:
+    """Stage every episode still to do (in this process or a spawn pool), with one progress bar over frames."""
     total_frames = sum(job.stop - job.start for job in jobs)
     with tqdm(
         total=total_frames,
@@ -455,6 +435,9 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
                 for future in futures:  # in order, so an error is reported for the first failing episode
                     bar.update(future.result())
 
+
+def _aggregate_and_publish(cfg: AugmentConfig, jobs, record: dict, tmp: Path, output_root: Path) -> dict:
+    """Merge the staged episodes into one dataset and move it to ``output_root``; returns the attack summary."""
     aggregate_root = tmp / "aggregate"
     if aggregate_root.exists():
         shutil.rmtree(aggregate_root)
@@ -467,13 +450,47 @@ def augment(cfg: AugmentConfig) -> AugmentResult:
     summary = summarize(aggregate_root)
     provenance = {"settings": record, "summary": summary}
     (aggregate_root / PROVENANCE_FILE).write_text(json.dumps(provenance, indent=2, sort_keys=True))
-
     if output_root.exists():  # --overwrite: the previous output goes only now that the new one is complete
-        previous = tmp / "previous"
-        os.replace(output_root, previous)
+        os.replace(output_root, tmp / "previous")
     os.replace(aggregate_root, output_root)
     shutil.rmtree(tmp)
-    return AugmentResult(output_root, len(jobs), total_frames, reused, summary)
+    return summary
+
+
+def augment(cfg: AugmentConfig) -> AugmentResult:
+    """Write the augmented dataset described by ``cfg``; see the module docstring."""
+    cfg.check_required()
+    cfg.phantom.validate()
+    source_root = _dataset_root(cfg.repo_id, cfg.root)
+    output_root = _dataset_root(cfg.output_repo_id, cfg.output_root)
+    _check_not_overlapping(source_root, output_root)
+    tmp = temporary_dir(output_root)
+    if output_root.exists() and not cfg.overwrite:
+        return _resume_finished(output_root, tmp, cfg)
+
+    meta = _checked_source_meta(cfg, source_root)
+    record = _run_record(cfg, source_root, meta)
+    _prepare_tmp(cfg, tmp, record)
+    plan = _Plan(
+        source_repo_id=cfg.repo_id,
+        source_root=str(source_root),
+        phantom=cfg.phantom,
+        unit=cfg.unit,
+        features=_output_features(meta, cfg.phantom),
+        fps=int(meta.fps),
+        robot_type=meta.robot_type,
+        use_videos=len(meta.video_keys) > 0,
+        vcodec=cfg.vcodec,
+        parallel_encoding=cfg.num_workers == 0,
+    )
+    jobs = _episode_jobs(cfg, meta, tmp)
+    for leftover in (tmp / "episodes").glob("*.partial"):
+        shutil.rmtree(leftover)
+    todo = [job for job in jobs if not Path(job.staging_root).exists()]
+    _write_episodes(cfg, plan, jobs, todo)
+    summary = _aggregate_and_publish(cfg, jobs, record, tmp, output_root)
+    total_frames = sum(job.stop - job.start for job in jobs)
+    return AugmentResult(output_root, len(jobs), total_frames, len(jobs) - len(todo), summary)
 
 
 # -- CLI -----------------------------------------------------------------------------------------------------------
