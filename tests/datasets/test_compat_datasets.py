@@ -4,6 +4,9 @@ from __future__ import annotations
 
 import inspect
 import itertools
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import torch
@@ -23,7 +26,14 @@ def test_default_features_and_home():
         "index",
         "task_index",
     }
-    assert isinstance(Path(compat.lerobot_home()), Path)
+
+
+def test_lerobot_home_follows_the_environment_variable_lerobot_reads(tmp_path):
+    home = tmp_path / "lerobot_home"
+    code = "from lerobot_phantom import _lerobot_compat as c; print(c.lerobot_home())"
+    env = {**os.environ, "HF_LEROBOT_HOME": str(home)}
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True)
+    assert Path(out.stdout.strip()) == home
 
 
 def test_aggregate_datasets_signature():
