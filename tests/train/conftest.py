@@ -7,10 +7,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 from pathlib import Path
 
 import pytest
-
-REPO = Path(__file__).resolve().parents[2]
-CONFIGS = REPO / "configs"
-FRAMES = 24  # 2 episodes x 12 frames
+from train_testkit import FRAMES, smolvla_args
 
 
 @pytest.fixture(scope="session")
@@ -30,21 +27,6 @@ def tiny_vlm(tmp_path_factory) -> Path:
     from lerobot_phantom.train.make_vlm import make_vlm
 
     return make_vlm(tmp_path_factory.mktemp("vlm") / "tiny_vlm", "tiny", tasks=TASKS)
-
-
-def dataset_args(root: Path) -> list[str]:
-    return ["--dataset.repo_id=phantom/tiny", f"--dataset.root={root}"]
-
-
-def smolvla_args(root: Path, vlm: Path, out: Path, *extra: str) -> list[str]:
-    """The tiny CPU config (configs/tiny_smolvla_cpu.json) pointed at the test's dataset, VLM and output dir."""
-    return [
-        f"--config_path={CONFIGS / 'tiny_smolvla_cpu.json'}",
-        *dataset_args(root),
-        f"--policy.vlm_model_name={vlm}",
-        f"--output_dir={out}",
-        *extra,
-    ]
 
 
 @pytest.fixture(scope="session")

@@ -3,7 +3,7 @@
 import re
 
 import pytest
-from conftest import CONFIGS
+from train_testkit import CONFIGS
 
 from lerobot_phantom.train.make_vlm import IMAGE_TOKENS, VLM_SIZES, main, make_vlm
 from lerobot_phantom.train.train import PhantomTrainPipelineConfig

@@ -6,8 +6,8 @@ from pathlib import Path
 
 import pytest
 import torch
-from conftest import CONFIGS, FRAMES, dataset_args, smolvla_args
 from safetensors.torch import load_file
+from train_testkit import CONFIGS, FRAMES, dataset_args, smolvla_args
 
 from lerobot_phantom.train.device_step import ATTACK_STEP_NAME
 from lerobot_phantom.train.loss_log import CLEAN, LOG_FILE_NAME
