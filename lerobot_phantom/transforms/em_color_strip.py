@@ -44,6 +44,7 @@ Deviations from the paper's code (and why):
 
 from __future__ import annotations
 
+import functools
 from typing import ClassVar
 
 import torch
@@ -213,6 +214,18 @@ def _corrupt_rows_gathered(out: torch.Tensor, weights: torch.Tensor) -> torch.Te
     return source.index_select(0, source_of).view(batch, 3, height, width)
 
 
+@functools.lru_cache(maxsize=256)
+def _band_runs(
+    height: int, num_stripes: float, band_fraction: float, next_num_stripes: float, mix: float
+) -> tuple[tuple[int, int], ...] | None:
+    """The fully corrupted row runs of one parameter set, or None when it has partial rows (validated; pure, so
+    cached: a level or the 9 stripe counts of ``"random"`` cost no tensor op per call)."""
+    weights = _row_weights(height, 1, torch.device("cpu"), num_stripes, band_fraction, next_num_stripes, mix)[0]
+    if not bool(((weights == 0) | (weights == 1)).all()):
+        return None
+    return tuple(_runs(weights.tolist()))
+
+
 def em_color_strip_rgb(
     x: torch.Tensor,
     num_stripes: float | torch.Tensor,
@@ -223,14 +236,44 @@ def em_color_strip_rgb(
     """``em_color_strip`` on RGB ``(B, 3, H, W)``, uint8 or float (the transform's inner op).
 
     Returns a fresh tensor; float values are clamped to [0, 1] (the input first, so every output row is too).
+    Samples with whole-row patterns (the levels, ``"random"``'s integer stripe counts) are grouped by pattern: the
+    batch is copied once in group order, each group's bands are corrupted in place through strided views, and one
+    more copy restores the order (none with a single group); other patterns gather their rows.
     """
     batch, _, height, _ = x.shape
+    columns = [
+        per_sample_values(value, batch, torch.device("cpu"), what).tolist()
+        for value, what in (
+            (num_stripes, "num_stripes"),
+            (band_fraction, "band_fraction"),
+            (num_stripes if next_num_stripes is None else next_num_stripes, "next_num_stripes"),
+            (mix, "mix"),
+        )
+    ]
+    groups: dict[tuple[tuple[int, int], ...], list[int]] = {}
+    for i, key in enumerate(zip(*columns, strict=True)):
+        runs = _band_runs(height, *key)
+        if runs is None:
+            groups = {}
+            break
+        groups.setdefault(runs, []).append(i)
+    if groups:
+        if len(groups) == 1:
+            out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
+            _corrupt_bands_(out, list(next(iter(groups))))
+            return out
+        order = [i for members in groups.values() for i in members]
+        index = torch.tensor(order, device=x.device)
+        grouped = x.index_select(0, index)  # whole images: a memcpy each, unlike a row gather
+        if x.dtype != torch.uint8:
+            grouped.clamp_(0.0, 1.0)
+        first = 0
+        for runs, members in groups.items():
+            _corrupt_bands_(grouped[first : first + len(members)], list(runs))
+            first += len(members)
+        return grouped.index_select(0, torch.argsort(index))
     weights = _row_weights(height, batch, x.device, num_stripes, band_fraction, next_num_stripes, mix)
     out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
-    uniform = bool((weights == weights[:1]).all())
-    if uniform and bool(((weights == 0) | (weights == 1)).all()):
-        _corrupt_bands_(out, _runs(weights[0].tolist()))
-        return out
     if not bool((weights > 0).any()):
         return out
     return _corrupt_rows_gathered(out, weights)
