@@ -220,10 +220,23 @@ def _band_runs(
 ) -> tuple[tuple[int, int], ...] | None:
     """The fully corrupted row runs of one parameter set, or None when it has partial rows (validated; pure, so
     cached: a level or the 9 stripe counts of ``"random"`` cost no tensor op per call)."""
-    weights = _row_weights(height, 1, torch.device("cpu"), num_stripes, band_fraction, next_num_stripes, mix)[0]
+    weights = _row_weights(height, 1, torch.device("cpu"), num_stripes, band_fraction, next_num_stripes, mix)[
+        0
+    ]
     if not bool(((weights == 0) | (weights == 1)).all()):
         return None
     return tuple(_runs(weights.tolist()))
+
+
+def _consecutive(members: list[int]) -> list[tuple[int, int]]:
+    """Increasing indices -> ``[first, stop)`` runs of consecutive ones."""
+    runs: list[tuple[int, int]] = []
+    for i in members:
+        if runs and runs[-1][1] == i:
+            runs[-1] = (runs[-1][0], i + 1)
+        else:
+            runs.append((i, i + 1))
+    return runs
 
 
 def em_color_strip_rgb(
@@ -236,9 +249,10 @@ def em_color_strip_rgb(
     """``em_color_strip`` on RGB ``(B, 3, H, W)``, uint8 or float (the transform's inner op).
 
     Returns a fresh tensor; float values are clamped to [0, 1] (the input first, so every output row is too).
-    Samples with whole-row patterns (the levels, ``"random"``'s integer stripe counts) are grouped by pattern: the
-    batch is copied once in group order, each group's bands are corrupted in place through strided views, and one
-    more copy restores the order (none with a single group); other patterns gather their rows.
+    Samples with whole-row patterns (the levels, ``"random"``'s integer stripe counts) are grouped by pattern and
+    corrupted in place through strided views: uint8 batches are copied once in group order and once back (two
+    cheap copies instead of ~20 ops per sample), float batches per run of consecutive samples of a copy; other
+    patterns gather their rows.
     """
     batch, _, height, _ = x.shape
     columns = [
@@ -262,11 +276,17 @@ def em_color_strip_rgb(
             out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
             _corrupt_bands_(out, list(next(iter(groups))))
             return out
+        if x.dtype != torch.uint8:
+            # float: a copy of the batch costs more than a few ops per sample, so each run of consecutive samples
+            # is corrupted in place in the clamped copy (measured: 86 vs 118 us per 224x224 image at batch 32)
+            out = x.clamp(0.0, 1.0).contiguous()
+            for runs, members in groups.items():
+                for first, stop in _consecutive(members):
+                    _corrupt_bands_(out[first:stop], list(runs))
+            return out
         order = [i for members in groups.values() for i in members]
         index = torch.tensor(order, device=x.device)
         grouped = x.index_select(0, index)  # whole images: a memcpy each, unlike a row gather
-        if x.dtype != torch.uint8:
-            grouped.clamp_(0.0, 1.0)
         first = 0
         for runs, members in groups.items():
             _corrupt_bands_(grouped[first : first + len(members)], list(runs))
