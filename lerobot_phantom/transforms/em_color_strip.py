@@ -228,6 +228,18 @@ def _band_runs(
     return tuple(_runs(weights.tolist()))
 
 
+def _values(value: float | torch.Tensor, batch: int, what: str) -> list[float]:
+    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> ``batch`` Python floats (one host copy, no tensor ops)."""
+    values = value.reshape(-1).tolist() if isinstance(value, torch.Tensor) else [float(value)]
+    if len(values) == 1:
+        return values * batch
+    if len(values) != batch:
+        raise ValueError(
+            f"{what} must be a scalar or have one value per sample ({batch}), got {len(values)} values"
+        )
+    return [float(v) for v in values]
+
+
 def _consecutive(members: list[int]) -> list[tuple[int, int]]:
     """Increasing indices -> ``[first, stop)`` runs of consecutive ones."""
     runs: list[tuple[int, int]] = []
@@ -256,7 +268,7 @@ def em_color_strip_rgb(
     """
     batch, _, height, _ = x.shape
     columns = [
-        per_sample_values(value, batch, torch.device("cpu"), what).tolist()
+        _values(value, batch, what)
         for value, what in (
             (num_stripes, "num_stripes"),
             (band_fraction, "band_fraction"),
