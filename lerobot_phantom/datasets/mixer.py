@@ -37,6 +37,7 @@ applied first.
 from __future__ import annotations
 
 import copy
+from functools import partial
 from typing import Any
 
 import torch
@@ -51,6 +52,7 @@ from lerobot_phantom.datasets.schedule import (
     sample_seed,
 )
 from lerobot_phantom.transforms.base import derive_seed
+from lerobot_phantom.transforms.intensity import is_random, random_intensities
 from lerobot_phantom.transforms.registry import ATTACK_IDS, CLEAN_ID, is_camera_attack, make_attack
 
 LABEL_KEYS = (
@@ -90,18 +92,33 @@ def instruction_generator(seed: int, channel: str) -> torch.Generator:
 
 
 class _Schedule:
-    """Per-epoch plans of both channels; recomputed lazily in each process when the epoch changes."""
+    """Per-epoch plans of both channels; recomputed lazily in each process when the epoch changes.
 
-    def __init__(self, config: PhantomConfig, num_items: int, num_camera_slots: int) -> None:
+    With ``intensity="random"`` each attack's stratified draws follow its adversarial-training distribution (its
+    ``random_parameter``, as the attack's own ``"random"`` draws), not a uniform ``s``.
+    """
+
+    def __init__(
+        self, config: PhantomConfig, num_items: int, num_camera_slots: int, attacks: dict[str, Any]
+    ) -> None:
         self.config = config
         self.num_items = num_items
         self.num_camera_slots = num_camera_slots
+        self.quantiles = {
+            CAMERA_CHANNEL: self._quantiles(config.attacks, attacks),
+            INSTRUCTION_CHANNEL: self._quantiles(config.instruction_attacks, attacks),
+        }
         self._epoch: int | None = None
         self._plans: dict[str, ChannelPlan] = {}
 
     def __getstate__(self) -> dict[str, Any]:
         # Plans are cheap to recompute and O(N): dataloader workers rebuild them instead of receiving copies.
         return {**self.__dict__, "_epoch": None, "_plans": {}}
+
+    def _quantiles(self, names: list[str], attacks: dict[str, Any]) -> list[Any] | None:
+        if not names or not is_random(self.config.intensity):
+            return None
+        return [partial(random_intensities, attacks[name]) for name in names]
 
     def plans(self, epoch: int) -> dict[str, ChannelPlan]:
         if epoch != self._epoch:
@@ -116,6 +133,7 @@ class _Schedule:
                     epoch=epoch,
                     channel=CAMERA_CHANNEL,
                     num_camera_slots=self.num_camera_slots,
+                    quantiles=self.quantiles[CAMERA_CHANNEL],
                 ),
                 INSTRUCTION_CHANNEL: plan_channel(
                     self.num_items,
@@ -125,6 +143,7 @@ class _Schedule:
                     seed=config.seed,
                     epoch=epoch,
                     channel=INSTRUCTION_CHANNEL,
+                    quantiles=self.quantiles[INSTRUCTION_CHANNEL],
                 ),
             }
             self._epoch = epoch
@@ -187,7 +206,10 @@ class PhantomDataset(Dataset):
 
         self._num_items = len(dataset)
         self._schedule = _Schedule(
-            config, self._num_items, max(1, len(self.attack_cameras)) if config.random_camera else 1
+            config,
+            self._num_items,
+            max(1, len(self.attack_cameras)) if config.random_camera else 1,
+            self.attacks,
         )
         # Shared memory, so that set_epoch in the main process reaches persistent dataloader workers too.
         self._epoch = torch.zeros((), dtype=torch.int64).share_memory_()

@@ -8,9 +8,12 @@ by ``--phantom.instruction_rate``/``instruction_attacks``) is planned per epoch,
    epoch is exactly ``k / N`` (off from ``rate`` by at most ``1 / (2N)``), not merely ``rate`` in expectation;
 3. those ``k`` positions are split between the attacks in proportion to their weights (largest remainder), so the
    per-attack counts are exact too;
-4. within each attack's share, intensities are stratified: the share is cut into equal strata of the intensity
-   range and each item gets a uniform draw inside its own stratum (a Latin-hypercube draw: uniform marginally,
-   and the histogram over an epoch is flat to within one item per stratum);
+4. within each attack's share, intensities are stratified: the share is cut into ``count`` equal strata of
+   [0, 1) and each item gets a uniform draw ``u`` inside its own stratum (a Latin-hypercube draw: uniform
+   marginally, the histogram over an epoch flat to within one item per stratum), mapped to an intensity by the
+   slot's quantile function: ``low + (high - low) * u`` for an intensity range, or, for ``"random"``, the
+   attack's adversarial-training distribution (``intensity.random_intensities``: e.g. ultrasound blur's
+   ``randint(5, 20)`` px), so its epoch histogram follows that distribution to within one item per stratum;
 5. for ``--phantom.cameras=[random]``, the camera slots are dealt evenly over the attacked items the same way.
 
 Nothing depends on the number of dataloader workers, on the sampler order or on the process rank: item ``i``'s
@@ -21,7 +24,7 @@ come from ``sample_seed(seed, epoch, i)``.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import torch
@@ -78,12 +81,20 @@ def plan_channel(
     epoch: int,
     channel: str,
     num_camera_slots: int = 1,
+    quantiles: Sequence[Callable[[torch.Tensor], torch.Tensor]] | None = None,
 ) -> ChannelPlan:
-    """Plan one channel for one epoch (see the module docstring for the construction)."""
+    """Plan one channel for one epoch (see the module docstring for the construction).
+
+    ``quantiles``: one function per attack slot (same order as ``weights``) from stratified uniform draws ``u``
+    in [0, 1) to intensities in [0, 1] (``intensity.random_intensities`` bound to the attack, for ``"random"``);
+    ``None`` spreads ``u`` uniformly over ``intensity_range``.
+    """
     if num_items < 0:
         raise ValueError(f"num_items must be >= 0, got {num_items}")
     if num_camera_slots < 1:
         raise ValueError(f"num_camera_slots must be >= 1, got {num_camera_slots}")
+    if quantiles is not None and len(quantiles) != len(weights):
+        raise ValueError(f"need one quantile function per attack slot ({len(weights)}), got {len(quantiles)}")
     generator = torch.Generator().manual_seed(derive_seed("phantom-plan", int(seed), int(epoch), channel))
     choice = torch.full((num_items,), -1, dtype=torch.int16)
     intensity = torch.zeros(num_items, dtype=torch.float32)
@@ -103,6 +114,10 @@ def plan_channel(
         choice[members] = slot
         strata = torch.randperm(count, generator=generator).to(torch.float64)
         jitter = torch.rand(count, generator=generator, dtype=torch.float64)
-        intensity[members] = (low + (high - low) * (strata + jitter) / count).to(torch.float32)
+        u = (strata + jitter) / count
+        if quantiles is None:
+            intensity[members] = (low + (high - low) * u).to(torch.float32)
+        else:
+            intensity[members] = quantiles[slot](u).to(torch.float32).reshape(count)
     camera_slot[order] = (torch.randperm(attacked, generator=generator) % num_camera_slots).to(torch.int16)
     return ChannelPlan(choice, intensity, camera_slot)

@@ -44,6 +44,7 @@ Deviations from the paper's code (and why):
 
 from __future__ import annotations
 
+import functools
 from typing import ClassVar
 
 import torch
@@ -205,12 +206,49 @@ def _corrupt_rows_gathered(out: torch.Tensor, weights: torch.Tensor) -> torch.Te
         if out.dtype == torch.uint8:  # the partial rows' blend in float, on those rows only
             clean = original.to(torch.float32).div_(255.0)
             blended = torch.lerp(clean, em_color_error(clean[None])[0], w).mul_(255.0).round_()
-            corrupted[:, partial] = blended.to(torch.uint8)
+            corrupted[:, partial] = blended.to(torch.int16).to(torch.uint8)  # 3x faster than float -> uint8
         else:
             corrupted[:, partial] = torch.lerp(original, corrupted.index_select(1, partial), w.to(out.dtype))
     source_of = torch.arange(count, device=out.device)
     source_of[index] = torch.arange(count, count + index.numel(), device=out.device)
     return source.index_select(0, source_of).view(batch, 3, height, width)
+
+
+@functools.lru_cache(maxsize=256)
+def _band_runs(
+    height: int, num_stripes: float, band_fraction: float, next_num_stripes: float, mix: float
+) -> tuple[tuple[int, int], ...] | None:
+    """The fully corrupted row runs of one parameter set, or None when it has partial rows (validated; pure, so
+    cached: a level or the 9 stripe counts of ``"random"`` cost no tensor op per call)."""
+    weights = _row_weights(height, 1, torch.device("cpu"), num_stripes, band_fraction, next_num_stripes, mix)[
+        0
+    ]
+    if not bool(((weights == 0) | (weights == 1)).all()):
+        return None
+    return tuple(_runs(weights.tolist()))
+
+
+def _values(value: float | torch.Tensor, batch: int, what: str) -> list[float]:
+    """A scalar or a ``(batch,)`` / ``(1,)`` tensor -> ``batch`` Python floats (one host copy, no tensor ops)."""
+    values = value.reshape(-1).tolist() if isinstance(value, torch.Tensor) else [float(value)]
+    if len(values) == 1:
+        return values * batch
+    if len(values) != batch:
+        raise ValueError(
+            f"{what} must be a scalar or have one value per sample ({batch}), got {len(values)} values"
+        )
+    return [float(v) for v in values]
+
+
+def _consecutive(members: list[int]) -> list[tuple[int, int]]:
+    """Increasing indices -> ``[first, stop)`` runs of consecutive ones."""
+    runs: list[tuple[int, int]] = []
+    for i in members:
+        if runs and runs[-1][1] == i:
+            runs[-1] = (runs[-1][0], i + 1)
+        else:
+            runs.append((i, i + 1))
+    return runs
 
 
 def em_color_strip_rgb(
@@ -223,14 +261,51 @@ def em_color_strip_rgb(
     """``em_color_strip`` on RGB ``(B, 3, H, W)``, uint8 or float (the transform's inner op).
 
     Returns a fresh tensor; float values are clamped to [0, 1] (the input first, so every output row is too).
+    Samples with whole-row patterns (the levels, ``"random"``'s integer stripe counts) are grouped by pattern and
+    corrupted in place through strided views: uint8 batches are copied once in group order and once back (two
+    cheap copies instead of ~20 ops per sample), float batches per run of consecutive samples of a copy; other
+    patterns gather their rows.
     """
     batch, _, height, _ = x.shape
+    columns = [
+        _values(value, batch, what)
+        for value, what in (
+            (num_stripes, "num_stripes"),
+            (band_fraction, "band_fraction"),
+            (num_stripes if next_num_stripes is None else next_num_stripes, "next_num_stripes"),
+            (mix, "mix"),
+        )
+    ]
+    groups: dict[tuple[tuple[int, int], ...], list[int]] = {}
+    for i, key in enumerate(zip(*columns, strict=True)):
+        runs = _band_runs(height, *key)
+        if runs is None:
+            groups = {}
+            break
+        groups.setdefault(runs, []).append(i)
+    if groups:
+        if len(groups) == 1:
+            out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
+            _corrupt_bands_(out, list(next(iter(groups))))
+            return out
+        if x.dtype != torch.uint8:
+            # float: a copy of the batch costs more than a few ops per sample, so each run of consecutive samples
+            # is corrupted in place in the clamped copy (measured: 86 vs 118 us per 224x224 image at batch 32)
+            out = x.clamp(0.0, 1.0).contiguous()
+            for runs, members in groups.items():
+                for first, stop in _consecutive(members):
+                    _corrupt_bands_(out[first:stop], list(runs))
+            return out
+        order = [i for members in groups.values() for i in members]
+        index = torch.tensor(order, device=x.device)
+        grouped = x.index_select(0, index)  # whole images: a memcpy each, unlike a row gather
+        first = 0
+        for runs, members in groups.items():
+            _corrupt_bands_(grouped[first : first + len(members)], list(runs))
+            first += len(members)
+        return grouped.index_select(0, torch.argsort(index))
     weights = _row_weights(height, batch, x.device, num_stripes, band_fraction, next_num_stripes, mix)
     out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
-    uniform = bool((weights == weights[:1]).all())
-    if uniform and bool(((weights == 0) | (weights == 1)).all()):
-        _corrupt_bands_(out, _runs(weights[0].tolist()))
-        return out
     if not bool((weights > 0).any()):
         return out
     return _corrupt_rows_gathered(out, weights)

@@ -122,13 +122,18 @@ def intensity_for(values: torch.Tensor, points: Sequence[float]) -> torch.Tensor
         raise ValueError(
             f"need 4 non-decreasing level points (identity, weak, medium, strong), got {points!r}"
         )
-    v = values.to(torch.float32)
-    s = torch.zeros_like(v)
-    for k in range(3):
-        low, high = float(points[k]), float(points[k + 1])
-        frac = torch.ones_like(v) if high == low else ((v - low) / (high - low)).clamp(0.0, 1.0)
-        s = torch.where(v >= low, torch.maximum(s, (k + frac) / 3.0), s)
-    return s
+    v = values.to(torch.float32).contiguous()
+    # the map is monotone, so s lies on the last segment whose start is <= v (one vectorised lookup, not a loop)
+    starts = torch.tensor(points[:3], dtype=torch.float32, device=v.device)
+    segment = torch.searchsorted(starts, v, right=True) - 1
+    k = segment.clamp(min=0)
+    ends64 = torch.tensor(points, dtype=torch.float64, device=v.device)
+    span = (ends64[1:] - ends64[:3]).to(torch.float32)[k]  # as the Python float difference, then float32
+    flat = span == 0
+    frac = torch.where(
+        flat, torch.ones_like(v), ((v - starts[k]) / torch.where(flat, 1.0, span)).clamp(0.0, 1.0)
+    )
+    return torch.where(segment < 0, torch.zeros_like(v), (k.to(torch.float32) + frac) / 3.0)
 
 
 @dataclass(frozen=True)

@@ -285,7 +285,8 @@ class LaserBlinding(CameraAttack):
         assert self._user_pattern is not None
         return self._cached(
             ("user", height, width, str(device)),
-            lambda: resize_pattern(self._user_pattern, height, width).to(device),
+            # contiguous CHW: an image's HWC pixels make every broadcast blend several times slower
+            lambda: resize_pattern(self._user_pattern, height, width).to(device).contiguous(),
         )
 
     def spot_pixel(self, position: torch.Tensor, height: int, width: int) -> torch.Tensor:

@@ -41,12 +41,16 @@ so the blur is a sum of ``N + 1`` shifted views of the image with an in-bounds c
 by doubling: ``~2 log2(N)`` shifted adds (5 instead of 17 at the strong level on 224x224); other directions take
 ``~N`` strided adds. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical
 parameters (one pass per distinct displacement: at most 16 under ``"random"``, which draws the authors' whole-pixel
-``randint(5, 20)``). uint8 images are blurred on their 0-255 values (float32 sums of integers are exact) and
-rounded once, with no scaling to [0, 1] and back.
+``randint(5, 20)``; the geometry of each displacement is cached). uint8 images are blurred on their 0-255
+values: the sums in int16 (exact), the division in float32, rounded once (half to even, as the float path),
+with no scaling to [0, 1] and back. Cost, measured (``scripts/bench_transforms.py``): a few images at a time in
+cache, the strong level takes about 12 passes over the frame (widen, 5 shifted adds with their border copies,
+convert, divide, round, narrow twice); every one of them is at least a ``torch.clone``'s cost.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from typing import ClassVar
 
@@ -125,76 +129,138 @@ def _shift_add(
     if r0 >= r1 or c0 >= c1:
         return out.copy_(a)
     torch.add(a[..., r0:r1, c0:c1], b[..., r0 + dr : r1 + dr, c0 + dc : c1 + dc], out=out[..., r0:r1, c0:c1])
-    for rows, cols in ((slice(0, r0), slice(None)), (slice(r1, None), slice(None))):
-        out[..., rows, cols].copy_(a[..., rows, cols])
-    for cols in (slice(0, c0), slice(c1, None)):
-        out[..., r0:r1, cols].copy_(a[..., r0:r1, cols])
+    # the border strips b does not reach keep a (empty strips are skipped: each op costs a dispatch)
+    for rows, cols in ((slice(0, r0), slice(None)), (slice(r1, height), slice(None))):
+        if rows.start < rows.stop:
+            out[..., rows, cols].copy_(a[..., rows, cols])
+    for cols in (slice(0, c0), slice(c1, width)):
+        if cols.start < cols.stop:
+            out[..., r0:r1, cols].copy_(a[..., r0:r1, cols])
     return out
 
 
-def _box_sum(x: torch.Tensor, step: tuple[int, int], length: int) -> torch.Tensor:
+def _box_sum(
+    x: torch.Tensor, step: tuple[int, int], length: int, scratch: list[torch.Tensor]
+) -> torch.Tensor:
     """``sum_{i < length} x[r + i sr, c + i sc]`` (zero outside) by doubling: ~2 log2(length) shifted adds instead of
-    ``length`` (5 instead of 17 at the paper's strong level on 224x224), summed as a tree (float error ~log2)."""
+    ``length`` (5 instead of 17 at the paper's strong level on 224x224), summed as a tree (float error ~log2).
+
+    ``scratch``: four buffers shaped like ``x`` (reused by every chunk of a batch: no allocation per add). The
+    result is one of them, or ``x`` itself when ``length == 1``."""
+    free = list(scratch)
     result, covered, power, size = None, 0, x, 1
     while True:
         if length & 1:
             if result is None:
                 result, covered = power, size
             else:
-                result = _shift_add(result, power, covered, step, torch.empty_like(x))
-                covered += size
+                target = free.pop()
+                _shift_add(result, power, covered, step, target)
+                if result is not x and result is not power:
+                    free.append(result)
+                result, covered = target, covered + size
         length >>= 1
         if not length:
             return result
-        power = _shift_add(power, power, size, step, torch.empty_like(x))
-        size *= 2
+        target = free.pop()
+        _shift_add(power, power, size, step, target)
+        if power is not x and power is not result:
+            free.append(power)
+        power, size = target, size * 2
 
 
-def _linear_blur(x: torch.Tensor, d_row: float, d_col: float, upper: float | None = None) -> torch.Tensor:
-    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views.
-
-    ``upper``: clamp the result to [0, upper], chunk by chunk while it is in cache (a fresh tensor then)."""
-    batch, _, height, width = x.shape
+@functools.lru_cache(maxsize=64)
+def _linear_geometry(
+    height: int, width: int, d_row: float, d_col: float
+) -> tuple[int, tuple[int, int] | None, list, torch.Tensor]:
+    """Per image size and displacement: (samples - 1, the box step or None, the samples' spans, the in-bounds
+    count map ``(H, W)`` float32 on the CPU). Pure, so cached: a batch of one displacement costs no Python per
+    image, and "random"'s at most 16 displacements are computed once."""
     num = min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES)
-    if num <= 0:
-        return x if upper is None else x.clamp(0.0, upper)
     spans = [
         (_axis_spans(height, i / num * d_row), _axis_spans(width, i / num * d_col)) for i in range(num + 1)
     ]
-    row_valid = _axis_valid(height, [rows for rows, _ in spans], x.device)
-    col_valid = _axis_valid(width, [cols for _, cols in spans], x.device)
-    count = (row_valid.T @ col_valid).to(x.dtype)  # (H, W) in-bounds samples; sample 0 is the pixel itself
+    row_valid = _axis_valid(height, [rows for rows, _ in spans], torch.device("cpu"))
+    col_valid = _axis_valid(width, [cols for _, cols in spans], torch.device("cpu"))
+    count = row_valid.T @ col_valid  # (H, W) in-bounds samples; sample 0 is the pixel itself
     # The paper's diagonal (and any axis-aligned path): sample i sits exactly i steps of (0 or 1, 0 or 1) away,
     # so the path is a box along one direction, summed by doubling.
     shifts = [
         (math.floor(i / num * d_row + SNAP), math.floor(i / num * d_col + SNAP)) for i in range(num + 1)
     ]
     step = shifts[1]
-    if step in ((1, 1), (1, 0), (0, 1)) and all(
+    is_box = step in ((1, 1), (1, 0), (0, 1)) and all(
         s == (i * step[0], i * step[1]) for i, s in enumerate(shifts)
-    ):
-        out = torch.empty_like(x)
-        per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())  # a few images at a time stay in cache
-        for first in range(0, batch, per_chunk):
-            part = x[first : first + per_chunk]
-            torch.div(_box_sum(part, step, num + 1), count, out=out[first : first + per_chunk])
-            if upper is not None:
-                out[first : first + per_chunk].clamp_(0.0, upper)
-        return out
+    )
+    return num, step if is_box else None, spans, count
+
+
+def _linear_blur(x: torch.Tensor, d_row: float, d_col: float, upper: float | None = None) -> torch.Tensor:
+    """Fast path: the paper's path with no rotation and no radial part, as a sum of shifted views.
+
+    Float ``x``: the mean, clamped to [0, upper] when ``upper`` is given (chunk by chunk while it is in cache; a
+    fresh tensor then). uint8 ``x``: the mean of the 0-255 values rounded to uint8; the sums run in int16 (exact:
+    at most 101 x 255), only the division in float32, so the result equals the float path's rounded mean."""
+    if min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES) <= 0:
+        return x if x.dtype == torch.uint8 or upper is None else x.clamp(0.0, upper)
     out = torch.empty_like(x)
-    # a few images at a time keep the ~N read-modify-write passes in cache
-    per_chunk = max(1, _CHUNK_ELEMENTS // x[0].numel())
-    for first in range(0, batch, per_chunk):
-        part = x[first : first + per_chunk]
-        total = part.clone()  # sample i = 0: offset (0, 0)
-        for row_spans, col_spans in spans[1:]:
-            for r0, r1, rs in row_spans:
-                for c0, c1, cs in col_spans:
-                    total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
-        torch.div(total, count, out=out[first : first + per_chunk])
-        if upper is not None:
-            out[first : first + per_chunk].clamp_(0.0, upper)
+    _linear_blur_into(out, x, list(range(x.shape[0])), d_row, d_col, upper)
     return out
+
+
+def _linear_blur_into(
+    out: torch.Tensor, x: torch.Tensor, members: list[int], d_row: float, d_col: float, upper: float | None
+) -> None:
+    """``out[members] = _linear_blur(x[members], ...)`` without gathering or scattering the batch: a few images
+    at a time are read into a scratch that stays in cache (views when they are consecutive) and written back."""
+    _, channels, height, width = x.shape
+    if min(int(max(abs(d_row), abs(d_col)) + SNAP), MAX_SAMPLES) <= 0:
+        for i in members:
+            out[i].copy_(x[i] if x.dtype == torch.uint8 or upper is None else x[i].clamp(0.0, upper))
+        return
+    num, step, spans, count = _linear_geometry(height, width, float(d_row), float(d_col))
+    integer = x.dtype == torch.uint8
+    work_dtype = torch.int16 if integer else x.dtype
+    count = count.to(x.device, torch.float32 if integer else x.dtype)
+    per_chunk = min(len(members), max(1, _CHUNK_ELEMENTS // x[0].numel()))  # a few images stay in cache
+    shape = (per_chunk, channels, height, width)
+    scratch = [torch.empty(shape, dtype=work_dtype, device=x.device) for _ in range(4 if step else 1)]
+    gathered = torch.empty(shape, dtype=work_dtype, device=x.device)
+    quotient = torch.empty(shape, dtype=torch.float32, device=x.device) if integer else None
+    for start in range(0, len(members), per_chunk):
+        chunk = members[start : start + per_chunk]
+        size, first = len(chunk), chunk[0]
+        consecutive = chunk[-1] - first == size - 1  # members are increasing
+        if consecutive and not integer:
+            part = x[first : first + size]
+        else:
+            part = gathered[:size]
+            if consecutive:
+                part.copy_(x[first : first + size])
+            else:
+                for j, i in enumerate(chunk):
+                    part[j].copy_(x[i])
+        if step is not None:
+            total = _box_sum(part, step, num + 1, [buffer[:size] for buffer in scratch])
+        else:
+            total = scratch[0][:size].copy_(part)  # sample i = 0: offset (0, 0)
+            for row_spans, col_spans in spans[1:]:
+                for r0, r1, rs in row_spans:
+                    for c0, c1, cs in col_spans:
+                        total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
+        if integer:
+            mean = torch.div(total, count, out=quotient[:size]).round_()
+            # float32 -> uint8 is 3x slower than float32 -> int16 -> uint8 on the CPU (values are 0..255 here)
+            result = gathered[:size].copy_(mean)
+        else:
+            result = torch.div(total, count, out=gathered[:size] if part is not gathered[:size] else total)
+            if upper is not None:
+                result.clamp_(0.0, upper)
+        if consecutive:
+            out[first : first + size].copy_(result)
+        else:
+            for j, i in enumerate(chunk):
+                out[i].copy_(result[j])
 
 
 def _general_blur(
@@ -251,8 +317,9 @@ def ultrasound_blur_float(
     scale: float | torch.Tensor = 0.0,
     upper: float | None = None,
 ) -> torch.Tensor:
-    """``ultrasound_blur`` on float RGB ``(B, 3, H, W)`` in [0, 1] (the transform's inner op). ``upper``: also clamp
-    the result to [0, upper] while it is in cache (a fresh tensor then; the mean of in-range values is in range)."""
+    """``ultrasound_blur`` on RGB ``(B, 3, H, W)`` (the transform's inner op): float in [0, 1], or uint8, blurred on
+    its 0-255 values and rounded once. ``upper`` (float only): also clamp the result to [0, upper] while it is in
+    cache (a fresh tensor then; the mean of in-range values is in range)."""
     batch = x.shape[0]
     columns = _per_sample(dx, batch, "dx")
     rows = _per_sample(dy, batch, "dy")
@@ -261,23 +328,27 @@ def ultrasound_blur_float(
     groups: dict[tuple[float, float, float, float], list[int]] = {}
     for i, key in enumerate(zip(rows, columns, angles, scales, strict=True)):
         groups.setdefault(key, []).append(i)
-    out = torch.empty_like(x) if len(groups) > 1 else None
+    out = torch.empty_like(x)
     for (d_row, d_col, angle, radial), members in groups.items():
-        part = x if out is None else x[members]
         if angle == 0.0 and radial == 0.0:
-            blurred = _linear_blur(part, d_row, d_col, upper)
+            _linear_blur_into(out, x, members, d_row, d_col, upper)
+            continue
+        part = x if len(groups) == 1 else x[members]
+        if part.dtype == torch.uint8:
+            mean = _general_blur(part.to(torch.float32), d_row, d_col, angle, radial).round_()
+            blurred = mean.to(torch.int16).to(torch.uint8)  # float -> uint8 through int16: 3x faster
         else:
             blurred = _general_blur(part, d_row, d_col, angle, radial, upper)
-        if out is None:
+        if len(groups) == 1:
             return blurred
         out[members] = blurred
     return out
 
 
 def _blur_uint8(x: torch.Tensor, dx, dy, theta_deg, scale) -> torch.Tensor:
-    """uint8 RGB: the blur on the 0-255 values themselves (float32 sums of integers are exact), rounded once; no
-    scaling to [0, 1] and back (the mean of in-range values needs no clamp)."""
-    return ultrasound_blur_float(x.to(torch.float32), dx, dy, theta_deg, scale).round_().to(torch.uint8)
+    """uint8 RGB: the blur on the 0-255 values themselves (int16 sums, exact), rounded once; no scaling to [0, 1]
+    and back (the mean of in-range values needs no clamp)."""
+    return ultrasound_blur_float(x, dx, dy, theta_deg, scale)
 
 
 def ultrasound_blur(

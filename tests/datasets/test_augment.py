@@ -177,7 +177,6 @@ def test_unit_episode_attacks_whole_episodes_with_one_parameter_set(image_datase
 
 
 def test_instruction_attacks_become_new_tasks(image_dataset_root, tmp_path):
-    pytest.importorskip("lerobot_phantom.transforms.instruction")
     phantom = PhantomConfig(rate=0.0, instruction_attacks=["voice_spoofing"], instruction_rate=0.5, seed=3)
     result = augment(config(image_dataset_root, tmp_path / "out", phantom=phantom))
     source, output = load(image_dataset_root, REPO), load(result.output_root)

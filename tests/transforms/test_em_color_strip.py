@@ -212,3 +212,18 @@ def test_random_draws_the_authors_integer_stripe_counts():
     for i in range(4):
         expected = _reference(imgs[i], int(small["num_stripes"][i]))
         torch.testing.assert_close(out[i], expected, atol=0, rtol=0)
+
+
+@pytest.mark.parametrize("dtype", [torch.uint8, torch.float32])
+def test_random_batch_equals_each_sample_on_its_own(dtype):
+    """ "random" groups the batch by stripe count (one copy in group order, one back): each sample's output is the
+    one it gets alone."""
+    images = _random_uint8((10, 3, 50, 30), 8)
+    images = images if dtype == torch.uint8 else images.float() / 255
+    attack = EMColorStrip("random", seed=1)
+    params = attack.sample_params(10, 50, 30, generator=torch.Generator().manual_seed(2))
+    assert len(set(params["num_stripes"].tolist())) > 2
+    out = attack.apply_params(images, params)
+    for i in range(10):
+        alone = {k: v[i : i + 1] for k, v in params.items()}
+        assert torch.equal(out[i : i + 1], attack.apply_params(images[i : i + 1], alone)), f"sample {i}"

@@ -180,3 +180,16 @@ def test_watermark_fully_outside_is_identity():
     img = _random_uint8((3, 16, 16), seed=3)
     out = LightProjection("strong", x_offset=10_000)(img)
     assert torch.equal(out, img)
+
+
+@pytest.mark.parametrize("position", ["fixed", "random"])
+def test_uint8_kernel_is_the_float_composite_rounded(position):
+    """The uint8 kernel (PIL's integer paste formula in int16) equals the float path rounded, with per-sample
+    transparencies and (random) positions, the watermark partly off the frame included."""
+    images = _random_uint8((8, 3, 48, 64), 5)
+    attack = LightProjection("random", position=position, max_offset=150.0, seed=2)
+    params = attack.sample_params(8, 48, 64, generator=torch.Generator().manual_seed(3))
+    assert len(set(params["transparency"].tolist())) == 8
+    out = attack.apply_params(images, params)
+    reference = attack.apply_params(images.float() / 255, params)
+    assert torch.equal(out, torch.round(reference * 255).to(torch.uint8))

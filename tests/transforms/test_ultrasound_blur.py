@@ -246,3 +246,18 @@ def test_random_draws_the_authors_integer_displacements():
     assert float((d < 10).double().mean()) == pytest.approx(5 / 16, abs=0.03)
     half = UltrasoundBlur("random").sample_params(8, 128, 128, generator=torch.Generator().manual_seed(0))
     torch.testing.assert_close(half["dx"] * 2, d[:8])  # same draws, scaled with the image
+
+
+@pytest.mark.parametrize("random_direction", [False, True])
+def test_uint8_path_is_the_exactly_rounded_mean_for_mixed_displacements(random_direction):
+    """The uint8 kernel sums in int16 and divides once: equal to the float64 mean of the 0-255 values rounded half
+    to even, per sample, whatever the grouping of a batch with several displacements (box and strided paths)."""
+    images = _random_uint8((6, 3, 40, 48), 21)
+    attack = UltrasoundBlur("random", random_direction=random_direction, seed=4)
+    params = attack.sample_params(6, 40, 48, generator=torch.Generator().manual_seed(9))
+    assert len(set(params["dx"].tolist())) > 1  # several groups
+    out = attack.apply_params(images, params)
+    for i in range(6):
+        d_row, d_col = float(params["dy"][i]), float(params["dx"][i])
+        expected = torch.round(_linear_blur(images[i : i + 1].double(), d_row, d_col)).to(torch.uint8)
+        assert torch.equal(out[i : i + 1], expected), f"sample {i} (d_row={d_row:.3f}, d_col={d_col:.3f})"
