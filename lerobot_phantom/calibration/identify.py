@@ -204,10 +204,28 @@ def parameter_intervals(
     return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
 
 
+def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozenset[str]:
+    """The effects in ``effects`` that build on ``effect``, directly or through another one (``Effect.requires``)."""
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    found: set[str] = set()
+    frontier = {effect}
+    while frontier:
+        frontier = {e for e in effects if requires.get(e, set()) & frontier} - found
+        found |= frontier
+    return frozenset(found)
+
+
 def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
-    """The parameters the model with ``effects`` has and the model without ``effect`` lacks."""
-    without = {p.name for p in problem.param_specs(effects - {effect})}
-    return [p for p in problem.param_specs(effects) if p.name not in without]
+    """The parameters ``effect`` itself adds to the model with ``effects``.
+
+    Removing an effect also removes what builds on it (a stripe model without the exposure overlap has no
+    detection threshold either), so the parameters the model loses with it are split: those of each dependant
+    (found the same way, leaves first) belong to that dependant, the rest to ``effect``. A child at its bound
+    therefore makes the child "not identified", never its parent."""
+    below = dependants(problem, effects, effect)
+    without = {p.name for p in problem.param_specs(effects - {effect} - below)}
+    theirs = {p.name for child in below for p in own_params(problem, effects, child)}
+    return [p for p in problem.param_specs(effects) if p.name not in without and p.name not in theirs]
 
 
 @dataclass

@@ -5,12 +5,16 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
 from lerobot_phantom.calibration.identify import (
     Interval,
     at_bound,
     bootstrap,
+    dependants,
     error_ratio,
     identify,
+    identify_selection,
+    own_params,
     percentile_interval,
     resample,
     rmse_interval,
@@ -114,3 +118,50 @@ def test_each_condition_alone_makes_it_not_identified(override, reason):
 
 def test_a_change_of_functional_form_needs_no_null_value():
     assert identified(nulls={}).identified
+
+
+class ParentAndChild(Problem):
+    """A parent extension and a child that builds on it; without the parent the model has neither parameter (as
+    a stripe model without the exposure overlap has no detection threshold). The child's parameter sits at its
+    bound on every fit."""
+
+    candidates = (Effect("parent", "a real cause"), Effect("child", "a refinement", requires=("parent",)))
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        if "parent" not in effects:
+            return []
+        return [Param("rate", 1.0, 0.0, 10.0)] + (
+            [Param("threshold", 0.5, 0.0, 1.0)] if "child" in effects else []
+        )
+
+    def fit(self, effects, items, start=None) -> Fit:
+        names = [p.name for p in self.param_specs(effects)]
+        values = {"rate": 3.0 + 0.01 * float(np.mean(items)), "threshold": 0.0}
+        return Fit(effects, {n: values[n] for n in names})
+
+
+def test_own_params_of_a_parent_exclude_its_dependants_params():
+    problem = ParentAndChild()
+    both = frozenset({"parent", "child"})
+    assert dependants(problem, both, "parent") == {"child"}
+    assert [p.name for p in own_params(problem, both, "parent")] == ["rate"]
+    assert [p.name for p in own_params(problem, both, "child")] == ["threshold"]
+
+
+def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
+    problem = ParentAndChild()
+    items = np.arange(20)
+    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+    steps = [
+        Step([], 2.0, {}, 4.0 * per_item),
+        Step(["parent"], 1.0, {}, per_item),
+        Step(["child", "parent"], 0.9, {}, 0.8 * per_item),
+    ]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    parent, child = selection.results
+    assert parent["effect"] == "parent" and parent["identified"], parent["reasons"]
+    assert child["effect"] == "child" and not child["identified"]
+    assert any("threshold = 0 sits at its low bound" in r for r in child["reasons"])
+    assert selection.identified == ["parent"]
+    assert selection.fit.effects == {"parent"} and set(selection.fit.params) == {"rate"}
