@@ -3,6 +3,11 @@
 Base (the paper): the captured colour is an alpha blend of the surface and the projected colour. Physically a
 projector's light *adds* to the ambient light, in proportion to what the surface reflects, seen through the
 camera's colour filters (cross-talk between primaries), and the sensor saturates.
+
+Every model's output is clipped to the file's range (no camera writes more than its white); ``clipping`` is a
+sensor that saturates *below* the file's maximum (a white level < 1, e.g. video range or white-balance gains
+applied after the raw clip), so saturation exactly at the file's maximum is part of every model and is never
+named as a cause.
 """
 
 from __future__ import annotations
@@ -64,7 +69,11 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
     elif additive:
         specs.append(Param("strength", 0.3, 0.0, 20.0, scale=0.3))
     if "albedo_modulation" in effects:
-        specs.append(Param("reflectance_floor", 0.1, 0.0, 10.0, scale=0.1))
+        # light reflected ~ (surface + floor): a positive floor is light returned whatever the reflectance
+        # (specular sheen); a slightly negative one removes the clean frame's veiling glare and black offset,
+        # which the projected light is not multiplied by (at most a few percent of full scale). A large floor
+        # is the null (no modulation): the range ends where modulation has all but vanished.
+        specs.append(Param("reflectance_floor", 0.1, -0.05, 2.0, scale=0.1))
     if "clipping" in effects:
         specs.append(Param("white", 0.95, 0.2, 1.0, scale=0.1))
     if "sensor_gamma" in effects:
@@ -76,7 +85,7 @@ def projection_nulls(effect: str) -> dict[str, float]:
     """Values at which an effect reduces to the model without it (none for a change of form)."""
     if effect == "channel_crosstalk":  # no camera channel picks up another projected channel
         return {n: 0.0 for n in CROSSTALK_NAMES if n[-2] != n[-1]}
-    if effect == "clipping":
+    if effect == "clipping":  # saturation at the file's maximum is in every model
         return {"white": 1.0}
     if effect == "sensor_gamma":
         return {"gamma": 1.0}
@@ -98,7 +107,7 @@ def projection_predict(
     if "additive_light" in effects:
         light = strength * light * (1.0 if "channel_crosstalk" in effects else params["strength"])
         if "albedo_modulation" in effects:
-            light = light * (surface_lin + params["reflectance_floor"])
+            light = light * (surface_lin + params["reflectance_floor"]).clamp(min=0.0)
         total = surface_lin + light
     else:
         opacity = params["opacity"] * strength
