@@ -38,7 +38,10 @@ EFFECTS = (
     Effect(
         "channel_crosstalk",
         "the projector's red, green and blue primaries are seen through the camera's overlapping colour filters: "
-        "each camera channel picks up a mix of the projected channels (a 3x3 matrix)",
+        "each camera channel picks up a mix of the projected channels (a 3x3 matrix); a property of projected "
+        "light, so it builds on additive_light (a blend with a free matrix can dim the surface and add light at "
+        "once, which absorbs tone-curve and reflectance effects instead of naming them)",
+        requires=("additive_light",),
     ),
     Effect(
         "clipping",
@@ -111,10 +114,7 @@ def projection_predict(
         total = surface_lin + light
     else:
         opacity = params["opacity"] * strength
-        # with cross-talk the matrix carries the projected light's scale itself: opacity x matrix would let the
-        # two trade off without bound (only their product is seen), so opacity only dims the surface
-        seen = strength * light if "channel_crosstalk" in effects else opacity * light
-        total = (1.0 - opacity) * surface_lin + seen
+        total = (1.0 - opacity) * surface_lin + opacity * light
     if "clipping" in effects:
         total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
     if gamma:
@@ -158,12 +158,8 @@ def projection_kwargs(fit: Fit) -> dict:
         "reflectance_floor": p.get("reflectance_floor", 0.0),
         "gamma": p.get("gamma", 1.0),
     }
-    if "channel_crosstalk" in effects and not additive:
-        kwargs["strength"] = p["opacity"]
-    if "channel_crosstalk" in effects:
-        # the blend transform scales the matrix by its opacity: hand it the matrix per unit opacity
-        per_unit = 1.0 if additive else 1.0 / max(p["opacity"], 1e-6)
-        kwargs["crosstalk"] = [[per_unit * p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+    if "channel_crosstalk" in effects:  # builds on additive light: the matrix carries the light's scale
+        kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
     return kwargs
