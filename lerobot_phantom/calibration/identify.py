@@ -14,7 +14,10 @@ The rule (:func:`identify`): an extension is a named cause only if
    range, not the camera);
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
-   least one such parameter excludes its null value.
+   least one such parameter excludes its null value;
+5. the problem's own adequacy checks of the effect's physics pass, where it has any
+   (``problem.identification_checks(effect, fit, items) -> [reasons]``; e.g. a stabiliser's motion blur must be one
+   path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
 
 Otherwise it is reported as "not identified" with the reasons, and it is not part of the model that is written.
 """
@@ -274,9 +277,16 @@ def identify_selection(
             nulls=nulls,
         )
         result = outcome.as_dict()
+        # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
+        # whole frame); each failed check is a reason
+        checks = getattr(problem, "identification_checks", None)
+        failed = checks(effect, selected_fit, fit_items) if checks is not None and outcome.identified else []
+        if failed:
+            result.update(identified=False, status="not identified")
+            result["reasons"].extend(failed)
         requires = next((e.requires for e in problem.candidates if e.name == effect), ())
         missing = [r for r in requires if r not in identified]
-        if missing and outcome.identified:
+        if missing and result["identified"]:
             result.update(identified=False, status="not identified")
             result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
         result.update(
