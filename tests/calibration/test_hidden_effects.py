@@ -114,7 +114,7 @@ def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack, see
 def test_shot_noise_is_found_by_likelihood_and_changes_no_prediction(tmp_path):
     measured = tmp_path / "measured"
     measured.mkdir()
-    shot = 1e-3  # noise variance per unit signal in [0, 1] units, on clean and attacked frames alike
+    shot = 1e-3  # noise variance per unit of linear signal (full scale 1), on clean and attacked frames alike
     kit.render_em_truncation(measured, set(), seed=13, shot=shot, dim=0.15)
     report = calibrate(
         CalibrateConfig(attack="em_truncation", measured=str(measured), out=str(tmp_path / "out"))
@@ -123,10 +123,13 @@ def test_shot_noise_is_found_by_likelihood_and_changes_no_prediction(tmp_path):
     assert report["extended"]["effects"] == []
     assert [f["effect"] for f in report["findings"]] == ["shot_noise"]
     noise = report["noise"]
-    assert noise["kept"] and noise["validation_noise_scale_ratio"] >= 1 / (1 - 0.05)
-    assert noise["heldout_noise_scale_ratio"] > 1.02  # the gain holds on pairs never seen
+    # named (noise.py): the linear-light variance law generalises, its interval excludes 0, it is most of the noise
+    assert noise["kept"] and noise["validation_noise_scale_ratio"] > 1.0, noise["reasons"]
+    assert noise["intervals"]["shot_gain_grey"]["low"] > 0.0 and noise["shot_share"]["estimate"] >= 0.5
+    assert noise["heldout_noise_scale_ratio"] > 1.0  # the gain holds on pairs never seen
     assert report["gain"]["rmse_ratio"] == pytest.approx(1.0)  # a noise model predicts nothing new
-    # residual = attacked - clean: two independent draws, variance 2 (read^2 + shot * signal) -> gain 2 * shot * 255
+    # residual = attacked - clean: two independent draws, variance 2 (read^2 + shot * signal) in linear light ->
+    # gain 2 * shot * 255 linear grey levels^2 per grey level
     assert noise["shot_noise"]["shot_gain_grey"] == pytest.approx(2 * shot * 255, rel=0.35)
-    assert "shot_noise" in json.loads((tmp_path / "out" / "calibrated.json").read_text())["effects"]
+    assert "shot_noise" not in json.loads((tmp_path / "out" / "calibrated.json").read_text())["effects"]
     assert "Noise model" in (tmp_path / "out" / "report.md").read_text()
