@@ -3,7 +3,8 @@
 A *problem* is one kind of measured data with a base model (the paper's simulation) and a library of named
 physical extensions. Its data is cut into *items* (table rows, image tiles or whole images) so that splits never
 share an item between fitting and scoring. Selection is forward: starting from the base, the extension that most
-lowers the inner cross-validated RMSE is kept if it lowers it by a clear relative margin; repeat until none does.
+lowers the inner cross-validated RMSE is kept if it lowers it by a clear relative margin, or a pair of extensions
+when the pair beats every single one by that margin (interacting effects); repeat until nothing does.
 """
 
 from __future__ import annotations
@@ -261,6 +262,7 @@ def forward_select(
     Only ``fit_items`` are used. Every step keeps each fit item's validation squared error, so the effect size of
     a step can be bootstrapped over items (``identify.error_ratio``)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
+    requires = {e.name: set(e.requires) for e in problem.candidates}
 
     def aligned(per_item: dict[int, float]) -> np.ndarray:
         return np.array([per_item[int(i)] for i in fit_items], np.float64)
@@ -279,13 +281,11 @@ def forward_select(
         tried = {k: v[0] for k, v in scored.items()}
         best = min(tried, key=tried.__getitem__)
         steps[-1].tried = tried
-        if tried[best] <= (1.0 - margin) * current:
-            chosen = chosen | {best}
-            current, parents, per_item = scored[best]
-            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
-            continue
-        # Interacting effects can each be useless alone (a halo is invisible while the model cannot saturate):
-        # before stopping, try pairs, which must then bring twice the margin.
+        # Interacting effects can each be weak alone and strong together (a halo is invisible while the model
+        # cannot saturate; a reflectance term only pays in linear light): every step also scores each pair. A
+        # pair is taken over the best single effect only when it beats it by the margin (its second effect earns
+        # its place given the first) and brings twice the margin over the current model - or once the margin
+        # when one of the two only exists to carry the other (``requires``: the pair is one extension).
         pairs: dict[tuple[str, str], tuple[float, list[Fit], dict[int, float]]] = {}
         for first in tried:
             for effect in problem.candidates:
@@ -297,19 +297,34 @@ def forward_select(
                 pairs[(first, second)] = cross_validated(
                     problem, chosen | {first, second}, splits, scored[first][1]
                 )
-        if not pairs:
-            break
-        pair = min(pairs, key=lambda k: pairs[k][0])
         steps[-1].tried.update({"+".join(k): v[0] for k, v in pairs.items()})
-        if pairs[pair][0] > (1.0 - 2.0 * margin) * current:
-            break
-        first, second = pair
-        if second in tried and tried[second] < tried[first]:  # the better one alone is the intermediate step
-            first, second = second, first
-        steps.append(Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2]), paired=True))
-        chosen = chosen | {first, second}
-        current, parents, per_item = pairs[pair]
-        steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
+        needed = {
+            (a, b): min(
+                (1.0 - margin) * tried[best],
+                (1.0 - (1.0 if a in requires[b] or b in requires[a] else 2.0) * margin) * current,
+            )
+            for a, b in pairs
+        }
+        pair = min(pairs, key=lambda k: pairs[k][0] / needed[k]) if pairs else None
+        if pair is not None and pairs[pair][0] <= needed[pair]:
+            first, second = pair
+            if (
+                second in tried and tried[second] < tried[first]
+            ):  # the better one alone is the intermediate step
+                first, second = second, first
+            steps.append(
+                Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2]), paired=True)
+            )
+            chosen = chosen | {first, second}
+            current, parents, per_item = pairs[pair]
+            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
+            continue
+        if tried[best] <= (1.0 - margin) * current:
+            chosen = chosen | {best}
+            current, parents, per_item = scored[best]
+            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
+            continue
+        break
     return chosen, steps
 
 

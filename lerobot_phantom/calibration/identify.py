@@ -14,7 +14,10 @@ The rule (:func:`identify`): an extension is a named cause only if
    range, not the camera);
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
-   least one such parameter excludes its null value.
+   least one such parameter excludes its null value;
+5. the problem's own adequacy checks of the effect's physics pass, where it has any
+   (``problem.identification_checks(effect, fit, items) -> [reasons]``; e.g. a stabiliser's motion blur must be one
+   path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
 
 Otherwise it is reported as "not identified" with the reasons, and it is not part of the model that is written.
 """
@@ -204,10 +207,28 @@ def parameter_intervals(
     return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
 
 
+def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozenset[str]:
+    """The effects in ``effects`` that build on ``effect``, directly or through another one (``Effect.requires``)."""
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    found: set[str] = set()
+    frontier = {effect}
+    while frontier:
+        frontier = {e for e in effects if requires.get(e, set()) & frontier} - found
+        found |= frontier
+    return frozenset(found)
+
+
 def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
-    """The parameters the model with ``effects`` has and the model without ``effect`` lacks."""
-    without = {p.name for p in problem.param_specs(effects - {effect})}
-    return [p for p in problem.param_specs(effects) if p.name not in without]
+    """The parameters ``effect`` itself adds to the model with ``effects``.
+
+    Removing an effect also removes what builds on it (a stripe model without the exposure overlap has no
+    detection threshold either), so the parameters the model loses with it are split: those of each dependant
+    (found the same way, leaves first) belong to that dependant, the rest to ``effect``. A child at its bound
+    therefore makes the child "not identified", never its parent."""
+    below = dependants(problem, effects, effect)
+    without = {p.name for p in problem.param_specs(effects - {effect} - below)}
+    theirs = {p.name for child in below for p in own_params(problem, effects, child)}
+    return [p for p in problem.param_specs(effects) if p.name not in without and p.name not in theirs]
 
 
 @dataclass
@@ -256,9 +277,16 @@ def identify_selection(
             nulls=nulls,
         )
         result = outcome.as_dict()
+        # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
+        # whole frame); each failed check is a reason
+        checks = getattr(problem, "identification_checks", None)
+        failed = checks(effect, selected_fit, fit_items) if checks is not None and outcome.identified else []
+        if failed:
+            result.update(identified=False, status="not identified")
+            result["reasons"].extend(failed)
         requires = next((e.requires for e in problem.candidates if e.name == effect), ())
         missing = [r for r in requires if r not in identified]
-        if missing and outcome.identified:
+        if missing and result["identified"]:
             result.update(identified=False, status="not identified")
             result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
         result.update(

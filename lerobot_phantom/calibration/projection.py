@@ -3,6 +3,11 @@
 Base (the paper): the captured colour is an alpha blend of the surface and the projected colour. Physically a
 projector's light *adds* to the ambient light, in proportion to what the surface reflects, seen through the
 camera's colour filters (cross-talk between primaries), and the sensor saturates.
+
+Every model's output is clipped to the file's range (no camera writes more than its white); ``clipping`` is a
+sensor that saturates *below* the file's maximum (a white level < 1, e.g. video range or white-balance gains
+applied after the raw clip), so saturation exactly at the file's maximum is part of every model and is never
+named as a cause.
 """
 
 from __future__ import annotations
@@ -33,7 +38,10 @@ EFFECTS = (
     Effect(
         "channel_crosstalk",
         "the projector's red, green and blue primaries are seen through the camera's overlapping colour filters: "
-        "each camera channel picks up a mix of the projected channels (a 3x3 matrix)",
+        "each camera channel picks up a mix of the projected channels (a 3x3 matrix); a property of projected "
+        "light, so it builds on additive_light (a blend with a free matrix can dim the surface and add light at "
+        "once, which absorbs tone-curve and reflectance effects instead of naming them)",
+        requires=("additive_light",),
     ),
     Effect(
         "clipping",
@@ -64,7 +72,11 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
     elif additive:
         specs.append(Param("strength", 0.3, 0.0, 20.0, scale=0.3))
     if "albedo_modulation" in effects:
-        specs.append(Param("reflectance_floor", 0.1, 0.0, 10.0, scale=0.1))
+        # light reflected ~ (surface + floor): a positive floor is light returned whatever the reflectance
+        # (specular sheen); a slightly negative one removes the clean frame's veiling glare and black offset,
+        # which the projected light is not multiplied by (at most a few percent of full scale). A large floor
+        # is the null (no modulation): the range ends where modulation has all but vanished.
+        specs.append(Param("reflectance_floor", 0.1, -0.05, 2.0, scale=0.1))
     if "clipping" in effects:
         specs.append(Param("white", 0.95, 0.2, 1.0, scale=0.1))
     if "sensor_gamma" in effects:
@@ -76,7 +88,7 @@ def projection_nulls(effect: str) -> dict[str, float]:
     """Values at which an effect reduces to the model without it (none for a change of form)."""
     if effect == "channel_crosstalk":  # no camera channel picks up another projected channel
         return {n: 0.0 for n in CROSSTALK_NAMES if n[-2] != n[-1]}
-    if effect == "clipping":
+    if effect == "clipping":  # saturation at the file's maximum is in every model
         return {"white": 1.0}
     if effect == "sensor_gamma":
         return {"gamma": 1.0}
@@ -98,14 +110,11 @@ def projection_predict(
     if "additive_light" in effects:
         light = strength * light * (1.0 if "channel_crosstalk" in effects else params["strength"])
         if "albedo_modulation" in effects:
-            light = light * (surface_lin + params["reflectance_floor"])
+            light = light * (surface_lin + params["reflectance_floor"]).clamp(min=0.0)
         total = surface_lin + light
     else:
         opacity = params["opacity"] * strength
-        # with cross-talk the matrix carries the projected light's scale itself: opacity x matrix would let the
-        # two trade off without bound (only their product is seen), so opacity only dims the surface
-        seen = strength * light if "channel_crosstalk" in effects else opacity * light
-        total = (1.0 - opacity) * surface_lin + seen
+        total = (1.0 - opacity) * surface_lin + opacity * light
     if "clipping" in effects:
         total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
     if gamma:
@@ -149,12 +158,8 @@ def projection_kwargs(fit: Fit) -> dict:
         "reflectance_floor": p.get("reflectance_floor", 0.0),
         "gamma": p.get("gamma", 1.0),
     }
-    if "channel_crosstalk" in effects and not additive:
-        kwargs["strength"] = p["opacity"]
-    if "channel_crosstalk" in effects:
-        # the blend transform scales the matrix by its opacity: hand it the matrix per unit opacity
-        per_unit = 1.0 if additive else 1.0 / max(p["opacity"], 1e-6)
-        kwargs["crosstalk"] = [[per_unit * p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+    if "channel_crosstalk" in effects:  # builds on additive light: the matrix carries the light's scale
+        kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
     return kwargs

@@ -21,6 +21,7 @@ import pandas as pd
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutter_rows_lit
 
 STRIPE_COLUMNS = ("frequency", "exposure", "duty_cycle", "affected_rows_mean")
@@ -200,6 +201,7 @@ class StripeProblem(Problem):
     attack = "laser_color_strip"
     input_kind = "stripe_table"
     units = "rows"
+    item_name = "table rows"
     base_model = "fixed band of rows (the paper's laser color strip, band height fitted)"
     extended_model = "rolling shutter: phase-averaged pulse/exposure overlap over the row readout"
     candidates = EFFECTS
@@ -363,6 +365,29 @@ class StripeProblem(Problem):
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
         residual = self.residual(fit, items)
         return float(np.sum(residual**2)), len(items)
+
+    def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
+        """One residual (rows) per table row, against every setting a missing cause could follow: laser
+        frequency, exposure, duty cycle, pulse on-time (duty / frequency), the predicted row count, and - when the
+        model has a row time - the readout-aliasing phase, the fractional part of the number of laser periods in
+        one frame readout (``f x row time x height``): frames whose readout is not a whole number of periods see
+        stripes drift and their count alternate, a dependence the phase-averaged model has only on average."""
+        residual = self.residual(fit, items)
+        on_time = self.duty[items] / self.frequency_hz[items]
+        covariates = {
+            "frequency_hz": self.frequency_hz[items],
+            "exposure_s": self.exposure_s[items],
+            "duty": self.duty[items],
+            "on_time_s": on_time,
+            "predicted_rows": self.predict_fit(fit, items),
+        }
+        if "row_time_s" in fit.params:
+            periods = self.frequency_hz[items] * fit.params["row_time_s"] * self.image_height
+            covariates["readout_aliasing_phase"] = periods - np.floor(periods)
+        return ResidualSample(
+            [np.array([r]) for r in residual],
+            {name: [np.array([v]) for v in values] for name, values in covariates.items()},
+        )
 
     # -- reporting -----------------------------------------------------------------------------------------
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:

@@ -59,14 +59,20 @@ def scene(rng: np.random.Generator, height: int, width: int, checkers: int = 0) 
     return np.clip(image, 0.05, 0.95)
 
 
+READ_NOISE = 0.2 / 255.0  # sensor read noise, sd in linear light (full scale 1)
+
+
 def save(
-    path: Path, image: np.ndarray, rng: np.random.Generator, noise: float = 1.0 / 255.0, shot: float = 0.0
+    path: Path, image: np.ndarray, rng: np.random.Generator, noise: float = READ_NOISE, shot: float = 0.0
 ) -> None:
-    """Sensor read noise (sd ``noise``) plus photon shot noise (variance ``shot`` x signal), then 8-bit
-    quantisation."""
-    sd = np.sqrt(noise**2 + shot * np.clip(image, 0.0, 1.0))
-    noisy = np.clip(image + rng.normal(0.0, 1.0, image.shape) * sd, 0.0, 1.0)
-    Image.fromarray((noisy * 255).round().astype(np.uint8)).save(path)
+    """The encoded ``image`` as a sensor records it: read noise (sd ``noise``) plus photon shot noise (variance
+    ``shot`` x signal) added to the *linear* light (the image decoded as sRGB), before the tone curve, as a sensor
+    adds them; then the sRGB curve and 8-bit quantisation."""
+    linear = srgb_decode(np.clip(image, 0.0, 1.0))
+    sd = np.sqrt(noise**2 + shot * linear)
+    noisy = np.clip(linear + rng.normal(0.0, 1.0, image.shape) * sd, 0.0, 1.0)
+    encoded = srgb_encode(noisy)
+    Image.fromarray((encoded * 255).round().astype(np.uint8)).save(path)
 
 
 def sizes(rng: np.random.Generator, n: int) -> list[tuple[int, int]]:
@@ -125,7 +131,7 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
             total = total / (1 + truth["auto_exposure"] * s * srgb_decode(pattern).mean())
         attacked = encode(np.clip(total, 0, 1))
         for name, image in (("clean", clean), ("attacked", attacked), ("pattern", pattern)):
-            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else 1.0 / 255.0)
+            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else READ_NOISE)
         rows.append(
             {
                 "clean": f"clean_{i}.png",
@@ -172,7 +178,7 @@ def render_light_projection(folder: Path, effects: set[str], seed: int, n_pairs:
         else:
             attacked = (1 - truth["opacity"] * s) * clean + truth["opacity"] * s * light
         for name, image in (("clean", clean), ("attacked", np.clip(attacked, 0, 1)), ("pattern", projected)):
-            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else 1.0 / 255.0)
+            save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else READ_NOISE)
         rows.append(
             {
                 "clean": f"clean_{i}.png",

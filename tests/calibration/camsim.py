@@ -296,7 +296,8 @@ def laser_blinding_pairs(
 
     Physical (``digital_alpha=None``): attacked irradiance = scene + power * spot; the sensor saturates and, when the
     camera has auto-exposure, the metered exposure drops as the laser gets brighter. The pattern is one capture of
-    the laser alone (dark room, the clean scene's fixed exposure) at a reference power: the peak power of the pairs
+    the laser alone (dark room, the first clean scene's exposure, kept for the session unless the camera has
+    auto-exposure) at a reference power: the peak power of the pairs
     without a glare tail; 3% of it with one, so the faint tail is lost in the pattern's quantisation and only
     shows at high power. ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha *
     intensity, in 8-bit output space (the null case)."""
@@ -311,7 +312,14 @@ def laser_blinding_pairs(
     pattern_exposure = None
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        # a camera without auto-exposure keeps the exposure set on the first scene for the whole session (the
+        # pattern is recorded at it too); re-metering every scene would scale the laser's light relative to the
+        # pattern by a factor nothing in the pair records
+        fixed = None if cam.auto_exposure else pattern_exposure
+        if fixed is None:
+            clean, exposure = clean_capture(refl * light, cam, rng)
+        else:
+            clean, exposure = capture(refl * light, cam, rng, exposure=fixed)
         if pattern_exposure is None:
             pattern_exposure = exposure
             pattern, _ = capture(dark + reference * spot, cam, rng, exposure=pattern_exposure)
@@ -358,8 +366,13 @@ def light_projection_pairs(
     power: float = 0.8,
     digital_alpha: float | None = None,
     falloff: float = 0.0,
+    pattern_record: str = "board",
 ) -> list[FramePair]:
-    """Light projection pairs; the pattern is the projector's frame captured on a white board in the dark.
+    """Light projection pairs; the pattern is the projector's frame captured on a white board in the dark
+    (``pattern_record="board"``) or the frame the projector was sent (``"emitted"``, what SLAP's tables record as
+    the projected colour). A board capture is taken through the camera's own colour filters, so the camera's
+    response to the projector primaries (the cross-talk ``M``) and the projector gamma are already in it and
+    cannot show in the pairs; only the emitted frame leaves them to be found.
 
     Physical: surface irradiance = ambient + power * intensity * M (projector_frame ** 2.2), where M is the camera's
     3x3 response to the projector's primaries (diagonal 1, off-diagonal ``crosstalk`` on average); the camera sees
@@ -377,6 +390,8 @@ def light_projection_pairs(
         projector = (frame**2.2) @ mix.T
         pattern, _ = capture(board * power * projector, cam, rng, exposure=exposure)
         pattern_u8 = encode(pattern, cam)
+        if pattern_record == "emitted":
+            pattern_u8 = np.round(frame * 255).astype(np.uint8)
         if digital_alpha is not None:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             t = digital_alpha * intensity

@@ -29,6 +29,12 @@ def fitted_part(report: dict) -> dict:
         "intervals": report["extended"]["param_intervals"],
         "selection": (report["selection"]["selected"], report["selection"]["steps"]),
         "identification": report["identification"],
+        # the noise model is fitted and judged on the fit items too; only its held-out scores may move
+        "noise": {
+            k: v
+            for k, v in report.get("noise", {}).items()
+            if k not in ("heldout_noise_scale_ratio", "residual_vs_signal")
+        },
     }
 
 

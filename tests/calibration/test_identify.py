@@ -4,17 +4,25 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import torch
 
+from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
+from lerobot_phantom.calibration.frame_models.common import Pair
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
 from lerobot_phantom.calibration.identify import (
     Interval,
     at_bound,
     bootstrap,
+    dependants,
     error_ratio,
     identify,
+    identify_selection,
+    own_params,
     percentile_interval,
     resample,
     rmse_interval,
 )
+from lerobot_phantom.transforms import physics
 
 CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
 
@@ -114,3 +122,100 @@ def test_each_condition_alone_makes_it_not_identified(override, reason):
 
 def test_a_change_of_functional_form_needs_no_null_value():
     assert identified(nulls={}).identified
+
+
+class ParentAndChild(Problem):
+    """A parent extension and a child that builds on it; without the parent the model has neither parameter (as
+    a stripe model without the exposure overlap has no detection threshold). The child's parameter sits at its
+    bound on every fit."""
+
+    candidates = (Effect("parent", "a real cause"), Effect("child", "a refinement", requires=("parent",)))
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        if "parent" not in effects:
+            return []
+        return [Param("rate", 1.0, 0.0, 10.0)] + (
+            [Param("threshold", 0.5, 0.0, 1.0)] if "child" in effects else []
+        )
+
+    def fit(self, effects, items, start=None) -> Fit:
+        names = [p.name for p in self.param_specs(effects)]
+        values = {"rate": 3.0 + 0.01 * float(np.mean(items)), "threshold": 0.0}
+        return Fit(effects, {n: values[n] for n in names})
+
+
+def test_own_params_of_a_parent_exclude_its_dependants_params():
+    problem = ParentAndChild()
+    both = frozenset({"parent", "child"})
+    assert dependants(problem, both, "parent") == {"child"}
+    assert [p.name for p in own_params(problem, both, "parent")] == ["rate"]
+    assert [p.name for p in own_params(problem, both, "child")] == ["threshold"]
+
+
+def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
+    problem = ParentAndChild()
+    items = np.arange(20)
+    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+    steps = [
+        Step([], 2.0, {}, 4.0 * per_item),
+        Step(["parent"], 1.0, {}, per_item),
+        Step(["child", "parent"], 0.9, {}, 0.8 * per_item),
+    ]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    parent, child = selection.results
+    assert parent["effect"] == "parent" and parent["identified"], parent["reasons"]
+    assert child["effect"] == "child" and not child["identified"]
+    assert any("threshold = 0 sits at its low bound" in r for r in child["reasons"])
+    assert selection.identified == ["parent"]
+    assert selection.fit.effects == {"parent"} and set(selection.fit.params) == {"rate"}
+
+
+def rotation_blur(image: torch.Tensor, max_deg: float, samples: int = 16) -> torch.Tensor:
+    """Mean of ``image`` rotated about its centre by 0 .. ``max_deg`` degrees (bilinear, border repeated)."""
+    out = torch.zeros_like(image)
+    for angle in torch.linspace(0.0, np.radians(max_deg), samples, dtype=image.dtype):
+        rotation = torch.tensor(
+            [[torch.cos(angle), -torch.sin(angle), 0.0], [torch.sin(angle), torch.cos(angle), 0.0]]
+        )
+        grid = torch.nn.functional.affine_grid(
+            rotation[None].to(image.dtype), [1, *image.shape], align_corners=True
+        )
+        out += torch.nn.functional.grid_sample(image[None], grid, padding_mode="border", align_corners=True)[
+            0
+        ]
+    return out / samples
+
+
+def blur_pairs(kind: str, seed: int = 0, n_pairs: int = 6) -> BlurFrames:
+    """Textured 48x64 frames blurred by one motion of the whole image (a resonance, the library's own sinusoidal
+    path) or by a rotation about the centre (every part of the frame moves a different way)."""
+    generator = torch.Generator().manual_seed(seed)
+    pairs = []
+    for i in range(n_pairs):
+        blocks = torch.rand(3, 12, 16, generator=generator, dtype=torch.float64)
+        clean = blocks.repeat_interleave(4, 1).repeat_interleave(4, 2).contiguous()
+        if kind == "resonance":
+            offsets = physics.blur_path_offsets("sinusoidal", 17, dtype=torch.float64)
+            attacked = physics.line_blur(clean[None], torch.tensor(6.0), torch.tensor(3.0), offsets)[0]
+        else:
+            attacked = rotation_blur(clean, max_deg=8.0)
+        pairs.append(Pair(f"pair{i}", clean, attacked, None, 1.0))
+    return BlurFrames(pairs, seed)
+
+
+@pytest.mark.parametrize("kind", ["resonance", "rotation"])
+def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame(kind):
+    problem = blur_pairs(kind)
+    items = np.arange(len(problem.pairs))
+    fit = problem.fit(frozenset({"sinusoidal_motion"}), items)
+    reasons = problem.identification_checks("sinusoidal_motion", fit, items)
+    if kind == "resonance":
+        # the whole-frame path is the true one (6, 3) px at the 64-px working size = x4 at the 256-px reference
+        assert np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]) == pytest.approx(
+            4 * np.hypot(6, 3), rel=0.1
+        )
+        assert reasons == []
+    else:
+        assert reasons and all("not one motion of the image" in r for r in reasons)
+    assert problem.identification_checks("sensor_gamma", fit, items) == []

@@ -69,7 +69,9 @@ def random_camera(rng: np.random.Generator, **fixed) -> cs.Camera:
 
 
 def _gamma_camera(rng):
-    return {"tone": "power", "tone_gamma": float(rng.uniform(1.0, 1.25))}
+    # power-law tone curves of real cameras (Rec. 709's 1/0.45, 2.2, legacy 1.8): a gamma near 1 would plant an
+    # effect of size zero (gamma 1 is the library's null, composing the encoded values is then exact)
+    return {"tone": "power", "tone_gamma": float(rng.uniform(1.8, 2.4))}
 
 
 CASES = [
@@ -124,8 +126,15 @@ CASES = [
         "projection_crosstalk",
         "light_projection",
         "effect",
+        # the emitted frame as pattern: a board capture through the same colour filters already holds the
+        # cross-talk, which could then not be seen in the pairs at all
         lambda rng, cam: cs.light_projection_pairs(
-            rng, cam, N_PAIRS, power=rng.uniform(0.4, 0.8), crosstalk=rng.uniform(0.25, 0.4)
+            rng,
+            cam,
+            N_PAIRS,
+            power=rng.uniform(0.4, 0.8),
+            crosstalk=rng.uniform(0.25, 0.4),
+            pattern_record="emitted",
         ),
         planted=frozenset({"additive_light", "albedo_modulation", "channel_crosstalk"}),
         tolerated=LINEAR_LIGHT,
@@ -142,7 +151,10 @@ CASES = [
         "projection_sensor_gamma",
         "light_projection",
         "effect",
-        lambda rng, cam: cs.light_projection_pairs(rng, cam, N_PAIRS, power=rng.uniform(0.4, 0.8)),
+        # projector light comparable to the ambient light: a weak addition is a small perturbation that any tone
+        # curve maps almost linearly (measured: power 0.4-0.8 left the curve 2% of the validation RMSE, at the
+        # noise floor; 1.0-1.6 leaves 6-9%)
+        lambda rng, cam: cs.light_projection_pairs(rng, cam, N_PAIRS, power=rng.uniform(1.0, 1.6)),
         planted=frozenset({"additive_light", "albedo_modulation", "sensor_gamma"}),
         camera={"tone": "power"},
     ),
@@ -367,9 +379,13 @@ def test_case(name, root):
 
 @pytest.mark.slow
 @pytest.mark.xfail(
-    reason="issue 12 open: the library names the planted effect in about 4 of 11 effect cases (needs >= 90%); "
-    "auto_exposure, halo_power_law, channel_crosstalk, clipping, sensor_gamma, sinusoidal_motion and shot_noise "
-    "are missed or not identified (measured 2026-11-23, see the README's calibration section)",
+    reason="issue 12 open: measured 2026-11-23 (session 3, master seed 555 + final projection code) the library "
+    "names the planted effects in 5 of 10 core effect cases (needs >= 90%): blinding auto-exposure, projection "
+    "sensor_gamma, strip period, free band and sinusoidal blur are named; blinding_halo (the glare tail is recorded "
+    "in the pattern at its 3% reference power, so linear light reproduces it), projection_clipping (camsim "
+    "saturates at the file's white, which every library model contains), projection_crosstalk under the filmic "
+    "tone curve (albedo not identified), em_strip_bayer_flip (seed-dependent) and truncation_shot_noise are "
+    "missed; see /work/notes/camsim-status.md, Session 3",
     strict=False,
 )
 def test_planted_effects_are_named(root):

@@ -1,28 +1,120 @@
-"""The shot-noise variance model on residuals with a known variance law (no CLI)."""
+"""The linear-light noise model on frames with a known sensor noise (no CLI).
+
+Frames are rendered the way a camera makes them: noise is added to the *linear* signal (photon shot noise with
+variance proportional to the light, read noise constant), then the sRGB curve and 8-bit rounding. The model must
+name photon noise when it is there and not when the sensor has only read noise or no noise at all."""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 import pytest
+import torch
 
-from lerobot_phantom.calibration.noise import fit_variance, mean_nll
+from lerobot_phantom.calibration.core import Fit
+from lerobot_phantom.calibration.noise import (
+    QUANTISATION_VARIANCE,
+    NoiseSample,
+    fit_variance,
+    linearise,
+    mean_nll,
+    select_shot_noise,
+)
+from lerobot_phantom.transforms import physics
+
+FULL_WELL = 400.0  # electrons at saturation: photon noise of several grey levels
 
 
-def test_variance_law_is_recovered_and_beats_a_constant_only_when_present():
-    rng = np.random.default_rng(0)
-    signal = rng.uniform(5, 250, 40_000)
-    read_var, gain = 4.0, 0.3
-    shot_residual = rng.normal(0.0, 1.0, signal.shape) * np.sqrt(read_var + gain * signal)
-    fitted_read, fitted_gain = fit_variance(signal, shot_residual, shot=True)
-    assert fitted_read == pytest.approx(read_var, rel=0.3)
-    assert fitted_gain == pytest.approx(gain, rel=0.1)
-    constant = fit_variance(signal, shot_residual, shot=False)
-    assert (
-        mean_nll(signal, shot_residual, fitted_read, fitted_gain)
-        < mean_nll(signal, shot_residual, *constant) - 0.05
+@dataclass
+class Frames:
+    attacked: torch.Tensor
+    clean: torch.Tensor
+
+
+class IdentityProblem:
+    """A camera attack that changes nothing: every residual is the two frames' sensor noise."""
+
+    def __init__(self, pairs: list[Frames]) -> None:
+        self.pairs = pairs
+
+    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+        return self.pairs[index].clean
+
+
+def capture(linear: np.ndarray, rng: np.random.Generator, *, shot: bool, read: float) -> torch.Tensor:
+    """Linear light -> noisy linear (Poisson photons + Gaussian read noise, in full-well units) -> sRGB, 8 bits."""
+    if shot:
+        linear = rng.poisson(linear * FULL_WELL) / FULL_WELL
+    linear = linear + rng.normal(0.0, read, linear.shape)
+    encoded = physics.encode(torch.from_numpy(np.clip(linear, 0.0, 1.0)), None)
+    return torch.round(255.0 * encoded) / 255.0
+
+
+def frame_pairs(seed: int, *, shot: bool, read: float, n_pairs: int = 8) -> list[Frames]:
+    """Scenes of flat 8x8 blocks (levels 0.02-0.9 of full scale, linear), captured twice."""
+    rng = np.random.default_rng(seed)
+    pairs = []
+    for _ in range(n_pairs):
+        blocks = rng.uniform(0.02, 0.9, (3, 6, 8))
+        scene = np.kron(blocks, np.ones((8, 8)))
+        clean = capture(scene, rng, shot=shot, read=read)
+        pairs.append(Frames(capture(scene, rng, shot=shot, read=read), clean))
+    return pairs
+
+
+def select(pairs: list[Frames]) -> dict:
+    return select_shot_noise(
+        IdentityProblem(pairs),
+        Fit(frozenset(), {}),
+        np.arange(6),
+        np.arange(6, 8),
+        seed=0,
+        margin=0.05,
+        folds=4,
     )
 
-    flat_residual = rng.normal(0.0, 2.0, signal.shape)
-    flat_read, flat_gain = fit_variance(signal, flat_residual, shot=True)
-    assert flat_gain < 0.01
-    assert flat_read == pytest.approx(4.0, rel=0.05)
+
+def test_linearise_inverts_the_srgb_curve_and_gives_its_slope():
+    grey = np.array([10.0, 100.0, 200.0])
+    linear, slope = linearise(grey, None)
+    back = 255.0 * physics.encode(torch.from_numpy(linear), None).numpy()
+    assert back == pytest.approx(grey, abs=1e-6)
+    step = 1e-6
+    numeric = 255.0 * (physics.encode(torch.from_numpy(linear + step), None).numpy() - back / 255.0) / step
+    assert slope == pytest.approx(numeric, rel=1e-3)
+
+
+def test_variance_law_is_recovered_in_linear_light():
+    rng = np.random.default_rng(0)
+    signal = rng.uniform(0.02, 0.9, 40_000)
+    _, slope = linearise(255.0 * physics.encode(torch.from_numpy(signal), None).numpy(), None)
+    read_var, shot = 1e-5, 2.0 / FULL_WELL
+    variance = QUANTISATION_VARIANCE + slope**2 * (read_var + shot * signal)
+    sample = NoiseSample(
+        signal, slope, np.zeros_like(signal), rng.normal(0.0, 1.0, signal.shape) * np.sqrt(variance)
+    )
+    fitted = fit_variance(sample, shot=True)
+    assert fitted["shot"] == pytest.approx(shot, rel=0.1)
+    assert fitted["detail"] == pytest.approx(0.0, abs=1e-3)
+    assert mean_nll(sample, fitted) < mean_nll(sample, fit_variance(sample, shot=False)) - 0.01
+
+
+def test_photon_noise_is_named_although_flat_in_output_units():
+    noise = select(frame_pairs(1, shot=True, read=1.5 / FULL_WELL))
+    # under the sRGB curve photon noise is almost flat in output grey levels: a test in output units cannot see it
+    rmse = np.array(noise["residual_vs_signal"]["rmse"])
+    assert rmse.max() / rmse.min() < 1.6
+    assert noise["kept"], noise["reasons"]
+    assert noise["tone_curve"].startswith("sRGB")
+    # residual of two captures: variance 2 x shot; per frame 1 / FULL_WELL, in linear grey levels x 255
+    assert noise["shot_noise"]["shot_gain_grey"] == pytest.approx(2 * 255.0 / FULL_WELL, rel=0.25)
+    assert noise["intervals"]["shot_gain_grey"]["low"] > 0.0
+    assert noise["shot_share"]["estimate"] >= 0.5
+
+
+@pytest.mark.parametrize("read", [0.0, 0.01], ids=["no sensor noise", "read noise only"])
+def test_no_photon_noise_is_not_named(read):
+    noise = select(frame_pairs(2, shot=False, read=read))
+    assert not noise["kept"]
+    assert noise["reasons"]

@@ -1,9 +1,31 @@
-"""Laser blinding frame pairs: the scene, a capture of the laser alone, and the blinded frame."""
+"""Laser blinding frame pairs: the scene, a capture of the laser alone, and the blinded frame.
+
+Base: the paper's alpha blend of the scene and the encoded pattern. ``linear_light_saturation`` reads the pattern
+as laser irradiance instead, which needs two corrections any capture of a laser "alone" calls for:
+
+* the capture's dark level (the dark room's residual light and the sensor's black level) is not laser light and
+  does not grow with the laser's power: the per-channel median of the capture's outer half (far from the spot) is
+  subtracted in linear light;
+* where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
+  extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
+  radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
+  sigma^2))``, the Gaussian's ``exp((R^2 - r^2) / (2 sigma^2))`` written with the distance ``d`` (reference pixels)
+  to the nearest unsaturated pixel, so that saturated areas of any shape are followed. This matters whenever the
+  blinded frame is exposed less than the capture (auto-exposure, a weaker beam): the saturated disc then
+  shrinks, and a model holding the core at the full well would paint it grey instead.
+
+``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
+*clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
+1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
+``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
+average, as centre-weighted meters do when the spot is central).
+"""
 
 from __future__ import annotations
 
 import numpy as np
 import torch
+from scipy import ndimage
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, Pair, PixelProblem, flat_pixels
@@ -37,6 +59,46 @@ def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
     return float(xs.double().mean()), float(ys.double().mean())
 
 
+# a saturated capture reads a few grey levels below 255 where JPEG rings in its flat white: 248 and above counts
+SATURATED = 247.5 / 255.0
+
+
+def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
+    """Per-channel median (encoded) of the capture's outer half, by distance from the spot's centre: the dark
+    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
+    _, height, width = pattern.shape
+    ys, xs = torch.meshgrid(
+        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
+    )
+    radius = torch.hypot(xs - centre[0], ys - centre[1]).reshape(-1)
+    outer = radius >= radius.median()
+    return pattern.reshape(3, -1)[:, outer].median(dim=1).values
+
+
+def saturated_depth(pattern: torch.Tensor) -> torch.Tensor:
+    """(3, H, W): per channel, the distance (working pixels) from each saturated pixel of the capture to the
+    nearest unsaturated one (0 outside the saturated area)."""
+    # holes left by compression noise are closed: a saturated area has no unsaturated islands
+    clipped = [ndimage.binary_fill_holes(c) for c in (pattern >= SATURATED).numpy()]
+    return torch.from_numpy(
+        np.stack([ndimage.distance_transform_edt(c) if c.any() else np.zeros(c.shape) for c in clipped])
+    )
+
+
+def laser_irradiance(
+    pattern: torch.Tensor,
+    dark: torch.Tensor,
+    core_depth: torch.Tensor,
+    core_radius: torch.Tensor,
+    params: dict,
+) -> torch.Tensor:
+    """Laser light per unit power from the decoded capture: its dark level removed, its saturated core
+    extrapolated (module docstring)."""
+    depth = torch.minimum(core_depth, core_radius)
+    rise = (2.0 * core_radius * depth - depth**2) / (2.0 * params["core_sigma_ref_px"] ** 2)
+    return (pattern - dark).clamp(min=0.0) * torch.exp(rise.clamp(max=50.0))
+
+
 class BlindingFrames(PixelProblem):
     attack = "laser_blinding"
     base_model = "alpha blend of the scene and the laser pattern (the paper's laser blinding)"
@@ -50,20 +112,27 @@ class BlindingFrames(PixelProblem):
             )
         super().__init__(pairs, seed)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
-        # a fixed sample of each pattern's pixels: the mean light the exposure meter sees, for any tone curve
+        self.dark_levels = [dark_level(p.pattern, c) for p, c in zip(pairs, self.centres, strict=True)]
+        self.core_depths = [saturated_depth(p.pattern) * p.to_reference for p in pairs]
+        # equivalent radius (reference pixels) of each channel's saturated area
+        self.core_radii = [
+            torch.sqrt((d > 0).sum(dim=(1, 2)).double() / torch.pi) * p.to_reference
+            for p, d in zip(pairs, self.core_depths, strict=True)
+        ]
+        # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
         probe_rng = np.random.default_rng(seed + 7)
-        self.pattern_probe = torch.stack(
-            [
-                flat_pixels(p.pattern, torch.as_tensor(probe_rng.choice(p.height * p.width, 1024)))
-                for p in pairs
-            ]
-        )
+        self.probes = [torch.as_tensor(np.sort(probe_rng.choice(p.height * p.width, 1024))) for p in pairs]
         self.colours = []
         for p in pairs:
             lin = physics.srgb_to_linear(p.pattern).reshape(3, -1)
             weight = lin.mean(0)
             colour = (lin * weight).sum(1) / weight.sum().clamp(min=1e-9)
             self.colours.append(colour / colour.max().clamp(min=1e-9))
+
+        self.probe_features = {
+            k: torch.cat([self.features(i, self.probes[i])[k] for i in range(len(pairs))])
+            for k in self.features(0, self.probes[0])
+        }
 
     def centre(self, index: int) -> tuple[float, float]:
         return self.centres[index]
@@ -83,6 +152,9 @@ class BlindingFrames(PixelProblem):
         return {
             "scene": flat_pixels(pair.clean, pixels),
             "pattern": flat_pixels(pair.pattern, pixels),
+            "dark": self.dark_levels[index].reshape(1, 3).expand(n, 3),
+            "core_depth": flat_pixels(self.core_depths[index], pixels),
+            "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
             "radius": radius,
             "strength": torch.full((n, 1), pair.intensity, dtype=torch.float64),
             "pair": torch.full((n,), index, dtype=torch.long),
@@ -92,7 +164,12 @@ class BlindingFrames(PixelProblem):
     def param_specs(self, effects):
         specs = []
         if "linear_light_saturation" in effects:
-            specs.append(Param("gain", 1.0, 0.0, 100.0, scale=1.0))
+            # laser power in the frames over the power the pattern was recorded at (a capture at a few percent of
+            # the attack's power, to keep its core unsaturated, needs tens)
+            specs.append(Param("gain", 1.0, 0.0, 200.0, scale=1.0))
+            # beam width behind the capture's saturated core (module docstring), reference pixels: from a
+            # fraction of a pixel to far wider than the frame (a flat core, held at the full well)
+            specs.append(Param("core_sigma_ref_px", 20.0, 0.5, 2000.0, scale=10.0))
         else:
             specs.append(Param("alpha", 0.5, 0.0, 1.0, scale=0.3))
         if "halo_power_law" in effects:
@@ -102,7 +179,9 @@ class BlindingFrames(PixelProblem):
                 Param("halo_scale_ref_px", 8.0, 0.3, 200.0, scale=8.0),
             ]
         if "auto_exposure" in effects:
-            specs.append(Param("auto_exposure", 0.5, 0.0, 100.0, scale=0.5))
+            # power of the meter's exposure factor (module docstring): 0 = no reaction; a central spot can
+            # weigh several times its area in a centre-weighted meter, hence the range up to 4
+            specs.append(Param("auto_exposure", 0.5, 0.0, 4.0, scale=0.5))
         if "sensor_gamma" in effects:
             specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
         return specs
@@ -113,33 +192,76 @@ class BlindingFrames(PixelProblem):
             effect, {}
         )
 
-    def predict_features(self, effects, params, f):
+    @staticmethod
+    def tone(effects, params):
+        """Tone curve the light is composed in: fitted, sRGB (linear light), or the encoded values (the paper)."""
         if "sensor_gamma" in effects:
-            gamma = params["gamma"]
-        elif "linear_light_saturation" in effects:
-            gamma = None  # sRGB
-        else:
-            gamma = 1.0  # the paper composes the encoded values
-        scene, pattern = physics.decode(f["scene"], gamma), physics.decode(f["pattern"], gamma)
+            return params["gamma"]
+        return None if "linear_light_saturation" in effects else 1.0
+
+    def compose(self, effects, params, f, gamma) -> torch.Tensor:
+        """Scene plus laser light (linear in the tone curve ``gamma``), before exposure changes and clipping."""
+        scene = physics.decode(f["scene"], gamma)
         s = f["strength"]
         if "linear_light_saturation" in effects:
-            light, scene_weight = s * params["gain"] * pattern, 1.0
+            laser = laser_irradiance(
+                physics.decode(f["pattern"], gamma),
+                physics.decode(f["dark"], gamma),
+                f["core_depth"],
+                f["core_radius"],
+                params,
+            )
+            light, scene_weight = s * params["gain"] * laser, 1.0
         else:
             opacity = (params["alpha"] * s).clamp(0.0, 1.0)
-            light, scene_weight = opacity * pattern, 1.0 - opacity
-        # the exposure meter sees the injected pattern light (not the scene), as physics.laser_injection
-        pattern_mean = physics.decode(self.pattern_probe, gamma).mean(dim=(1, 2))[f["pair"]].unsqueeze(1)
-        level = params["gain"] if "linear_light_saturation" in effects else params["alpha"]
-        mean_light = level * s * pattern_mean
+            light, scene_weight = opacity * physics.decode(f["pattern"], gamma), 1.0 - opacity
         if "halo_power_law" in effects:
             halo = physics.power_law_halo(
                 f["radius"], params["halo_amplitude"], params["halo_exponent"], params["halo_scale_ref_px"]
             )
             light = light + s * halo * f["colour"]
-        total = scene_weight * scene + light
+        return scene_weight * scene + light
+
+    def exposure_factor(self, effects, params, gamma) -> torch.Tensor:
+        """Per pair: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
+        steps on the concave, piecewise-linear meter reading; differentiable through the iterations)."""
+        f = self.probe_features
+        n = len(self.pairs)
+        total = self.compose(effects, params, f, gamma).mean(1).reshape(n, -1)
+        target = physics.decode(f["scene"], gamma).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
+        k = torch.ones(n, dtype=total.dtype)
+        for _ in range(12):
+            lit = (k[:, None] * total < 1.0).to(total.dtype)
+            reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+            slope = (total * lit).mean(1).clamp(min=1e-9)
+            k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+        return k ** params["auto_exposure"]
+
+    def predict_features(self, effects, params, f):
+        gamma = self.tone(effects, params)
+        total = self.compose(effects, params, f, gamma)
         if "auto_exposure" in effects:
-            total = total / (1.0 + params["auto_exposure"] * mean_light)
+            total = total * self.exposure_factor(effects, params, gamma)[f["pair"]].unsqueeze(1)
         return physics.encode(total.clamp(0.0, 1.0), gamma)
+
+    def divisor_auto_exposure(self, fit: Fit) -> float:
+        """The transform's auto-exposure ``1 / (1 + a * mean injected light)`` (``physics.inject_linear_light``)
+        closest, over the fit's frames, to the metered exposure factors (least squares in ``1 / factor - 1``).
+        The core extrapolation has no counterpart in the transform, whose spot pattern is not clipped."""
+        p, effects = fit.params, fit.effects
+        gamma = self.tone(effects, p)
+        with torch.no_grad():
+            factor = self.exposure_factor(effects, p, gamma)
+            level = p["gain"] if "linear_light_saturation" in effects else p["alpha"]
+            f = self.probe_features
+            light = (
+                level
+                * f["strength"]
+                * (physics.decode(f["pattern"], gamma) - physics.decode(f["dark"], gamma))
+            )
+            metered = light.clamp(min=0.0).mean(1).reshape(len(self.pairs), -1).mean(1)
+            excess = 1.0 / factor.clamp(min=1e-6) - 1.0
+        return float(max((metered * excess).sum() / (metered**2).sum().clamp(min=1e-12), 0.0))
 
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserBlinding`` options: the paper's alpha levels, or the physical model (``physics.laser_injection``)."""
@@ -154,7 +276,7 @@ class BlindingFrames(PixelProblem):
             "glare_amplitude": p.get("halo_amplitude", 0.0),
             "glare_exponent": p.get("halo_exponent", 2.0),
             "glare_scale_ref_px": p.get("halo_scale_ref_px", 8.0),
-            "auto_exposure": p.get("auto_exposure", 0.0),
+            "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0)
             "gamma": p["gamma"] if "sensor_gamma" in effects else (None if linear else 1.0),
         }

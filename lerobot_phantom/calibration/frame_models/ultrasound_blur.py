@@ -1,4 +1,10 @@
-"""Ultrasound blur frame pairs: a clean frame and the frame blurred by the resonating stabiliser."""
+"""Ultrasound blur frame pairs: a clean frame and the frame blurred by the resonating stabiliser.
+
+Base (the paper's linear blur, Appendix A): sample ``n`` of the path sits ``n`` steps along the displacement, so the
+path starts at the pixel and runs one way, a uniform average over ``[0, d]``. A resonance instead oscillates about
+the rest position: ``sinusoidal_motion`` is the path ``(d / 2) sin(w t)``, centred, its dwell time arcsine-weighted
+toward both turning points.
+"""
 
 from __future__ import annotations
 
@@ -9,11 +15,22 @@ from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squar
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
 from lerobot_phantom.transforms import physics
 
+PATH_PARAMS = ("dx_ref_px", "dy_ref_px")
+# starting paths: lengths (reference pixels) x directions over the whole circle (a one-way path is not its reverse)
+PATH_GRID = [
+    {"dx_ref_px": length * np.cos(angle), "dy_ref_px": length * np.sin(angle)}
+    for length in (2.0, 5.0, 10.0, 20.0, 35.0, 55.0, 80.0)
+    for angle in np.arange(24) * np.pi / 12
+]
+PATH_AGREEMENT_DEG = 20.0  # direction tolerance of a quadrant's path against the whole frame's
+PATH_AGREEMENT_SHARE = 0.3  # length tolerance, as a share of the whole frame's path length
+
 BLUR_EFFECTS = (
     Effect(
         "sinusoidal_motion",
-        "ultrasound makes the gyroscope resonate, so the stabiliser moves the image sinusoidally: the motion "
-        "dwells at its turning points, an arcsine-weighted blur path instead of a uniform line average",
+        "ultrasound makes the gyroscope resonate, so the stabiliser moves the image sinusoidally about its rest "
+        "position: the path is centred on the pixel (not a one-way displacement) and the motion dwells at its "
+        "turning points, an arcsine-weighted blur path instead of a uniform line average",
     ),
     SENSOR_GAMMA,
 )
@@ -21,7 +38,7 @@ BLUR_EFFECTS = (
 
 class BlurFrames(FrameProblem):
     attack = "ultrasound_blur"
-    base_model = "uniform line average along a fitted displacement (the paper's ultrasound blur, linear part)"
+    base_model = "uniform line average from the pixel along a fitted displacement (the paper's ultrasound blur, linear part)"
     extended_model = "resonant (sinusoidal) motion blur"
     candidates = BLUR_EFFECTS
     taps = 17
@@ -44,8 +61,10 @@ class BlurFrames(FrameProblem):
 
     def blur(self, effects, params, index: int) -> torch.Tensor:
         pair = self.pairs[index]
-        path = "sinusoidal" if "sinusoidal_motion" in effects else "uniform"
-        offsets = physics.blur_path_offsets(path, self.taps, dtype=torch.float64)
+        if "sinusoidal_motion" in effects:
+            offsets = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
+        else:  # the paper's one-way path: offsets in [0, 1] of the displacement
+            offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64) + 0.5
         gamma = params.get("gamma") if "sensor_gamma" in effects else 1.0
         x = physics.decode(pair.clean.unsqueeze(0), gamma)
         scale = pair.intensity / pair.to_reference
@@ -63,12 +82,9 @@ class BlurFrames(FrameProblem):
                 [(self.blur(effects, p, int(i)) - self.pairs[int(i)].attacked).ravel() for i in items]
             )
 
-        # the blur displacement is far from convex (textures alias): start from the best points of a grid of
-        # directions and lengths, scored on a few pairs, besides any nested model's fit
-        grid = []
-        for length in (2.0, 5.0, 10.0, 20.0, 35.0, 55.0):
-            for angle in np.arange(12) * np.pi / 12:
-                grid.append({"dx_ref_px": length * np.cos(angle), "dy_ref_px": length * np.sin(angle)})
+        # the blur displacement is far from convex (textures alias): start from the best points of PATH_GRID,
+        # scored on a few pairs, besides any nested model's fit
+        grid = PATH_GRID
         base = {"gamma": torch.tensor(2.2, dtype=torch.float64)} if "sensor_gamma" in effects else {}
         probe = items[:3]
 
@@ -97,6 +113,68 @@ class BlurFrames(FrameProblem):
             max_nfev=30,
         )
         return Fit(effects, params)
+
+    def quadrant_paths(self, fit: Fit, items: np.ndarray) -> list[np.ndarray]:
+        """The displacement (dx, dy at the reference scale) fitted on each quadrant of the frames alone, every
+        other parameter held at ``fit``'s values and the whole-frame path as the start."""
+        specs = [p for p in self.param_specs(fit.effects) if p.name in ("dx_ref_px", "dy_ref_px")]
+        held = {
+            k: torch.tensor(v, dtype=torch.float64) for k, v in fit.params.items() if k not in PATH_PARAMS
+        }
+        paths = []
+        for top, left in ((0, 0), (0, 1), (1, 0), (1, 1)):
+
+            def errors(p, top=top, left=left):
+                parts = []
+                for i in items:
+                    pair = self.pairs[int(i)]
+                    rows = slice(top * pair.height // 2, (top + 1) * pair.height // 2 or None)
+                    cols = slice(left * pair.width // 2, (left + 1) * pair.width // 2 or None)
+                    error = self.blur(fit.effects, {**held, **p}, int(i)) - pair.attacked
+                    parts.append(error[:, rows, cols].ravel())
+                return torch.cat(parts)
+
+            # a quadrant's own path may lie in another basin than the whole frame's: also start from the grid
+            with torch.no_grad():
+                costs = [
+                    float(
+                        (errors({k: torch.tensor(v, dtype=torch.float64) for k, v in g.items()}) ** 2).sum()
+                    )
+                    for g in PATH_GRID
+                ]
+            starts = [PATH_GRID[int(k)] for k in np.argsort(costs)[:2]]
+            params = fit_least_squares(
+                specs, errors, warm=fit.params, starts=starts, autodiff=False, max_nfev=30
+            )
+            paths.append(np.array([params["dx_ref_px"], params["dy_ref_px"]]))
+        return paths
+
+    def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
+        """A stabiliser moves the whole image, so a motion path is one path for the whole frame: the path fitted
+        on each quadrant alone must agree with the whole frame's, within ``PATH_AGREEMENT_DEG`` in direction
+        (modulo 180 degrees for a centred path, which is its own reverse) and ``PATH_AGREEMENT_SHARE`` in length.
+        A blur that is not one motion of the image (a rotation, a lens-dependent smear) fits a resonant path
+        better than the paper's one-way path without being a resonance: it is then not named."""
+        if effect != "sinusoidal_motion":
+            return []
+        whole = np.array([fit.params["dx_ref_px"], fit.params["dy_ref_px"]])
+        length = float(np.hypot(*whole))
+        reasons = []
+        for name, path in zip(
+            ("top left", "top right", "bottom left", "bottom right"),
+            self.quadrant_paths(fit, items),
+            strict=True,
+        ):
+            turn = abs(np.degrees(np.arctan2(path[1], path[0]) - np.arctan2(whole[1], whole[0])))
+            turn = min(turn % 180.0, 180.0 - turn % 180.0)
+            stretch = abs(float(np.hypot(*path)) - length) / max(length, 1e-9)
+            if turn > PATH_AGREEMENT_DEG or stretch > PATH_AGREEMENT_SHARE:
+                reasons.append(
+                    f"the {name} quadrant's path ({np.hypot(*path):.1f} px at {np.degrees(np.arctan2(path[1], path[0])):.0f} "
+                    f"deg) is not the whole frame's ({length:.1f} px at {np.degrees(np.arctan2(whole[1], whole[0])):.0f} deg): "
+                    "the blur is not one motion of the image"
+                )
+        return reasons
 
     def transform_kwargs(self, fit: Fit) -> dict:
         """``UltrasoundBlur`` options: the blur path (camera physics); its length stays the attack's setting."""
