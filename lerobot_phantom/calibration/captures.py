@@ -153,7 +153,9 @@ class CaptureProblem(Problem):
         return specs
 
     def predict(self, effects, p, pixels: torch.Tensor) -> torch.Tensor:
-        radius = torch.hypot(self.xs[pixels] - p["cx"], self.ys[pixels] - p["cy"])
+        # not torch.hypot: its derivative is 0/0 on a pixel at the spot's centre, and forward-mode autodiff spreads
+        # that NaN to every column of the Jacobian; 1e-12 px^2 changes no radius that matters
+        radius = torch.sqrt((self.xs[pixels] - p["cx"]) ** 2 + (self.ys[pixels] - p["cy"]) ** 2 + 1e-12)
         profile = physics.laser_spot_profile(
             radius,
             p["sigma"],
