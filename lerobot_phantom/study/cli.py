@@ -37,6 +37,8 @@ from lerobot_phantom.study.stages import (
     REPORT,
     RESUME,
     RUN,
+    SELECT,
+    SELECTION_FILE,
     SKIP,
     SWEEP,
     Stage,
@@ -56,6 +58,7 @@ MODULES = {
     "lerobot-phantom-train": "lerobot_phantom.train.train",
     "lerobot-phantom-eval": "lerobot_phantom.eval.eval",
     "lerobot-phantom-report": "lerobot_phantom.eval.report",
+    "lerobot-phantom-select-checkpoint": "lerobot_phantom.eval.select_checkpoint",
 }
 
 
@@ -188,6 +191,7 @@ class Study:
         }
         report = self.records.get("report", {})
         self.manifest["report"] = report["output"] if report.get("status") == "done" else None
+        self.manifest["selection"] = self.selection()
         write_manifest(self.dir, self.manifest)
 
     def results(self) -> dict[str, str]:
@@ -195,8 +199,17 @@ class Study:
         return {
             stage.role: f"{stage.output}/{EVAL_FILE}"
             for stage in self.stages
-            if stage.kind == SWEEP and self.records.get(stage.name, {}).get("status") == "done"
+            if stage.kind == SWEEP
+            and stage.role is not None
+            and self.records.get(stage.name, {}).get("status") == "done"
         }
+
+    def selection(self) -> str | None:
+        """selection.json of the checkpoint selection, relative to the study directory, once it is done."""
+        for stage in self.stages:
+            if stage.kind == SELECT and self.records.get(stage.name, {}).get("status") == "done":
+                return f"{stage.output}/{SELECTION_FILE}"
+        return None
 
     def run_stage(self, stage: Stage, decision: str) -> None:
         fp = self.fingerprints[stage.name]
@@ -283,6 +296,8 @@ def publish(study_dir: Path, destination: Path) -> list[Path]:
             sources += [
                 p.relative_to(study_dir) for p in sorted((study_dir / output).rglob("*")) if p.is_file()
             ]
+        elif (study_dir / output / SELECTION_FILE).is_file():
+            sources.append(output / SELECTION_FILE)
         elif (study_dir / output / PRETRAINED / "train_config.json").is_file():
             sources.append(output / PRETRAINED / "train_config.json")
     written = []

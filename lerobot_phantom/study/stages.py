@@ -20,9 +20,11 @@ from lerobot_phantom.envs.suites import SUITES
 from lerobot_phantom.study.config import StudyConfig
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
-COLLECT, VLM, TRAIN, SWEEP, REPORT = "collect", "vlm", "train", "sweep", "report"
+COLLECT, VLM, TRAIN, SWEEP, SELECT, REPORT = "collect", "vlm", "train", "sweep", "select", "report"
 PRETRAINED = "checkpoints/last/pretrained_model"
 EVAL_FILE = "eval.json"
+SELECTION_FILE = "selection.json"
+CLEAN_RUN, SELECTED_RUN = "train/clean", "train/selected"
 
 # Decisions for a stage at the start of an invocation.
 SKIP, RESUME, RUN = "skip", "resume", "run"
@@ -31,13 +33,14 @@ SKIP, RESUME, RUN = "skip", "resume", "run"
 @dataclass(frozen=True)
 class Stage:
     name: str
-    kind: str  # collect | vlm | train | sweep | report
+    kind: str  # collect | vlm | train | sweep | select | report
     command: str  # the console script
     args: tuple[str, ...]
     output: str  # the stage's own directory, relative to the study directory
     depends: tuple[str, ...] = ()
     files: tuple[str, ...] = ()  # config files outside the study the command reads (hashed by content)
-    role: str | None = None  # sweeps: the name under which study.json's "results" lists the eval file
+    # Sweeps: the name under which study.json's "results" lists the eval file (None: a validation run).
+    role: str | None = None
 
     @property
     def argv(self) -> list[str]:
@@ -91,6 +94,8 @@ def is_complete(stage: Stage, study_dir: Path) -> bool:
     if stage.kind == SWEEP:
         path = out / EVAL_FILE
         return path.is_file() and bool(json.loads(path.read_text())["metadata"].get("complete"))
+    if stage.kind == SELECT:
+        return (out / SELECTION_FILE).is_file() and (out / PRETRAINED / "config.json").is_file()
     return (out / "summary.md").is_file()
 
 
@@ -148,11 +153,26 @@ class Planner:
         self.repo_id = f"local/phantom_{cfg.collect.suite}"
         self.clean_config = resolve_config(cfg.train.config_path)
         self.lora_config = resolve_config(cfg.lora.config_path)
+        # The clean policy everything downstream starts from: the selected checkpoint, or the last one.
+        self.start_stage = "select_clean" if cfg.select.enabled else "train_clean"
+        self.run_dirs = {"train_clean": CLEAN_RUN, "select_clean": SELECTED_RUN}
 
     def add(self, *args, **kwargs) -> Stage:
         stage = Stage(*args, **kwargs)
         self.stages.append(stage)
         return stage
+
+    def run_dir(self, stage_name: str) -> str:
+        return self.run_dirs.get(stage_name, f"train/{stage_name.removeprefix('train_')}")
+
+    def env_args(self) -> list[str]:
+        c = self.cfg.collect
+        return [
+            "--env.type=phantom_table",
+            f"--env.task={c.suite}",
+            f"--env.observation_height={c.image_size}",
+            f"--env.observation_width={c.image_size}",
+        ]
 
     def dataset_args(self) -> list[str]:
         return [f"--dataset.repo_id={self.repo_id}", "--dataset.root=data/demos"]
@@ -181,7 +201,7 @@ class Planner:
             *self.dataset_args(),
             # Absolute: the path is saved in the checkpoint, which the demo and users load from other directories.
             f"--policy.vlm_model_name={Path(self.cfg.output_dir).resolve() / 'vlm'}",
-            "--output_dir=train/clean",
+            f"--output_dir={CLEAN_RUN}",
             "--phantom.rate=0",
             f"--seed={t.seed}",
             *([f"--steps={t.steps}"] if t.steps is not None else []),
@@ -194,9 +214,64 @@ class Planner:
             TRAIN,
             "lerobot-phantom-train",
             tuple(args),
-            "train/clean",
+            CLEAN_RUN,
             (COLLECT, VLM),
             (self.clean_config,),
+        )
+
+    def checkpoint_steps(self) -> list[int]:
+        """The steps at which the clean run saves a checkpoint (LeRobot: every save_freq steps and the last)."""
+        t = self.cfg.train
+        recipe = json.loads(Path(self.clean_config).read_text())
+        steps = t.steps if t.steps is not None else recipe["steps"]
+        save_freq = t.save_freq if t.save_freq is not None else recipe["save_freq"]
+        marks = list(range(save_freq, steps + 1, save_freq))
+        return marks if marks and marks[-1] == steps else [*marks, steps]
+
+    def selection(self) -> None:
+        """Every clean checkpoint evaluated clean on the validation seeds, then the best one copied."""
+        from lerobot.utils.train_utils import get_step_identifier
+
+        sel = self.cfg.select
+        steps = self.checkpoint_steps()
+        evals, checkpoints, names = [], [], []
+        for step in steps:
+            ident = get_step_identifier(step, steps[-1])
+            checkpoint = f"{CLEAN_RUN}/checkpoints/{ident}/pretrained_model"
+            output = f"sweeps/validation/{ident}"
+            args = [
+                f"--policy.path={checkpoint}",
+                *self.env_args(),
+                f"--eval.n_episodes={sel.n_episodes}",
+                f"--eval.batch_size={min(sel.batch_size, sel.n_episodes)}",
+                f"--seed={sel.seed}",
+                "--phantom.attacks=[]",  # clean only
+                f"--output_dir={output}",
+                *self.cfg.sweep.extra_args,
+            ]
+            stage = self.add(
+                f"sweep_validation_{ident}",
+                SWEEP,
+                "lerobot-phantom-eval",
+                tuple(args),
+                output,
+                ("train_clean",),
+            )
+            evals.append(f"{output}/{EVAL_FILE}")
+            checkpoints.append(checkpoint)
+            names.append(stage.name)
+        args = [
+            f"--evals={flag_list(evals)}",
+            f"--checkpoints={flag_list(checkpoints)}",
+            f"--output_dir={SELECTED_RUN}",
+        ]
+        self.add(
+            "select_clean",
+            SELECT,
+            "lerobot-phantom-select-checkpoint",
+            tuple(args),
+            SELECTED_RUN,
+            tuple(names),
         )
 
     def lora(self, name: str, rate: float, attacks, *extra: str) -> None:
@@ -204,7 +279,7 @@ class Planner:
         lo = self.cfg.lora
         args = [
             f"--config_path={self.lora_config}",
-            f"--policy.path=train/clean/{PRETRAINED}",
+            f"--policy.path={self.run_dir(self.start_stage)}/{PRETRAINED}",
             *self.dataset_args(),
             f"--output_dir=train/{name}",
             f"--steps={lo.steps}",
@@ -229,21 +304,15 @@ class Planner:
             "lerobot-phantom-train",
             tuple(args),
             f"train/{name}",
-            ("train_clean",),
+            (self.start_stage,),
             (self.lora_config,),
         )
 
     def sweep(self, role: str, policy_stage: str, attacks=None, *extra: str) -> None:
-        s, c = self.cfg.sweep, self.cfg.collect
-        policy = (
-            "train/clean" if policy_stage == "train_clean" else f"train/{policy_stage.removeprefix('train_')}"
-        )
+        s = self.cfg.sweep
         args = [
-            f"--policy.path={policy}/{PRETRAINED}",
-            "--env.type=phantom_table",
-            f"--env.task={c.suite}",
-            f"--env.observation_height={c.image_size}",
-            f"--env.observation_width={c.image_size}",
+            f"--policy.path={self.run_dir(policy_stage)}/{PRETRAINED}",
+            *self.env_args(),
             f"--eval.n_episodes={s.n_episodes}",
             f"--eval.batch_size={min(s.batch_size, s.n_episodes)}",
             f"--seed={s.seed}",
@@ -276,7 +345,7 @@ class Planner:
             self.lora("at_calibrated", lo.rate, lo.attacks, physics)
             self.sweep("at_calibrated", "train_at_calibrated", camera)
             for role, policy in (
-                ("before", "train_clean"),
+                ("before", self.start_stage),
                 ("after", "train_at"),
                 ("at_calibrated", "train_at_calibrated"),
             ):
@@ -292,7 +361,7 @@ class Planner:
             self.sweep("at_instruction", "train_at_instruction")
 
     def report(self) -> None:
-        sweeps = {s.role: s for s in self.stages if s.kind == SWEEP}
+        sweeps = {s.role: s for s in self.stages if s.kind == SWEEP and s.role is not None}
         labels = {"before": "before", "after": "AT", "control": "control"}
         inputs = [role for role in sweeps if role in labels or not role.endswith("_calibrated_physics")]
         pairs = [("before", "after"), ("control", "after")]
@@ -327,7 +396,9 @@ class Planner:
     def plan(self) -> list[Stage]:
         self.collect()
         self.clean_training()
-        self.sweep("before", "train_clean")
+        if self.cfg.select.enabled:
+            self.selection()
+        self.sweep("before", self.start_stage)
         self.lora("at", self.cfg.lora.rate, self.cfg.lora.attacks)
         self.lora("control", 0.0, self.cfg.lora.attacks)
         self.sweep("after", "train_at")
