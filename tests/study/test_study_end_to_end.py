@@ -33,6 +33,18 @@ def test_micro_study_runs_every_stage_then_skips_them_all(micro):
     assert set(manifest["results"]) == {"before", "after", "control"}
     assert manifest["conditions"] == {key: ["clean", "laser_blinding@strong"] for key in manifest["results"]}
     assert manifest["report"] == "report"
+    # Both clean checkpoints were scored clean on the validation seeds; the sweeps ran the selected one.
+    selection = json.loads((study_dir / manifest["selection"]).read_text())
+    assert [c["checkpoint"] for c in selection["candidates"]] == [
+        f"train/clean/checkpoints/00000{i}/pretrained_model" for i in (1, 2)
+    ]
+    assert all(c["episodes"] == micro.select.n_episodes for c in selection["candidates"])
+    assert selection["selected"] in [c["checkpoint"] for c in selection["candidates"]]
+    validation = json.loads((study_dir / selection["candidates"][0]["eval"]).read_text())
+    assert [e["seed"] for e in validation["results"][0]["per_episode"]] == [5000, 5001]
+    assert [r["condition"] for r in validation["summary"]] == ["clean"]
+    before = json.loads((study_dir / manifest["results"]["before"]).read_text())
+    assert before["metadata"]["policy"]["path"] == "train/selected/checkpoints/last/pretrained_model"
     # The AT run fine-tuned a LoRA adapter from the clean checkpoint; the control too, at rate 0.
     for name, rate in (("at", 0.3), ("control", 0.0)):
         config = json.loads(

@@ -42,6 +42,10 @@ class FakeRunner:
             (out / "meta" / "info.json").write_text("{}")
         elif stage.kind == "vlm":
             (out / "config.json").write_text("{}")
+        elif stage.kind == "select":
+            (out / PRETRAINED).mkdir(parents=True, exist_ok=True)
+            (out / PRETRAINED / "config.json").write_text("{}")
+            (out / "selection.json").write_text('{"selected": "train/clean/checkpoints/000002"}')
         else:
             (out / "summary.md").write_text("# Summary\n")
         if interrupted:
@@ -82,6 +86,7 @@ def test_manifest_records_every_stage_and_maps_roles_to_relative_eval_files(micr
         assert (micro_dir(micro) / path).is_file()
     assert manifest["conditions"]["after"] == ["clean", "laser_blinding@strong"]
     assert manifest["report"] == "report"
+    assert manifest["selection"] == "train/selected/selection.json"
     # The recorded command re-reads the config the study wrote.
     saved = json.loads((micro_dir(micro) / "study_config.json").read_text())
     assert saved["lora"]["steps"] == micro.lora.steps
@@ -157,6 +162,11 @@ def test_publish_copies_the_finished_results_with_paths_valid_relative_to_the_co
     for record in published["stages"].values():
         assert (destination / record["log"]).is_file()
     assert (destination / "train" / "clean" / PRETRAINED / "train_config.json").is_file()
+    assert (destination / published["selection"]).read_bytes() == (
+        study_dir / published["selection"]
+    ).read_bytes()
+    assert (destination / "sweeps" / "validation" / "000002" / "eval.json").is_file()
+    assert not (destination / "train" / "selected" / PRETRAINED).exists()
     # Data, VLM and checkpoints (weights) stay behind.
     assert not (destination / "data").exists() and not (destination / "vlm").exists()
     assert not (destination / "train" / "clean" / PRETRAINED / "config.json").exists()

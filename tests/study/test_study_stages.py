@@ -7,7 +7,13 @@ import shutil
 import pytest
 from study_testkit import micro_config
 
-from lerobot_phantom.study.config import BeyondSettings, LoRASettings, StudyConfig, SweepSettings
+from lerobot_phantom.study.config import (
+    BeyondSettings,
+    LoRASettings,
+    SelectSettings,
+    StudyConfig,
+    SweepSettings,
+)
 from lerobot_phantom.study.stages import (
     PRETRAINED,
     RESUME,
@@ -24,6 +30,9 @@ PAPER_LOOP = [
     "collect",
     "vlm",
     "train_clean",
+    "sweep_validation_000001",  # the micro run saves a checkpoint at steps 1 and 2
+    "sweep_validation_000002",
+    "select_clean",
     "sweep_before",
     "train_at",
     "train_control",
@@ -50,16 +59,57 @@ def test_paper_loop_in_dependency_order(micro):
         assert set(stage.depends) <= seen, stage.name
         seen.add(stage.name)
     s = by_name(stages)
-    assert s["train_at"].depends == ("train_clean",) == s["train_control"].depends
+    assert s["train_at"].depends == ("select_clean",) == s["train_control"].depends
+    assert s["sweep_before"].depends == ("select_clean",)
+    assert s["select_clean"].depends == ("sweep_validation_000001", "sweep_validation_000002")
     assert s["sweep_after"].depends == ("train_at",)
-    assert {x.role for x in stages if x.kind == "sweep"} == {"before", "after", "control"}
+    assert {x.role for x in stages if x.kind == "sweep"} == {None, "before", "after", "control"}
+
+
+def test_without_selection_everything_starts_from_the_last_clean_checkpoint(micro):
+    cfg = dataclasses.replace(micro, select=dataclasses.replace(micro.select, enabled=False))
+    s = by_name(plan(cfg))
+    assert list(s) == [n for n in PAPER_LOOP if not n.startswith(("sweep_validation", "select"))]
+    assert flag(s["sweep_before"], "policy.path") == f"train/clean/{PRETRAINED}"
+    assert flag(s["train_at"], "policy.path") == f"train/clean/{PRETRAINED}"
+    assert s["train_at"].depends == ("train_clean",)
+
+
+def test_selection_evaluates_every_saved_checkpoint_clean_on_validation_seeds(tmp_path):
+    # 5 steps saved every 2: LeRobot writes checkpoints 2, 4 and the last step 5.
+    cfg = micro_config(
+        tmp_path, train=dataclasses.replace(micro_config(tmp_path).train, steps=5, save_freq=2)
+    )
+    s = by_name(plan(cfg))
+    validations = [x for x in s.values() if x.name.startswith("sweep_validation_")]
+    assert [x.name for x in validations] == [f"sweep_validation_00000{i}" for i in (2, 4, 5)]
+    checkpoints = [flag(x, "policy.path") for x in validations]
+    assert checkpoints == [f"train/clean/checkpoints/00000{i}/pretrained_model" for i in (2, 4, 5)]
+    for x in validations:
+        assert x.role is None and x.depends == ("train_clean",)
+        assert json.loads(flag(x, "phantom.attacks")) == []
+        assert flag(x, "seed") == str(cfg.select.seed) != flag(s["sweep_before"], "seed")
+        assert flag(x, "eval.n_episodes") == str(cfg.select.n_episodes)
+    select = s["select_clean"]
+    assert json.loads(flag(select, "checkpoints")) == checkpoints
+    assert json.loads(flag(select, "evals")) == [f"{x.output}/eval.json" for x in validations]
+    assert flag(s["sweep_before"], "policy.path") == f"train/selected/{PRETRAINED}"
+    # The report never sees a validation run.
+    assert "validation" not in " ".join(s["report"].args)
+
+
+def test_validation_seeds_must_not_overlap_the_sweep_seeds(tmp_path):
+    with pytest.raises(ValueError, match=r"overlap the sweep's 1000\.\.1001"):
+        micro_config(tmp_path, select=SelectSettings(seed=999, n_episodes=2))
+    micro_config(tmp_path, select=SelectSettings(seed=998, n_episodes=2))  # 998, 999: disjoint
+    micro_config(tmp_path, select=SelectSettings(seed=1000, enabled=False))
 
 
 def test_at_and_control_differ_only_in_rate(micro):
     s = by_name(plan(micro))
     at, control = s["train_at"], s["train_control"]
     assert flag(at, "phantom.rate") == "0.3" and flag(control, "phantom.rate") == "0.0"
-    assert flag(at, "policy.path") == f"train/clean/{PRETRAINED}"
+    assert flag(at, "policy.path") == f"train/selected/{PRETRAINED}"
     differing = set(at.args) ^ set(control.args)
     assert {a.split("=")[0] for a in differing} == {"--phantom.rate", "--output_dir"}
     # The paper's recipe: the six camera attacks, intensity uniform weak..strong.
@@ -69,7 +119,7 @@ def test_at_and_control_differ_only_in_rate(micro):
 
 
 def test_sweeps_share_seeds_and_conditions(micro):
-    sweeps = [s for s in plan(micro) if s.kind == "sweep"]
+    sweeps = [s for s in plan(micro) if s.kind == "sweep" and s.role is not None]
     for name in ("seed", "eval.n_episodes", "phantom.attacks", "phantom.intensities", "env.task"):
         assert len({flag(s, name) for s in sweeps}) == 1, name
 
