@@ -20,7 +20,7 @@ Step 2 gives meaningful numbers in a minute or two. Step 3 is sized to fit the w
 hour on two cores, which is a fraction of the recipe's training (docs/recipe/README.md has the learning curve and
 the TSR each scale reaches): it shows the pipeline and its outputs, and its clean TSR says how far a short run gets.
 With ``--clean_policy=<pretrained_model dir>`` (a policy trained by the full recipe), or when a
-``lerobot-phantom-study`` run left its clean policy in ``outputs/study``, step 3 skips clean training and runs the
+``lerobot-phantom-study`` run left its clean policy in ``outputs/study`` (the checkpoint its selection stage chose), step 3 skips clean training and runs the
 defence on that policy. ``--gallery_only`` stops after step 1.
 """
 
@@ -141,17 +141,23 @@ def demo(cfg: DemoConfig) -> dict[str, Path]:
     return demo_run.outputs
 
 
-# Where `lerobot-phantom-study` (default --output_dir) leaves its clean policy, relative to the working directory.
-STUDY_CLEAN_POLICY = Path("outputs/study/train/clean/checkpoints/last/pretrained_model")
+# Where `lerobot-phantom-study` (default --output_dir) leaves its runs, relative to the working directory.
+STUDY_DIR = Path("outputs/study")
 
 
 def _trained_policy(cfg: DemoConfig) -> Path | None:
-    """--clean_policy, else the study's clean policy when a study has run here, else None (train one)."""
+    """--clean_policy, else the study's clean policy when a study has run here (the checkpoint its selection stage
+    chose on validation seeds, else the last one), else None (train one)."""
+    from lerobot_phantom.study.stages import CLEAN_RUN, PRETRAINED, SELECTED_RUN
+
     if cfg.clean_policy is not None:
         return Path(cfg.clean_policy)
-    if cfg.use_study_policy and (STUDY_CLEAN_POLICY / "config.json").exists():
-        print(f"\nusing the clean policy trained by lerobot-phantom-study: {STUDY_CLEAN_POLICY}", flush=True)
-        return STUDY_CLEAN_POLICY
+    if not cfg.use_study_policy:
+        return None
+    for policy in (STUDY_DIR / SELECTED_RUN / PRETRAINED, STUDY_DIR / CLEAN_RUN / PRETRAINED):
+        if (policy / "config.json").exists():
+            print(f"\nusing the clean policy trained by lerobot-phantom-study: {policy}", flush=True)
+            return policy
     return None
 
 

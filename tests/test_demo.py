@@ -31,6 +31,23 @@ def test_clean_policy_without_a_checkpoint_is_refused(tmp_path):
     assert not (tmp_path / "demo").exists()
 
 
+def test_a_study_policy_in_the_working_directory_is_used_the_selected_checkpoint_first(tmp_path, monkeypatch):
+    from lerobot_phantom.demo import _trained_policy
+
+    monkeypatch.chdir(tmp_path)
+    cfg = DemoConfig(out="demo")
+    assert _trained_policy(cfg) is None  # no study here: the demo trains its own
+    study = Path("outputs/study/train")
+    for run in ("clean", "selected"):
+        (study / run / "checkpoints/last/pretrained_model").mkdir(parents=True)
+    (study / "clean/checkpoints/last/pretrained_model/config.json").write_text("{}")
+    assert _trained_policy(cfg) == study / "clean/checkpoints/last/pretrained_model"
+    (study / "selected/checkpoints/last/pretrained_model/config.json").write_text("{}")
+    assert _trained_policy(cfg) == study / "selected/checkpoints/last/pretrained_model"
+    assert _trained_policy(DemoConfig(out="demo", use_study_policy=False)) is None
+    assert _trained_policy(DemoConfig(out="demo", clean_policy="mine")) == Path("mine")
+
+
 def test_demo_trains_with_the_shipped_cpu_recipe(tmp_path):
     """The demo's clean training is configs/smolvla_goal_cpu.json at a smaller scale, never LeRobot's frozen-VLM
     defaults (which keep the weight-free VLM at its random initialisation)."""
