@@ -20,8 +20,8 @@ Step 2 gives meaningful numbers in a minute or two. Step 3 is sized to fit the w
 hour on two cores, which is a fraction of the recipe's training (docs/recipe/README.md has the learning curve and
 the TSR each scale reaches): it shows the pipeline and its outputs, and its clean TSR says how far a short run gets.
 With ``--clean_policy=<pretrained_model dir>`` (a policy trained by the full recipe), or when a
-``lerobot-phantom-study`` run left its clean policy in ``outputs/study`` (the checkpoint its selection stage chose), step 3 skips clean training and runs the
-defence on that policy. ``--gallery_only`` stops after step 1.
+``lerobot-phantom-study`` run left its clean policy in ``outputs/study`` (the checkpoint its selection stage chose),
+step 3 skips clean training and runs the defence on that policy. ``--gallery_only`` stops after step 1.
 """
 
 from __future__ import annotations
