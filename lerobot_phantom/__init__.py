@@ -21,6 +21,7 @@ def register() -> None:
     from lerobot_phantom.envs import register_gym_envs
     from lerobot_phantom.envs.lerobot_config import PhantomTableEnvConfig  # noqa: F401  (registers "phantom_table")
     from lerobot_phantom.eval import servo_policy  # noqa: F401  (registers the "phantom_servo" policy type)
+    from lerobot_phantom.train import state_mask  # noqa: F401  (registers the "phantom_mask_state" processor step)
     from lerobot_phantom.transforms.lerobot_registration import register_image_transforms
 
     register_image_transforms()

@@ -38,10 +38,19 @@ TrainPipelineConfig = compat.train_pipeline_config_class()
 class PhantomTrainPipelineConfig(TrainPipelineConfig):
     # The attack mix used during training (the --phantom.* group); see lerobot_phantom.config.PhantomConfig.
     phantom: PhantomConfig = field(default_factory=PhantomConfig)
+    # Entries of observation.state the policy never sees (e.g. [3], phantom_table's gripper opening); the mask is
+    # saved in the checkpoint's preprocessor, so evaluation applies it too. See lerobot_phantom.train.state_mask.
+    mask_state: list[int] = field(default_factory=list)
 
     def validate(self) -> None:
         super().validate()
         self.phantom.validate()
+        if any(not isinstance(i, int) or i < 0 for i in self.mask_state) or len(set(self.mask_state)) != len(
+            self.mask_state
+        ):
+            raise ValueError(
+                f"--mask_state takes distinct indices >= 0 of observation.state, e.g. '[3]'; got {self.mask_state}"
+            )
         if self.dataset.streaming:
             raise ValueError(
                 "--dataset.streaming=true is not supported by lerobot-phantom-train: the mixer plans exact attack "
@@ -132,8 +141,10 @@ class _PhantomTrainingRun:
     # -- make_pre_post_processors -----------------------------------------------------------------------
     def make_pre_post_processors(self, *args: Any, **kwargs: Any) -> tuple[Any, Any]:
         from lerobot_phantom.train.device_step import PhantomAttackProcessorStep, TrainingPreprocessor
+        from lerobot_phantom.train.state_mask import add_state_mask
 
         preprocessor, postprocessor = self.originals["make_pre_post_processors"](*args, **kwargs)
+        preprocessor = add_state_mask(preprocessor, self.cfg.mask_state)
         attack_step = None
         if self.cfg.phantom.where == "device":
             attack_step = PhantomAttackProcessorStep(
