@@ -42,10 +42,12 @@ by doubling: ``~2 log2(N)`` shifted adds (5 instead of 17 at the strong level on
 ``~N`` strided adds. The general path gathers the ``N + 1`` samples of every pixel. A batch is grouped by identical
 parameters (one pass per distinct displacement: at most 16 under ``"random"``, which draws the authors' whole-pixel
 ``randint(5, 20)``; the geometry of each displacement is cached). uint8 images are blurred on their 0-255
-values: the sums in int16 (exact), the division in float32, rounded once (half to even, as the float path),
-with no scaling to [0, 1] and back. Cost, measured (``scripts/bench_transforms.py``): a few images at a time in
-cache, the strong level takes about 12 passes over the frame (widen, 5 shifted adds with their border copies,
-convert, divide, round, narrow twice); every one of them is at least a ``torch.clone``'s cost.
+values: the sums in int16 (exact), the division in float32, rounded once (half to even, as the float path:
+``1.5 * 2**23`` is added in the division's pass, which leaves the rounded mean in the low byte of the float's bit
+pattern), with no scaling to [0, 1] and back. Cost, measured (``scripts/bench_transforms.py``): a few images at a
+time in cache, the strong level takes about 9 passes over the frame (widen, 5 shifted adds with their border
+copies, convert, divide, narrow); every one of them is at least a ``torch.clone``'s cost. Float images take the
+5 adds and the division (straight into the output).
 """
 
 from __future__ import annotations
@@ -71,6 +73,8 @@ from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter,
 MAX_SAMPLES = 100
 SNAP = 1e-6
 _CHUNK_ELEMENTS = 1 << 20
+ROUNDER = torch.tensor(1.5 * 2**23)
+"""Added to a float32 value v in [0, 2**22), it leaves round(v) (half to even) in the low bits of the bit pattern."""
 LEVEL_DISPLACEMENT_PX: tuple[float, float, float, float] = (0.0, 5.0, 10.0, 20.0)
 
 
@@ -249,9 +253,16 @@ def _linear_blur_into(
                     for c0, c1, cs in col_spans:
                         total[..., r0:r1, c0:c1] += part[..., rs : rs + r1 - r0, cs : cs + c1 - c0]
         if integer:
-            mean = torch.div(total, count, out=quotient[:size]).round_()
-            # float32 -> uint8 is 3x slower than float32 -> int16 -> uint8 on the CPU (values are 0..255 here)
-            result = gathered[:size].copy_(mean)
+            # ROUNDER + total / count, in float32 (whose unit in the last place is 1 there), is the mean rounded half
+            # to even in the low bits of its bit pattern: read as int32 and narrowed to uint8 (which keeps the low
+            # byte), one division pass and one narrowing replace divide, round, float -> int16 -> uint8
+            widened = quotient[:size].copy_(total)  # addcdiv would convert int16 into a fresh float32 tensor
+            result = torch.addcdiv(ROUNDER, widened, count, out=widened).view(torch.int32)
+        elif consecutive:  # the mean straight into the output, clamped while it is in cache
+            result = torch.div(total, count, out=out[first : first + size])
+            if upper is not None:
+                result.clamp_(0.0, upper)
+            continue
         else:
             result = torch.div(total, count, out=gathered[:size] if part is not gathered[:size] else total)
             if upper is not None:
