@@ -106,8 +106,12 @@ def _corrupt_(red: torch.Tensor, green: torch.Tensor, blue: torch.Tensor) -> Non
         capped = green.clamp(max=102)
         torch.add(capped.bitwise_right_shift(1), capped, alpha=2, out=red)
     else:
-        new_green = torch.lerp(red, blue, 0.5).sub_(GREEN_OFFSET).clamp_(0.0, 1.0)
+        # each plane is overwritten after its last read (blue holds the (R + B) / 2 in between): 6 ops, no temporary
+        torch.lerp(red, blue, 0.5, out=blue)
         torch.mul(green, GREEN_GAIN, out=red).clamp_(0.0, 1.0)
+        torch.sub(blue, GREEN_OFFSET, out=green).clamp_(0.0, 1.0)
+        blue.copy_(red)
+        return
     blue.copy_(red)
     green.copy_(new_green)
 
