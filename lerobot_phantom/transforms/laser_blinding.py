@@ -394,7 +394,7 @@ class LaserBlinding(CameraAttack):
             return NotImplemented
         batch, _, height, width = x.shape
         pattern = self.patterns_for(params["position"], height, width, x.device)
-        alphas = params["alpha"].to(torch.float32).reshape(-1).expand(batch)
+        alphas = params["alpha"].to(x.device, torch.float32).reshape(-1).expand(batch)
         values = alphas.tolist()
         cacheable = self._fixed_position is not None
         grey = (
