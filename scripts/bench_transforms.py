@@ -14,7 +14,10 @@ float32 and uint8 batches:
   (``../shared/authors_patterns/README.md``; the patterns are generated when that folder is absent), one uint8
   HWC frame at a time as the authors' code runs; > 1 means faster than numpy;
 * EM truncation on one uint8 image (the functional ``em_truncation`` and the transform call) vs the authors'
-  ``np.delete`` / ``np.append`` (target: no slower).
+  ``np.delete`` / ``np.append`` (target: no slower);
+* what the uint8 targets cost: single torch passes (widen, narrow, add, divide, ...) and the sums of the passes
+  the laser blinding and ultrasound blur kernels need, and OpenCV's fused uint8 alternatives (``cv2.addWeighted``,
+  a ``cv2.boxFilter`` diagonal blur) with their share of values off the package's kernel.
 
 Timings are the best CPU time (``time.process_time``) of repeated calls after a warm-up: everything runs on one
 thread, and on a shared machine the wall clock mostly measures the run queue. The load average is printed and
