@@ -69,6 +69,8 @@ from lerobot_phantom.transforms.intensity import (
 LEVEL_STRIPES: tuple[float, float, float] = (8.0, 12.0, 16.0)
 STRIPE_LEVEL_MAP: tuple[float, float, float, float] = (LEVEL_STRIPES[0], *LEVEL_STRIPES)
 """Stripes at s = 0, weak, medium, strong for ``"random"``'s inverse map (below weak the bands thin instead)."""
+FLOAT_CHUNK_BYTES = 2 << 20
+"""Float batches are corrupted a few images (about this many bytes) at a time, in cache."""
 GREEN_GAIN = 2.5
 GREEN_OFFSET = 50.0 / 255.0
 
@@ -104,8 +106,12 @@ def _corrupt_(red: torch.Tensor, green: torch.Tensor, blue: torch.Tensor) -> Non
         capped = green.clamp(max=102)
         torch.add(capped.bitwise_right_shift(1), capped, alpha=2, out=red)
     else:
-        new_green = torch.lerp(red, blue, 0.5).sub_(GREEN_OFFSET).clamp_(0.0, 1.0)
+        # each plane is overwritten after its last read (blue holds the (R + B) / 2 in between): 6 ops, no temporary
+        torch.lerp(red, blue, 0.5, out=blue)
         torch.mul(green, GREEN_GAIN, out=red).clamp_(0.0, 1.0)
+        torch.sub(blue, GREEN_OFFSET, out=green).clamp_(0.0, 1.0)
+        blue.copy_(red)
+        return
     blue.copy_(red)
     green.copy_(new_green)
 
@@ -284,17 +290,21 @@ def em_color_strip_rgb(
             break
         groups.setdefault(runs, []).append(i)
     if groups:
-        if len(groups) == 1:
-            out = (x.clone() if x.dtype == torch.uint8 else x.clamp(0.0, 1.0)).contiguous()
-            _corrupt_bands_(out, list(next(iter(groups))))
-            return out
         if x.dtype != torch.uint8:
-            # float: a copy of the batch costs more than a few ops per sample, so each run of consecutive samples
-            # is corrupted in place in the clamped copy (measured: 86 vs 118 us per 224x224 image at batch 32)
-            out = x.clamp(0.0, 1.0).contiguous()
+            # float: each run of consecutive samples with one pattern is clamped into the output and corrupted
+            # there a few images at a time, while they are in cache (a grouping copy of the batch would cost more)
+            out = torch.empty(x.shape, dtype=x.dtype, device=x.device)
+            per_chunk = max(1, FLOAT_CHUNK_BYTES // (x[0].numel() * x.element_size()))
             for runs, members in groups.items():
                 for first, stop in _consecutive(members):
-                    _corrupt_bands_(out[first:stop], list(runs))
+                    for start in range(first, stop, per_chunk):
+                        chunk = slice(start, min(stop, start + per_chunk))
+                        torch.clamp(x[chunk], 0.0, 1.0, out=out[chunk])
+                        _corrupt_bands_(out[chunk], list(runs))
+            return out
+        if len(groups) == 1:
+            out = x.clone().contiguous()
+            _corrupt_bands_(out, list(next(iter(groups))))
             return out
         order = [i for members in groups.values() for i in members]
         index = torch.tensor(order, device=x.device)

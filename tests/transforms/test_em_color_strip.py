@@ -7,6 +7,7 @@ import pytest
 import torch
 from reference_em_blur import em_color_strip_reference
 
+from lerobot_phantom.transforms import em_color_strip as em_color_strip_module
 from lerobot_phantom.transforms.em_color_strip import (
     EMColorStrip,
     em_color_strip,
@@ -227,3 +228,18 @@ def test_random_batch_equals_each_sample_on_its_own(dtype):
     for i in range(10):
         alone = {k: v[i : i + 1] for k, v in params.items()}
         assert torch.equal(out[i : i + 1], attack.apply_params(images[i : i + 1], alone)), f"sample {i}"
+
+
+@pytest.mark.parametrize("intensity", ["strong", "random"])
+def test_float_batch_corrupted_chunk_by_chunk_equals_one_chunk(intensity, monkeypatch):
+    """Float batches are clamped and corrupted a few images at a time (``FLOAT_CHUNK_BYTES``, in cache): chunks of
+    two images give the output of one chunk, clamped to [0, 1] first."""
+    images = _random_uint8((7, 3, 50, 30), 9).float() / 255 * 1.2 - 0.1  # values outside [0, 1] too
+    attack = EMColorStrip(intensity, seed=1)
+    params = attack.sample_params(7, 50, 30, generator=torch.Generator().manual_seed(3))
+    whole = attack.apply_params(images, params)
+    monkeypatch.setattr(em_color_strip_module, "FLOAT_CHUNK_BYTES", 2 * images[0].numel() * 4)
+    chunked = attack.apply_params(images, params)
+    assert torch.equal(chunked, whole)
+    assert float(whole.min()) == 0.0 and float(whole.max()) == 1.0
+    assert not torch.equal(whole, images.clamp(0, 1))

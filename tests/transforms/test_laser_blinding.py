@@ -6,6 +6,7 @@ import pytest
 import torch
 from reference_optical import laser_blinding_reference
 
+from lerobot_phantom.transforms import laser_blinding as laser_blinding_module
 from lerobot_phantom.transforms.laser_blinding import (
     ALPHA_LEVELS,
     LaserBlinding,
@@ -213,6 +214,29 @@ def test_uint8_path_matches_float_path(level, position, pattern):
     assert (fast.int() - slow.int()).abs().max() <= 1
     single = attack.apply_params(img[1], {k: v[1:2] for k, v in params.items()})
     assert torch.equal(single, fast[1])
+
+
+def test_uint8_kernel_in_chunks_with_level_and_other_alphas_mixed(monkeypatch):
+    """The uint8 kernel blends a few images per op (``UINT8_CHUNK_BYTES``): chunks mixing the level table's alphas
+    (cached offset) with other alphas (lerp) give each image the blend it gets alone, the float path's blend
+    rounded."""
+    img = _random_uint8((7, 3, 18, 26), seed=4)
+    monkeypatch.setattr(laser_blinding_module, "UINT8_CHUNK_BYTES", 3 * img[0].numel() * 4)
+    attack = LaserBlinding("strong", seed=0)
+    intensity = torch.tensor(
+        [1 / 3, 1 / 3, 0.5, 1.0, 1.0, 1.0, 0.8]
+    )  # weak, weak, between, strong x3, between
+    params = attack.sample_params(7, 18, 26, intensity=intensity)
+    fast = attack.apply_params(img, params)
+    exact = attack.apply_params(img.float() / 255, params).double() * 255
+    # equal to the float path's rounded value but at ties (x.5: the saturated glare core at alpha 0.9 gives
+    # 229.5 + 0.1 x), which the kernel rounds up and torch.round to even
+    tie = ((exact - exact.floor()) - 0.5).abs() < 1e-3
+    assert torch.equal(fast[~tie], torch.round(exact[~tie]).to(torch.uint8))
+    assert ((fast.double() - exact)[tie].abs() <= 0.5 + 1e-3).all()
+    for i in range(7):
+        alone = attack.apply_params(img[i], {k: v[i : i + 1] for k, v in params.items()})
+        assert torch.equal(alone, fast[i]), f"image {i}"
 
 
 def test_uint8_kernel_leaves_the_physical_model_to_the_float_path():

@@ -7,11 +7,13 @@ import pytest
 import torch
 from reference_em_blur import ultrasound_blur_reference
 
+from lerobot_phantom.transforms import ultrasound_blur as ultrasound_blur_module
 from lerobot_phantom.transforms.ultrasound_blur import (
     SNAP,
     UltrasoundBlur,
     _general_blur,
     _linear_blur,
+    _linear_geometry,
     ultrasound_blur,
 )
 
@@ -261,3 +263,19 @@ def test_uint8_path_is_the_exactly_rounded_mean_for_mixed_displacements(random_d
         d_row, d_col = float(params["dy"][i]), float(params["dx"][i])
         expected = torch.round(_linear_blur(images[i : i + 1].double(), d_row, d_col)).to(torch.uint8)
         assert torch.equal(out[i : i + 1], expected), f"sample {i} (d_row={d_row:.3f}, d_col={d_col:.3f})"
+
+
+def test_float_box_paths_in_chunks_equal_the_general_path_per_sample(monkeypatch):
+    """Float box paths (diagonal, vertical, horizontal) are summed by one reduction over a padded buffer, a few
+    images at a time: a batch whose displacements interleave (groups of non-consecutive samples, chunks of two)
+    gives every sample the general path's mean."""
+    images = torch.rand(7, 3, 33, 41, generator=torch.Generator().manual_seed(5), dtype=torch.float64)
+    monkeypatch.setattr(ultrasound_blur_module, "_FLOAT_BOX_CHUNK_ELEMENTS", 2 * images[0].numel())
+    d_col = torch.tensor([3.0, 0.0, 3.0, 6.0, 0.0, 3.0, 6.0], dtype=torch.float64)
+    d_row = torch.tensor([3.0, 5.0, 3.0, 0.0, 5.0, 3.0, 6.0], dtype=torch.float64)
+    out = ultrasound_blur_module.ultrasound_blur_float(images, d_col, d_row, upper=1.0)
+    for i in range(7):
+        d = (float(d_row[i]), float(d_col[i]))
+        assert _linear_geometry(33, 41, *d)[1] is not None  # a box path
+        expected = _general_blur(images[i : i + 1], *d, 0.0, 0.0)
+        torch.testing.assert_close(out[i : i + 1], expected, msg=f"sample {i} (d_row, d_col = {d})")
