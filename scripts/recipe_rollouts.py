@@ -42,6 +42,10 @@ def load(checkpoint: Path):
     from lerobot.configs.policies import PreTrainedConfig
     from lerobot.policies.factory import get_policy_class, make_pre_post_processors
 
+    from lerobot_phantom import register
+
+    register()  # the plugin's processor steps (e.g. --mask_state's) that a checkpoint's preprocessor may name
+
     config = PreTrainedConfig.from_pretrained(checkpoint)
     policy = get_policy_class(config.type).from_pretrained(checkpoint)
     policy.eval()
