@@ -18,10 +18,11 @@ unit of linear light), and its variance is modelled as
 Noise added after the tone curve in any other form (not a sensor's) is outside this model: under an sRGB curve a
 constant output-unit noise has nearly the shape of photon noise (``J^2 x`` is almost flat) and would be read as it.
 
-The tone curve is the fitted one when the mean model has ``sensor_gamma`` (a power law), otherwise sRGB
-(IEC 61966-2-1), the encoding of 8-bit camera images when nothing else is stated; the report says which. A camera
-with another curve (a filmic shoulder) makes the two terms unidentifiable from single exposures: the assumption is
-stated, not hidden.
+The tone curve is the fitted one when the mean model has one (``tone_shoulder``: the log-logistic shoulder of
+calibration/tone.py; ``sensor_gamma``: a power law), otherwise sRGB (IEC 61966-2-1), the encoding of 8-bit camera
+images when nothing else is stated; the report says which. Where no model fits the curve and the camera's curve has
+a shoulder, the two terms are unidentifiable from single exposures (linearised with sRGB, the variance falls with
+the signal): the assumption is stated, not hidden.
 
 Noise cannot be predicted pixel by pixel, so it can never lower an RMSE: it is judged as a model of the residual's
 *distribution*, by the mean Gaussian negative log-likelihood of residuals of pairs not used to fit it. The gain is
@@ -50,6 +51,7 @@ from scipy.optimize import nnls
 
 from lerobot_phantom.calibration.core import Fit, binned_rmse, kfold
 from lerobot_phantom.calibration.identify import Interval, bootstrap
+from lerobot_phantom.calibration.tone import shoulder_decode
 from lerobot_phantom.transforms import physics
 
 SAMPLES_PER_PAIR = 4000
@@ -83,21 +85,36 @@ class NoiseSample:
         return np.stack(columns, axis=1)
 
 
-def tone_curve(fit: Fit) -> float | None:
-    """The gamma that linearises the frames: the fitted ``sensor_gamma`` if the model has one, else None (sRGB)."""
+def tone_curve(fit: Fit) -> float | dict | None:
+    """What linearises the frames: the fitted shoulder curve (a dict of its parameters) if the mean model has
+    ``tone_shoulder``, the fitted ``sensor_gamma`` (a number) if it has that, else None (sRGB)."""
+    if "tone_shoulder" in fit.effects:
+        return {
+            k: float(fit.params[k])
+            for k in ("shoulder", "shoulder_exponent", "gamma")
+            if k in fit.params and (k != "gamma" or "sensor_gamma" in fit.effects)
+        }
     return float(fit.params["gamma"]) if "sensor_gamma" in fit.effects and "gamma" in fit.params else None
 
 
-def tone_curve_name(gamma: float | None) -> str:
-    if gamma is None:
+def tone_curve_name(curve: float | dict | None) -> str:
+    if curve is None:
         return "sRGB (IEC 61966-2-1; assumed: the model fits no tone curve)"
-    return f"power law, gamma {gamma:.3g} (fitted sensor_gamma)"
+    if isinstance(curve, dict):
+        return (
+            f"log-logistic shoulder (fitted tone_shoulder: s {curve['shoulder']:.3g}, n "
+            f"{curve['shoulder_exponent']:.3g}, gamma {curve.get('gamma', 1.0):.3g})"
+        )
+    return f"power law, gamma {curve:.3g} (fitted sensor_gamma)"
 
 
-def linearise(grey: np.ndarray, gamma: float | None) -> tuple[np.ndarray, np.ndarray]:
+def linearise(grey: np.ndarray, curve: float | dict | None) -> tuple[np.ndarray, np.ndarray]:
     """Output grey levels -> (linear light in [0, 1], tone-curve slope dy/dx in grey levels per unit of light)."""
     encoded = torch.from_numpy(np.asarray(grey, np.float64) / 255.0).requires_grad_(True)
-    linear = physics.decode(encoded, gamma)
+    if isinstance(curve, dict):
+        linear = shoulder_decode(encoded, curve, curve.get("gamma"))
+    else:
+        linear = physics.decode(encoded, curve)
     (dx_dy,) = torch.autograd.grad(linear.sum(), encoded)
     return linear.detach().numpy(), 255.0 / np.maximum(dx_dy.numpy(), 1e-12)
 
@@ -112,7 +129,7 @@ def residual_samples(problem, fit: Fit, items: np.ndarray, seed: int) -> dict[in
     """Per pair: residuals on a seeded pixel sample at their predicted signal in linear light and their local
     detail, clipped pixels left out."""
     rng = np.random.default_rng(seed)
-    gamma = tone_curve(fit)
+    curve = tone_curve(fit)
     out = {}
     for i in items:
         pair = problem.pairs[int(i)]
@@ -128,7 +145,7 @@ def residual_samples(problem, fit: Fit, items: np.ndarray, seed: int) -> dict[in
         )
         if len(usable) > SAMPLES_PER_PAIR:
             usable = np.sort(rng.choice(usable, SAMPLES_PER_PAIR, replace=False))
-        signal, slope = linearise(predicted[usable], gamma)
+        signal, slope = linearise(predicted[usable], curve)
         out[int(i)] = NoiseSample(signal, slope, detail[usable], measured[usable] - predicted[usable])
     return out
 
@@ -198,7 +215,7 @@ def select_shot_noise(
         return {"kept": False, "reasons": ["no unclipped pixels to judge the noise by"]}
     validation_ratio = math.exp((validation["read"] - validation["shot"]) / count)
     fitted, heldout = joined(fit_items), joined(heldout_items)
-    gamma = tone_curve(fit)
+    curve = tone_curve(fit)
     without, with_shot = fit_variance(fitted, False), fit_variance(fitted, True)
     heldout_ratio = math.exp(mean_nll(heldout, without) - mean_nll(heldout, with_shot))
 
@@ -235,7 +252,7 @@ def select_shot_noise(
         "validation on the fit pairs; named if the validation noise-scale ratio exp(NLL gain) is above 1, the "
         f"{100 * intervals['shot'].level:.0f}% bootstrap interval of shot (over fit pairs) excludes 0 and photon "
         f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance",
-        "tone_curve": tone_curve_name(gamma),
+        "tone_curve": tone_curve_name(curve),
         "validation_noise_scale_ratio": validation_ratio,
         "heldout_noise_scale_ratio": heldout_ratio,
         "shot_share": intervals["share"].as_dict(),
@@ -281,7 +298,7 @@ def apply_noise_finding(report: dict, fit: Fit, noise: dict) -> Fit:
             "evidence": f"linearised with the {noise['tone_curve']} tone curve, the signal-dependent variance "
             f"model scores the residuals of held-out pairs with a noise-scale ratio "
             f"{noise['heldout_noise_scale_ratio']:.3f} (inner validation {noise['validation_noise_scale_ratio']:.3f}); "
-            f"shot gain {shot['estimate']:.3g} linear grey levels^2 per grey level "
+            f"shot gain {shot['estimate']:.3g} linear-light grey levels^2 per linear-light grey level of signal "
             f"({100 * shot['level']:.0f}% interval {shot['low']:.3g}-{shot['high']:.3g}); it changes no "
             "prediction, so the RMSE is unchanged",
         }

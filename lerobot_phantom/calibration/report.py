@@ -302,14 +302,12 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
             "model of the residual's distribution instead: " + noise["criterion"] + ". "
             f"Inner validation noise-scale ratio {noise['validation_noise_scale_ratio']:.3f}, held out "
             f"{noise['heldout_noise_scale_ratio']:.3f}: "
-            + (
-                "kept"
-                if noise["kept"]
-                else "not kept (the residual's variance does not depend on the signal)"
-            )
-            + f". Fitted: read noise {noise['shot_noise']['read_noise_grey']:.3g} grey levels, shot gain "
-            f"{noise['shot_noise']['shot_gain_grey']:.3g} grey levels^2 per grey level. Held-out residual RMSE vs "
-            "predicted signal: "
+            + ("kept" if noise["kept"] else "not kept (" + "; ".join(noise["reasons"]) + ")")
+            + f". Tone curve that linearises the frames: {noise['tone_curve']}. Fitted, in linear-light grey "
+            "levels (linear light x 255, before the tone curve): read noise "
+            f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
+            "(variance per unit of signal). Held-out residual RMSE (output grey levels) vs predicted signal "
+            "(linear-light grey levels): "
             + ", ".join(
                 f"{x:.0f}: {r:.2f}"
                 for x, r in zip(

@@ -32,6 +32,8 @@ NAMED_SHARE = 0.9
 # under a tone curve that is not a pure power law, a gamma difference
 NOISE = frozenset({"shot_noise"})
 LINEAR_LIGHT = frozenset({"shot_noise", "sensor_gamma"})
+# a filmic camera's tone curve has a highlight shoulder: where light adds in linear irradiance, naming it is true
+SHOULDERED_TONES = frozenset({"filmic"})
 
 
 @dataclass(frozen=True)
@@ -341,6 +343,14 @@ def run_case(name: str, root: str) -> dict:
     return {"report": report, "seed": seed, "camera": camera}
 
 
+def tolerated(case: Case, camera: cs.Camera) -> frozenset:
+    """The effects a case may name besides its planted ones: the case's own, and the tone curve's shoulder when
+    the camera's curve has one and the case composes light in linear irradiance (the same cases as sensor_gamma)."""
+    if camera.tone in SHOULDERED_TONES and "sensor_gamma" in case.tolerated:
+        return case.tolerated | {"tone_shoulder"}
+    return case.tolerated
+
+
 def replay(case: Case, result: dict) -> str:
     return (
         f"case {case.name} (case seed {result['seed']}); replay with CAMSIM_SEED={MASTER_SEED}; "
@@ -360,12 +370,13 @@ def test_case(name, root):
     result = run_case(name, root)
     report = result["report"]
     named = named_causes(report)
-    unplanted = named - case.planted - case.tolerated
+    allowed = tolerated(case, result["camera"])
+    unplanted = named - case.planted - allowed
     where = replay(case, result)
     if case.kind == "null":
         assert not report["extended"]["effects"], f"null case gained {report['extended']['effects']}: {where}"
     elif case.kind == "unexplained":
-        invented = named - case.tolerated
+        invented = named - allowed
         assert not invented, f"an effect the library lacks was reported as {sorted(invented)}: {where}"
         if not unexplained_structure(report):
             # open (issue 12): the residual-structure rule misses the unnamed effect on some fresh draws (seen:
@@ -385,7 +396,10 @@ def test_case(name, root):
     "in the pattern at its 3% reference power, so linear light reproduces it), projection_clipping (camsim "
     "saturates at the file's white, which every library model contains), projection_crosstalk under the filmic "
     "tone curve (albedo not identified), em_strip_bayer_flip (seed-dependent) and truncation_shot_noise are "
-    "missed; see /work/notes/camsim-status.md, Session 3",
+    "missed; see /work/notes/camsim-status.md, Session 3. Session 4 (master seeds 1001-3003): a tone curve with a "
+    "shoulder (calibration/tone.py) fits camsim's filmic curve, but offered to selection it named no further planted "
+    "effect (under a filmic camera with an emitted pattern albedo and the shoulder trade off; clipping stays at the "
+    "file's white) and lowered held-out accuracy, so it is not offered; projection effect cases 3 of 9 named",
     strict=False,
 )
 def test_planted_effects_are_named(root):

@@ -1,0 +1,68 @@
+"""A camera tone curve with a highlight shoulder: a log-logistic (Naka-Rushton) response under a display gamma.
+
+Physics. Film's characteristic curve and the "filmic" tone mapping of camera ISPs are sigmoids in log exposure:
+a toe, a straight middle and a *shoulder* where ever more light adds ever less to the stored value, so that
+highlights roll off instead of clipping. The log-logistic response ``R = E**n / (E**n + E_50**n)`` (the
+Naka-Rushton law of photoreceptors, Hill's equation) is the standard one-knee form of such a curve. Normalised so
+that the sensor's saturation (linear light ``x = 1``) stays the file's white and written as an exposure transfer
+``h`` that reduces to the identity when the knee moves to infinite light:
+
+    u = (1 + s) x**n / (1 + s x**n),     h(x) = u ** (1 / n),     pixel = h(x) ** (1 / gamma)
+
+``s = E_50 ** -n`` >= 0 is the shoulder strength (``s = 0``: no shoulder, the curve is the power law of
+``sensor_gamma``, or the identity without it), ``n`` > 0 the sharpness of the knee (large ``n``: almost a hard
+clip at the knee), ``gamma`` the display exponent (1 when the model has no ``sensor_gamma``). Its inverse is closed
+form, ``u = pixel ** (gamma n)``, ``x = (u / (1 + s - s u)) ** (1 / n)``, so every model that composes light in
+linear irradiance (light projection: projector light adds to the ambient light) can decode and re-encode
+through it. A pure power law cannot bend back below the straight line in log-log at the bright end: fitted to a
+filmic camera it runs its exponent to the edge of its range and leaves the reflectance and cross-talk effects
+that ride on the bright pixels unexplained (measured on the independent camera simulator, camsim-status.md).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from lerobot_phantom.calibration.core import Param
+
+# x ** n at x = 0 has an undefined derivative in n (0 * log 0); the darkest modelled light is one part in 1e12
+TINY = 1e-12
+
+SHOULDER_PARAMS = (
+    # the knee's half-saturation light E_50 = s ** (-1 / n): s = 0.05 puts it ~20x above white (a barely bent
+    # curve), s = 500 a few hundredths of white; beyond either end the curve is a power law or a hard clip
+    Param("shoulder", 1.0, 0.0, 500.0, scale=3.0),
+    Param("shoulder_exponent", 1.0, 0.25, 4.0, scale=0.5),
+)
+
+
+def _parts(params: dict, gamma) -> tuple:
+    s = params["shoulder"]
+    n = params["shoulder_exponent"]
+    return s, n, (1.0 if gamma is None else gamma)
+
+
+def shoulder_decode(encoded: torch.Tensor, params: dict, gamma=None) -> torch.Tensor:
+    """Encoded pixel values in [0, 1] -> linear light in [0, 1] (the inverse of :func:`shoulder_encode`)."""
+    s, n, g = _parts(params, gamma)
+    u = encoded.clamp(TINY, 1.0) ** (g * n)
+    return (u / (1.0 + s - s * u)) ** (1.0 / n)
+
+
+def shoulder_encode(linear: torch.Tensor, params: dict, gamma=None) -> torch.Tensor:
+    """Linear light -> encoded pixel values (light beyond the sensor's saturation is clipped first)."""
+    s, n, g = _parts(params, gamma)
+    xn = linear.clamp(TINY, 1.0) ** n
+    u = (1.0 + s) * xn / (1.0 + s * xn)
+    return u ** (1.0 / (n * g))
+
+
+def equivalent_power_gamma(params: dict, gamma=None) -> float:
+    """The power-law gamma closest to the fitted curve in encoded values over the whole range (least squares on a
+    grid): what a consumer that knows only power laws (the attack transforms) can be given."""
+    x = torch.linspace(0.0, 1.0, 257, dtype=torch.float64)
+    curve = shoulder_encode(x, {k: float(v) for k, v in params.items()}, gamma).numpy()
+    grid = np.linspace(0.3, 5.0, 941)
+    errors = [np.mean((x.numpy() ** (1.0 / g) - curve) ** 2) for g in grid]
+    return float(grid[int(np.argmin(errors))])
