@@ -120,6 +120,10 @@ def main(args: list[str] | None = None) -> None:
 
     import draccus
 
+    from lerobot_phantom import register
+
+    register()  # as every lerobot-phantom-* script does
+
     cfg = draccus.parse(SelectCheckpointConfig, args=sys.argv[1:] if args is None else args)
     selection = select(cfg)
     for i, c in enumerate(selection["candidates"]):
