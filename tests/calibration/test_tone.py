@@ -94,20 +94,12 @@ def test_projection_with_a_shoulder_of_zero_is_the_model_without_it():
     params = {"strength": 0.4, "reflectance_floor": 0.1, "gamma": 2.1}
     effects = {"additive_light", "albedo_modulation", "sensor_gamma"}
     without = projection_predict(surface, projected, strength, effects, params)
-    null = projection_predict(
-        surface,
-        projected,
-        strength,
-        effects | {"tone_shoulder"},
-        {**params, "shoulder": 0.0, "shoulder_exponent": 2.0},
-    )
-    shouldered = projection_predict(
-        surface,
-        projected,
-        strength,
-        effects | {"tone_shoulder"},
-        {**params, "shoulder": 20.0, "shoulder_exponent": 1.2},
-    )
+
+    def with_shoulder(shoulder: float, exponent: float):
+        knee = {**params, "shoulder": shoulder, "shoulder_exponent": exponent}
+        return projection_predict(surface, projected, strength, effects | {"tone_shoulder"}, knee)
+
+    null, shouldered = with_shoulder(0.0, 2.0), with_shoulder(20.0, 1.2)
     assert torch.allclose(null, without, atol=1e-9)
     assert (shouldered - without).abs().max() > 0.02
 
