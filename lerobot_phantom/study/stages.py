@@ -358,7 +358,8 @@ class Planner:
                 f"--phantom.instruction_attacks={flag_list(b.instruction_attacks)}",
                 f"--phantom.instruction_rate={b.instruction_rate}",
             )
-            self.sweep("at_instruction", "train_at_instruction")
+            # Clean TSR and the instruction attacks are what mixing them in can change (issue 11, item 3).
+            self.sweep("at_instruction", "train_at_instruction", b.instruction_attacks)
 
     def report(self) -> None:
         sweeps = {s.role: s for s in self.stages if s.kind == SWEEP and s.role is not None}

@@ -153,6 +153,7 @@ def test_optional_stages(tmp_path):
         assert flag(s[f"sweep_{role}_calibrated_physics"], "phantom.calibration") == str(tmp_path.resolve())
     assert "--phantom.calibration" not in " ".join(s["sweep_at_calibrated"].args)
     assert json.loads(flag(s["train_at_instruction"], "phantom.instruction_attacks")) == ["voice_dos"]
+    assert json.loads(flag(s["sweep_at_instruction"], "phantom.attacks")) == ["voice_dos"]
     report = s["report"]
     pairs = list(zip(json.loads(flag(report, "before")), json.loads(flag(report, "after")), strict=True))
     assert ("sweeps/before/eval.json", "sweeps/at_without_laser_blinding/eval.json") in pairs
