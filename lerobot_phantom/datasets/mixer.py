@@ -53,7 +53,7 @@ from lerobot_phantom.datasets.schedule import (
 )
 from lerobot_phantom.transforms.base import derive_seed
 from lerobot_phantom.transforms.intensity import is_random, random_intensities
-from lerobot_phantom.transforms.registry import ATTACK_IDS, CLEAN_ID, is_camera_attack, make_attack
+from lerobot_phantom.transforms.registry import ATTACK_IDS, CLEAN_ID, is_camera_attack, make_attacks
 
 LABEL_KEYS = (
     "phantom.attack",
@@ -192,10 +192,11 @@ class PhantomDataset(Dataset):
         self._camera_bits = {key: 1 << self.camera_keys.index(key) for key in self.attack_cameras}
 
         # Built once here so that a bad name or calibration fails now, not in a worker at step 10 000.
-        self.attacks: dict[str, Any] = {
-            name: make_attack(name, intensity=config.intensity, calibration=config.calibration)
-            for name in dict.fromkeys([*config.attacks, *config.instruction_attacks])
-        }
+        self.attacks: dict[str, Any] = make_attacks(
+            [*config.attacks, *config.instruction_attacks],
+            intensity=config.intensity,
+            calibration=config.calibration,
+        )
 
         self.image_transforms = None
         if apply and getattr(dataset, "image_transforms", None) is not None:

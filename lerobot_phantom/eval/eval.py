@@ -48,7 +48,7 @@ from lerobot_phantom.eval.rollout import (
     AttackStep,
     Condition,
     EpisodeTasks,
-    build_conditions,
+    attack_steps,
     episode_outcomes,
 )
 from lerobot_phantom.transforms.base import derive_seed
@@ -223,6 +223,7 @@ def rollout_metadata(
         "conditions": [step.condition.key for step in steps],
         "attacks": {step.condition.key: repr(step.attack) for step in steps if step.attack is not None},
         "phantom": asdict(cfg.phantom),
+        "calibrated_attacks": sorted({step.condition.attack for step in steps if step.calibrated}),
         "versions": versions(),
         "complete": False,
     }
@@ -270,8 +271,7 @@ def evaluate(
     if cfg.seed is None:
         raise ValueError("paired comparisons need fixed env seeds: pass --seed=<int> (default 1000)")
     started = time.time()
-    # Every attack is built up front, so that a bad name or calibration fails before any rollout.
-    steps = [AttackStep(condition, cfg.phantom) for condition in build_conditions(cfg.phantom)]
+    steps = attack_steps(cfg.phantom)
     policy, preprocessor, postprocessor = ready_policy(cfg, policy, preprocessor, postprocessor)
     env_processors = compat.eval_env_processors(cfg.env, cfg.policy or policy.config)
     processors = (*env_processors, preprocessor, postprocessor)

@@ -30,7 +30,7 @@ from lerobot_phantom.eval.loading import (
     with_step,
 )
 from lerobot_phantom.eval.results import EVAL_FORMAT, write_eval
-from lerobot_phantom.eval.rollout import AttackStep, Condition, build_conditions
+from lerobot_phantom.eval.rollout import AttackStep, Condition, attack_steps
 from lerobot_phantom.transforms.base import derive_seed
 
 
@@ -146,7 +146,7 @@ def evaluate_offline(
     started = time.time()
     dataset = load_dataset(cfg)
     # The clean frame is every condition's reference, so the clean control is not a condition here.
-    steps = [AttackStep(condition, cfg.phantom) for condition in build_conditions(cfg.phantom)[1:]]
+    steps = attack_steps(cfg.phantom)[1:]
     policy, preprocessor, postprocessor = ready_policy(
         cfg, policy, preprocessor, postprocessor, ds_meta=dataset.meta
     )
@@ -168,6 +168,7 @@ def evaluate_offline(
             "clean_vs_recorded_l2": statistics.fmean(deviations.clean_vs_recorded),
             "conditions": [step.condition.key for step in steps],
             "phantom": asdict(cfg.phantom),
+            "calibrated_attacks": sorted({step.condition.attack for step in steps if step.calibrated}),
             "versions": versions(),
         },
         "results": deviations.rows(len(indices)),

@@ -27,7 +27,12 @@ from lerobot_phantom.eval.config import EvalPhantomConfig
 from lerobot_phantom.eval.results import CLEAN
 from lerobot_phantom.transforms.base import derive_seed
 from lerobot_phantom.transforms.intensity import parse_intensity
-from lerobot_phantom.transforms.registry import ATTACK_NAMES, is_camera_attack, make_attack
+from lerobot_phantom.transforms.registry import (
+    ATTACK_NAMES,
+    calibrated_attack_names,
+    is_camera_attack,
+    make_attack,
+)
 
 
 @dataclass(frozen=True)
@@ -143,19 +148,30 @@ def frames_to_video_frames(observation: dict[str, Any], keys: Sequence[str], cou
     return (row[:, :3].clamp(0, 1) * 255).round().to(torch.uint8).permute(0, 2, 3, 1).numpy()
 
 
+def attack_steps(phantom: EvalPhantomConfig) -> list[AttackStep]:
+    """One attacker per condition (clean first), all built now so that a bad name or calibration fails before any
+    rollout; ``--phantom.calibration`` gives its measured physics to the attacks it calibrates."""
+    calibrated = calibrated_attack_names(phantom.attacks, phantom.calibration)
+    return [
+        AttackStep(condition, phantom, calibrated=condition.attack in calibrated)
+        for condition in build_conditions(phantom)
+    ]
+
+
 class AttackStep(ProcessorStep):
     """The attacker, as the last step of the env preprocessor. ``arm()`` before each batch of episodes."""
 
-    def __init__(self, condition: Condition, phantom: EvalPhantomConfig) -> None:
+    def __init__(self, condition: Condition, phantom: EvalPhantomConfig, calibrated: bool = False) -> None:
         self.condition = condition
         self.phantom = phantom
+        self.calibrated = calibrated
         attack = None
         if condition.attack != CLEAN:
             extra = {} if condition.is_camera else {"mode": phantom.instruction_mode}
             attack = make_attack(
                 condition.attack,
                 intensity=condition.sampled_intensity,
-                calibration=phantom.calibration,
+                calibration=phantom.calibration if calibrated else None,
                 **extra,
             )
         self.attack = attack

@@ -18,7 +18,8 @@ from typing import Any
 import lerobot_phantom
 from lerobot_phantom.envs.suites import SUITES
 from lerobot_phantom.study.config import StudyConfig
-from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
+from lerobot_phantom.transforms.calibrated import calibration_files
+from lerobot_phantom.transforms.registry import CAMERA_ATTACKS, calibrated_attack_names
 
 COLLECT, VLM, TRAIN, SWEEP, SELECT, REPORT = "collect", "vlm", "train", "sweep", "select", "report"
 PRETRAINED = "checkpoints/last/pretrained_model"
@@ -39,6 +40,8 @@ class Stage:
     output: str  # the stage's own directory, relative to the study directory
     depends: tuple[str, ...] = ()
     files: tuple[str, ...] = ()  # config files outside the study the command reads (hashed by content)
+    # Files the command reads through a directory flag (a calibration set): their content enters the fingerprint.
+    inputs: tuple[str, ...] = ()
     # Sweeps: the name under which study.json's "results" lists the eval file (None: a validation run).
     role: str | None = None
 
@@ -69,6 +72,8 @@ def fingerprint(stage: Stage, upstream: dict[str, str]) -> str:
     for path in stage.files:
         args = [a.replace(path, f"sha256:{file_digest(path)}") for a in args]
     payload = {"command": stage.command, "args": args, "upstream": [upstream[d] for d in stage.depends]}
+    if stage.inputs:
+        payload["inputs"] = {path: file_digest(path) for path in stage.inputs}
     return hashlib.sha256(json.dumps(payload, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -274,7 +279,7 @@ class Planner:
             tuple(names),
         )
 
-    def lora(self, name: str, rate: float, attacks, *extra: str) -> None:
+    def lora(self, name: str, rate: float, attacks, *extra: str, inputs: tuple[str, ...] = ()) -> None:
         """LoRA fine-tuning from the clean checkpoint (rate 0: the control)."""
         lo = self.cfg.lora
         args = [
@@ -306,9 +311,12 @@ class Planner:
             f"train/{name}",
             (self.start_stage,),
             (self.lora_config,),
+            inputs=inputs,
         )
 
-    def sweep(self, role: str, policy_stage: str, attacks=None, *extra: str) -> None:
+    def sweep(
+        self, role: str, policy_stage: str, attacks=None, *extra: str, inputs: tuple[str, ...] = ()
+    ) -> None:
         s = self.cfg.sweep
         args = [
             f"--policy.path={self.run_dir(policy_stage)}/{PRETRAINED}",
@@ -330,6 +338,7 @@ class Planner:
             f"sweeps/{role}",
             (policy_stage,),
             role=role,
+            inputs=inputs,
         )
 
     def beyond(self) -> None:
@@ -341,15 +350,19 @@ class Planner:
         if b.calibration is not None:
             calibration = str(Path(b.calibration).resolve())
             physics = f"--phantom.calibration={calibration}"
+            inputs = tuple(str(path) for path in calibration_files(calibration).values())
+            # Only the attacks the calibration changes: under the others both physics, and so the outcomes on the
+            # same seeds, are the same.
             camera = [a for a in self.cfg.sweep.attacks if a in CAMERA_ATTACKS]
-            self.lora("at_calibrated", lo.rate, lo.attacks, physics)
-            self.sweep("at_calibrated", "train_at_calibrated", camera)
+            calibrated = list(calibrated_attack_names(camera, calibration))
+            self.lora("at_calibrated", lo.rate, lo.attacks, physics, inputs=inputs)
+            self.sweep("at_calibrated", "train_at_calibrated", calibrated)
             for role, policy in (
                 ("before", self.start_stage),
                 ("after", "train_at"),
                 ("at_calibrated", "train_at_calibrated"),
             ):
-                self.sweep(f"{role}_calibrated_physics", policy, camera, physics)
+                self.sweep(f"{role}_calibrated_physics", policy, calibrated, physics, inputs=inputs)
         if b.instruction_attacks:
             self.lora(
                 "at_instruction",

@@ -22,7 +22,7 @@ from lerobot_phantom.config import PhantomConfig
 from lerobot_phantom.datasets import LABEL_KEYS, camera_attack_params
 from lerobot_phantom.datasets.mixer import instruction_generator
 from lerobot_phantom.datasets.schedule import CAMERA_CHANNEL, INSTRUCTION_CHANNEL
-from lerobot_phantom.transforms.registry import ATTACK_NAMES, CLEAN_ID, is_camera_attack, make_attack
+from lerobot_phantom.transforms.registry import ATTACK_NAMES, CLEAN_ID, is_camera_attack, make_attacks
 
 ATTACK_STEP_NAME = "phantom_attack_processor"
 
@@ -52,10 +52,11 @@ class PhantomAttackProcessorStep(compat.processor_step_base()):
         config = self.phantom
         # The mixer draws a sample's per-camera parameters in this order (explicit --phantom.cameras keep theirs).
         self._camera_order = config.resolve_cameras(list(self.camera_keys)) if self.camera_keys else []
-        self._attacks = {
-            name: make_attack(name, intensity=config.intensity, calibration=config.calibration)
-            for name in dict.fromkeys([*config.attacks, *config.instruction_attacks])
-        }
+        self._attacks = make_attacks(
+            [*config.attacks, *config.instruction_attacks],
+            intensity=config.intensity,
+            calibration=config.calibration,
+        )
 
     def _attack(self, attack_id: int) -> Any:
         name = ATTACK_NAMES[attack_id]

@@ -1,7 +1,9 @@
 """Loading ``calibrated.json`` (written by ``lerobot-phantom-calibrate``) as constructor options of an attack.
 
 ``make_attack(name, calibration=DIR)`` merges ``calibrated_kwargs(name, DIR)`` under any explicit keyword
-arguments, so training and evaluation can run the measured physics instead of the paper's formulas.
+arguments, so training and evaluation can run the measured physics instead of the paper's formulas;
+``make_attacks(names, calibration=DIR)`` does so for the attacks ``DIR`` calibrates and keeps the paper's physics for
+the others.
 """
 
 from __future__ import annotations
@@ -14,15 +16,40 @@ CALIBRATED_FILE = "calibrated.json"
 SUPPORTED_FORMATS = (1,)
 
 
-def calibrated_kwargs(name: str, calibration_dir: str | Path) -> dict[str, Any]:
-    """Constructor options for attack ``name`` from ``calibration_dir/calibrated.json``."""
+def calibration_files(calibration_dir: str | Path) -> dict[str, Path]:
+    """Attack name -> ``calibrated.json`` of every attack ``calibration_dir`` calibrates.
+
+    ``calibration_dir`` is what one ``lerobot-phantom-calibrate --out DIR`` wrote (``DIR/calibrated.json``, one
+    attack), that file itself, or a calibration set: one such directory per attack (``DIR/<attack>/calibrated.json``),
+    so that training and evaluation that mix several attacks can run the measured physics of each.
+    """
     directory = Path(calibration_dir)
-    path = directory / CALIBRATED_FILE if directory.is_dir() or directory.suffix != ".json" else directory
-    if not path.is_file():
+    if directory.is_file() or directory.suffix == ".json":
+        candidates = [directory]
+    elif (directory / CALIBRATED_FILE).is_file():
+        candidates = [directory / CALIBRATED_FILE]
+    else:
+        candidates = sorted(directory.glob(f"*/{CALIBRATED_FILE}"))
+    if not candidates:
         raise FileNotFoundError(
-            f"no {CALIBRATED_FILE} in {directory}; write one with "
-            f"`lerobot-phantom-calibrate --attack {name} --measured PATH --out {directory}`"
+            f"no {CALIBRATED_FILE} in {directory} or its subdirectories; write one per attack with "
+            f"`lerobot-phantom-calibrate --attack NAME --measured PATH --out {directory}/NAME`"
         )
+    files: dict[str, Path] = {}
+    for path in candidates:
+        attack = read_calibration(path)["attack"]
+        if attack in files:
+            raise ValueError(f"{files[attack]} and {path} both calibrate {attack!r}; keep one")
+        if path.parent != directory and path.parent.name != attack:
+            raise ValueError(f"{path} calibrates {attack!r}: move it to {directory / attack}")
+        files[attack] = path
+    return files
+
+
+def read_calibration(path: Path) -> dict[str, Any]:
+    """The checked payload of one ``calibrated.json``."""
+    if not path.is_file():
+        raise FileNotFoundError(f"{path} does not exist; write it with `lerobot-phantom-calibrate`")
     try:
         payload = json.loads(path.read_text())
     except json.JSONDecodeError as err:
@@ -33,11 +60,17 @@ def calibrated_kwargs(name: str, calibration_dir: str | Path) -> dict[str, Any]:
         raise ValueError(
             f"{path} has format {payload.get('format')!r}; this version reads {SUPPORTED_FORMATS}"
         )
-    if payload["attack"] != name:
+    if not isinstance(payload["kwargs"], dict):
+        raise ValueError(f"{path}: 'kwargs' must be an object, got {type(payload['kwargs']).__name__}")
+    return payload
+
+
+def calibrated_kwargs(name: str, calibration_dir: str | Path) -> dict[str, Any]:
+    """Constructor options for attack ``name`` from ``calibration_dir`` (see ``calibration_files``)."""
+    files = calibration_files(calibration_dir)
+    if name not in files:
         raise ValueError(
-            f"{path} calibrates {payload['attack']!r}, not {name!r}; use a calibration directory per attack"
+            f"{calibration_dir} calibrates {sorted(files)}, not {name!r}; calibrate it with "
+            f"`lerobot-phantom-calibrate --attack {name} --measured PATH --out DIR/{name}`"
         )
-    kwargs = payload["kwargs"]
-    if not isinstance(kwargs, dict):
-        raise ValueError(f"{path}: 'kwargs' must be an object, got {type(kwargs).__name__}")
-    return dict(kwargs)
+    return dict(read_calibration(files[name])["kwargs"])

@@ -31,7 +31,7 @@ from torchvision.transforms import v2
 
 from lerobot_phantom.config import PhantomConfig
 from lerobot_phantom.transforms.base import IMAGE_TYPES, SeededAttack, first_image, rewrap
-from lerobot_phantom.transforms.registry import CAMERA_ATTACKS, make_attack
+from lerobot_phantom.transforms.registry import CAMERA_ATTACKS, make_attacks
 
 
 class PhantomMix(SeededAttack, v2.Transform):
@@ -70,10 +70,9 @@ class PhantomMix(SeededAttack, v2.Transform):
         self.config = config
         self._init_attack(config.intensity, config.seed, generator)
         # Built now, so that a bad name or calibration fails when the dataset is made, not in a worker.
-        self.attacks = {
-            name: make_attack(name, intensity=config.intensity, calibration=config.calibration)
-            for name in config.attacks
-        }
+        self.attacks = make_attacks(
+            config.attacks, intensity=config.intensity, calibration=config.calibration
+        )
         self._weights = torch.tensor(config.attack_weights, dtype=torch.float64)
 
     def make_params(self, flat_inputs: list[Any]) -> dict[str, Any]:

@@ -10,7 +10,12 @@ import torch
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
-from lerobot_phantom.transforms.registry import make_attack
+from lerobot_phantom.transforms.registry import (
+    CAMERA_ATTACKS,
+    calibrated_attack_names,
+    make_attack,
+    make_attacks,
+)
 
 CALIBRATED = {
     "laser_blinding": {
@@ -60,7 +65,7 @@ def test_calibrated_attack_identity_dtype_shape_and_difference(tmp_path, name):
     calibration = write(tmp_path, name, CALIBRATED[name])
     attack = make_attack(name, intensity=1.0, calibration=str(calibration), seed=0)
     other = next(n for n in sorted(CALIBRATED) if n != name)
-    with pytest.raises(ValueError, match=f"calibrates '{name}'"):
+    with pytest.raises(ValueError, match=rf"calibrates \['{name}'\], not '{other}'"):
         make_attack(other, intensity=1.0, calibration=str(calibration))
     x = scene()
     # identity at s = 0
@@ -86,6 +91,47 @@ def test_explicit_kwargs_override_the_calibration(tmp_path):
     calibration = write(tmp_path, "em_color_strip", CALIBRATED["em_color_strip"])
     attack = make_attack("em_color_strip", intensity=1.0, calibration=str(calibration), model="paper")
     assert attack.model == "paper"
+
+
+def test_a_calibration_set_calibrates_its_attacks_and_leaves_the_others_paper(tmp_path):
+    # What several `lerobot-phantom-calibrate --out SET/<attack>` runs write, for training that mixes attacks.
+    calibration_set = tmp_path / "set"
+    calibration_set.mkdir()
+    for name in ("laser_blinding", "light_projection"):
+        write(calibration_set, name, CALIBRATED[name])
+    assert calibrated_attack_names(CAMERA_ATTACKS, str(calibration_set)) == (
+        "laser_blinding",
+        "light_projection",
+    )
+    attacks = make_attacks(CAMERA_ATTACKS, intensity=1.0, calibration=str(calibration_set))
+    assert list(attacks) == list(CAMERA_ATTACKS)
+    assert attacks["laser_blinding"].model == "physical"
+    assert attacks["light_projection"].model == "additive"
+    x = scene()
+    for name in ("em_truncation", "ultrasound_blur", "laser_color_strip"):
+        paper = make_attack(name, intensity=1.0)
+        params = paper.sample_params(2, 48, 64, generator=torch.Generator().manual_seed(2))
+        assert torch.equal(attacks[name].apply_params(x, params), paper.apply_params(x, params)), name
+    # One attack asked for explicitly must be calibrated by the set; the error names what the set holds.
+    with pytest.raises(
+        ValueError, match=r"calibrates \['laser_blinding', 'light_projection'\], not 'em_truncation'"
+    ):
+        make_attack("em_truncation", calibration=str(calibration_set))
+    with pytest.raises(ValueError, match="none of the attacks asked for"):
+        make_attacks(["em_truncation", "voice_dos"], calibration=str(calibration_set))
+
+
+def test_a_calibration_set_refuses_a_misfiled_or_missing_calibration(tmp_path):
+    calibration_set = tmp_path / "set"
+    calibration_set.mkdir()
+    misfiled = write(calibration_set, "light_projection", CALIBRATED["light_projection"])
+    payload = {"format": 1, "attack": "laser_blinding", "kwargs": CALIBRATED["laser_blinding"]}
+    (misfiled / "calibrated.json").write_text(json.dumps(payload))
+    with pytest.raises(ValueError, match="move it to"):
+        make_attacks(CAMERA_ATTACKS, calibration=str(calibration_set))
+    (misfiled / "calibrated.json").unlink()
+    with pytest.raises(FileNotFoundError, match="--out"):
+        make_attacks(CAMERA_ATTACKS, calibration=str(calibration_set))
 
 
 def test_bad_model_names_are_rejected(tmp_path):

@@ -233,3 +233,29 @@ def test_resume_keeps_finished_conditions_and_runs_the_rest(tmp_path):
     other.resume = True
     with pytest.raises(ValueError, match="n_episodes"):
         evaluate(other, policy=kit.make_toy_policy("colour"))
+
+
+def test_a_calibration_set_gives_its_physics_to_the_attacks_it_calibrates(tmp_path):
+    # The study's calibrated-physics sweeps pass one set for all attacks (DIR/<attack>/calibrated.json).
+    folder = tmp_path / "calibration" / "laser_blinding"
+    folder.mkdir(parents=True)
+    kwargs = {"model": "physical", "gain": 1.5, "auto_exposure": 2.0}
+    payload = {"format": 1, "attack": "laser_blinding", "kwargs": kwargs}
+    (folder / "calibrated.json").write_text(json.dumps(payload))
+    cfg = make_cfg(
+        tmp_path,
+        n_episodes=2,
+        batch_size=2,
+        attacks=["laser_blinding", "em_truncation"],
+        intensities=["strong"],
+        calibration=str(folder.parent),
+    )
+    evaluate(cfg, policy=kit.make_toy_policy("oracle"))
+    meta = json.loads((cfg.output_dir / EVAL_FILENAME).read_text())["metadata"]
+    assert meta["calibrated_attacks"] == ["laser_blinding"]
+    assert "physical" in meta["attacks"]["laser_blinding@strong"]
+    with pytest.raises(ValueError, match="none of the attacks asked for"):
+        evaluate(
+            make_cfg(tmp_path / "b", attacks=["em_truncation"], calibration=str(folder.parent)),
+            policy=kit.make_toy_policy("oracle"),
+        )

@@ -134,12 +134,22 @@ def test_report_compares_at_with_before_and_with_control(micro):
     assert json.loads(flag(report, "labels")) == ["before", "AT", "control"]
 
 
+def calibration_set(tmp_path, kwargs=None):
+    """A calibration set holding laser blinding only (as `lerobot-phantom-calibrate --out SET/<attack>` writes)."""
+    folder = tmp_path / "calibration" / "laser_blinding"
+    folder.mkdir(parents=True, exist_ok=True)
+    payload = {"format": 1, "attack": "laser_blinding", "kwargs": kwargs or {"model": "physical"}}
+    (folder / "calibrated.json").write_text(json.dumps(payload))
+    return folder.parent
+
+
 def test_optional_stages(tmp_path):
+    calibration = calibration_set(tmp_path)
     cfg = micro_config(
         tmp_path,
         beyond=BeyondSettings(
             leave_one_out=("laser_blinding",),
-            calibration=str(tmp_path),
+            calibration=str(calibration),
             instruction_attacks=("voice_dos",),
         ),
     )
@@ -148,9 +158,14 @@ def test_optional_stages(tmp_path):
     assert "laser_blinding" not in json.loads(flag(held_out, "phantom.attacks"))
     assert len(json.loads(flag(held_out, "phantom.attacks"))) == len(CAMERA_ATTACKS) - 1
     assert json.loads(flag(s["sweep_at_without_laser_blinding"], "phantom.attacks")) == ["laser_blinding"]
-    assert flag(s["train_at_calibrated"], "phantom.calibration") == str(tmp_path.resolve())
+    assert flag(s["train_at_calibrated"], "phantom.calibration") == str(calibration.resolve())
+    assert len(json.loads(flag(s["train_at_calibrated"], "phantom.attacks"))) == len(CAMERA_ATTACKS)
+    # Sweeps cover the attacks the set calibrates: under the others both physics are the same.
+    assert json.loads(flag(s["sweep_at_calibrated"], "phantom.attacks")) == ["laser_blinding"]
     for role in ("before", "after", "at_calibrated"):
-        assert flag(s[f"sweep_{role}_calibrated_physics"], "phantom.calibration") == str(tmp_path.resolve())
+        sweep = s[f"sweep_{role}_calibrated_physics"]
+        assert flag(sweep, "phantom.calibration") == str(calibration.resolve())
+        assert json.loads(flag(sweep, "phantom.attacks")) == ["laser_blinding"]
     assert "--phantom.calibration" not in " ".join(s["sweep_at_calibrated"].args)
     assert json.loads(flag(s["train_at_instruction"], "phantom.instruction_attacks")) == ["voice_dos"]
     assert json.loads(flag(s["sweep_at_instruction"], "phantom.attacks")) == ["voice_dos"]
@@ -172,6 +187,22 @@ def test_optional_stages(tmp_path):
 def changed_stages(before: StudyConfig, after: StudyConfig) -> set[str]:
     old, new = fingerprints(plan(before)), fingerprints(plan(after))
     return {name for name in new if old.get(name) != new[name]}
+
+
+def test_a_recalibration_reruns_the_calibrated_stages_only(tmp_path):
+    cfg = micro_config(tmp_path, beyond=BeyondSettings(calibration=str(calibration_set(tmp_path))))
+    old = fingerprints(plan(cfg))
+    calibration_set(tmp_path, {"model": "physical", "gain": 2.0})
+    new = fingerprints(plan(cfg))
+    changed = {name for name in new if old[name] != new[name]}
+    assert changed == {
+        "train_at_calibrated",
+        "sweep_at_calibrated",
+        "sweep_before_calibrated_physics",
+        "sweep_after_calibrated_physics",
+        "sweep_at_calibrated_calibrated_physics",
+        "report",
+    }
 
 
 def test_a_changed_setting_changes_its_stage_and_the_ones_downstream_only(micro):
