@@ -423,15 +423,22 @@ class EMColorStrip(CameraAttack):
     ) -> dict[str, torch.Tensor]:
         """As ``CameraAttack.sample_params``; ``"random"`` gives the paper's pattern for the drawn integer N (the
         authors' training), not the cross-fade of the neighbouring levels that the same ``s`` means elsewhere."""
-        params = super().sample_params(
-            batch_size, height, width, intensity=intensity, generator=generator, device=device
-        )
         drawn = is_random(self.intensity if intensity is None else intensity)
-        if drawn and self.model == "paper" and self.num_stripes is None:
-            stripes = interpolate_levels(params["intensity"], STRIPE_LEVEL_MAP).round()
-            ones = torch.ones_like(stripes)
-            params.update(num_stripes=stripes, next_num_stripes=stripes, mix=0 * ones, band_fraction=ones)
-        return params
+        if not (drawn and self.model == "paper" and self.num_stripes is None):
+            return super().sample_params(
+                batch_size, height, width, intensity=intensity, generator=generator, device=device
+            )
+        # the same draw as the base's, without _sample's cross-fade parameters (replaced here: ~10 ops per call)
+        s = self._intensities(batch_size, intensity, generator, device)
+        stripes = interpolate_levels(s, STRIPE_LEVEL_MAP).round()
+        ones = torch.ones_like(stripes)
+        return {
+            "num_stripes": stripes,
+            "next_num_stripes": stripes,
+            "mix": 0 * ones,
+            "band_fraction": ones,
+            "intensity": s,
+        }
 
     def _sample(self, s, height, width, generator, device):
         if self.model == "bayer_phase_flip":
