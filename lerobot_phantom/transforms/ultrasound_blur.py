@@ -46,8 +46,9 @@ cached). uint8 images are blurred on their 0-255
 values: the sums in int16 (exact), the division in float32, rounded once (half to even, as the float path:
 ``1.5 * 2**23`` is added in the division's pass, which leaves the rounded mean in the low byte of the float's bit
 pattern), with no scaling to [0, 1] and back. Cost, measured (``scripts/bench_transforms.py``): a few images at a
-time in cache, the strong level takes about 9 passes over the frame (widen, 5 shifted adds with their border
-copies, convert, divide, narrow); every one of them is at least a ``torch.clone``'s cost. Float images on a box
+time in cache, the strong level takes about 9 passes over the frame (widen into a buffer zero-padded by the path's
+length, 5 shifted adds of one op each, convert, divide, narrow); every one of them costs 2-10 times a uint8
+``torch.clone``, so the uint8 blur stays near 0.02x clone (the bench prints this floor). Float images on a box
 path are instead copied into a zero-padded buffer in which the path of every pixel is one strided view, summed by
 one reduction (from the cache) and divided straight into the output.
 """
@@ -56,6 +57,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from typing import ClassVar
 
 import torch
@@ -146,14 +148,32 @@ def _shift_add(
     return out
 
 
+def _padded_shift_add(
+    a: torch.Tensor, b: torch.Tensor, k: int, step: tuple[int, int], out: torch.Tensor
+) -> torch.Tensor:
+    """``_shift_add`` on buffers zero-padded by at least the path's length below and right of the image: one op
+    over the rows and columns where ``b``'s shifted view exists (the rest of ``out`` keeps stale values, which no
+    valid sum reads: a sum of ``n`` samples is exact on the rows and columns whose ``n`` samples lie in the buffer,
+    and every later add reads it only there). No border copies: one op per add instead of up to five."""
+    dr, dc = k * step[0], k * step[1]
+    rows, cols = a.shape[-2] - dr, a.shape[-1] - dc
+    torch.add(a[..., :rows, :cols], b[..., dr:, dc:], out=out[..., :rows, :cols])
+    return out
+
+
 def _box_sum(
-    x: torch.Tensor, step: tuple[int, int], length: int, scratch: list[torch.Tensor]
+    x: torch.Tensor,
+    step: tuple[int, int],
+    length: int,
+    scratch: list[torch.Tensor],
+    shift_add: Callable[..., torch.Tensor] = _shift_add,
 ) -> torch.Tensor:
     """``sum_{i < length} x[r + i sr, c + i sc]`` (zero outside) by doubling: ~2 log2(length) shifted adds instead of
     ``length`` (5 instead of 17 at the paper's strong level on 224x224), summed as a tree (float error ~log2).
 
     ``scratch``: four buffers shaped like ``x`` (reused by every chunk of a batch: no allocation per add). The
-    result is one of them, or ``x`` itself when ``length == 1``."""
+    result is one of them, or ``x`` itself when ``length == 1``. ``shift_add``: ``_shift_add``, or
+    ``_padded_shift_add`` when ``x`` is zero-padded by ``length - 1`` along ``step``."""
     free = list(scratch)
     result, covered, power, size = None, 0, x, 1
     while True:
@@ -162,7 +182,7 @@ def _box_sum(
                 result, covered = power, size
             else:
                 target = free.pop()
-                _shift_add(result, power, covered, step, target)
+                shift_add(result, power, covered, step, target)
                 if result is not x and result is not power:
                     free.append(result)
                 result, covered = target, covered + size
@@ -170,7 +190,7 @@ def _box_sum(
         if not length:
             return result
         target = free.pop()
-        _shift_add(power, power, size, step, target)
+        shift_add(power, power, size, step, target)
         if power is not x and power is not result:
             free.append(power)
         power, size = target, size * 2
@@ -234,8 +254,12 @@ def _linear_blur_into(
     count = count.to(x.device, torch.float32 if integer else x.dtype)
     per_chunk = min(len(members), max(1, _CHUNK_ELEMENTS // x[0].numel()))  # a few images stay in cache
     shape = (per_chunk, channels, height, width)
-    scratch = [torch.empty(shape, dtype=work_dtype, device=x.device) for _ in range(4 if step else 1)]
-    gathered = torch.empty(shape, dtype=work_dtype, device=x.device)
+    # uint8 box paths sum in buffers zero-padded by the path's length (one op per doubling add, no border copies)
+    pad_rows, pad_cols = (num * step[0], num * step[1]) if integer and step else (0, 0)
+    padded = (per_chunk, channels, height + pad_rows, width + pad_cols)
+    scratch = [torch.empty(padded, dtype=work_dtype, device=x.device) for _ in range(4 if step else 1)]
+    gathered = torch.zeros(padded, dtype=work_dtype, device=x.device)
+    interior = gathered[:, :, :height, :width]
     quotient = torch.empty(shape, dtype=torch.float32, device=x.device) if integer else None
     rounder = torch.tensor(ROUNDER, dtype=torch.float32, device=x.device)
     for start in range(0, len(members), per_chunk):
@@ -245,13 +269,17 @@ def _linear_blur_into(
         if consecutive and not integer:
             part = x[first : first + size]
         else:
-            part = gathered[:size]
+            part = interior[:size]
             if consecutive:
                 part.copy_(x[first : first + size])
             else:
                 for j, i in enumerate(chunk):
                     part[j].copy_(x[i])
-        if step is not None:
+        if step is not None and integer:
+            buffers = [buffer[:size] for buffer in scratch]
+            total = _box_sum(gathered[:size], step, num + 1, buffers, _padded_shift_add)
+            total = total[:, :, :height, :width]
+        elif step is not None:
             total = _box_sum(part, step, num + 1, [buffer[:size] for buffer in scratch])
         else:
             total = scratch[0][:size].copy_(part)  # sample i = 0: offset (0, 0)
@@ -271,7 +299,7 @@ def _linear_blur_into(
                 result.clamp_(0.0, upper)
             continue
         else:
-            result = torch.div(total, count, out=gathered[:size] if part is not gathered[:size] else total)
+            result = torch.div(total, count, out=part)  # the gathered copy, no longer needed
             if upper is not None:
                 result.clamp_(0.0, upper)
         if consecutive:

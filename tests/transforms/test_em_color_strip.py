@@ -243,3 +243,16 @@ def test_float_batch_corrupted_chunk_by_chunk_equals_one_chunk(intensity, monkey
     assert torch.equal(chunked, whole)
     assert float(whole.min()) == 0.0 and float(whole.max()) == 1.0
     assert not torch.equal(whole, images.clamp(0, 1))
+
+
+@pytest.mark.parametrize("num_stripes", [9, 11, 13])
+def test_a_last_band_whose_period_runs_past_the_frame_is_corrupted_exactly(num_stripes):
+    """At 224 rows, 9, 11 and 13 stripes leave a last band whose period (band + gap) runs past the frame's end;
+    the bands are still corrupted through one strided view: the batch equals the paper's code per image."""
+    images = _random_uint8((2, 3, 224, 24), seed=num_stripes)
+    step = 224 // num_stripes
+    last_band = max(range(0, 224 - step, 2 * step))
+    assert last_band + 2 * step > 224  # the case this test is about
+    out = em_color_strip(images, num_stripes)
+    for i in range(2):
+        torch.testing.assert_close(out[i], _reference(images[i], num_stripes), atol=0, rtol=0)

@@ -279,3 +279,19 @@ def test_float_box_paths_in_chunks_equal_the_general_path_per_sample(monkeypatch
         assert _linear_geometry(33, 41, *d)[1] is not None  # a box path
         expected = _general_blur(images[i : i + 1], *d, 0.0, 0.0)
         torch.testing.assert_close(out[i : i + 1], expected, msg=f"sample {i} (d_row, d_col = {d})")
+
+
+def test_uint8_box_paths_in_padded_chunks_are_the_exactly_rounded_mean(monkeypatch):
+    """uint8 box paths (diagonal, vertical, horizontal) are summed by doubling in int16 buffers zero-padded by the
+    path's length, a few images at a time: with interleaved displacements (groups of non-consecutive samples, chunks
+    of two, stale scratch from the previous chunk and group) every sample is its float64 mean rounded half to even."""
+    images = _random_uint8((7, 3, 33, 41), 23)
+    monkeypatch.setattr(ultrasound_blur_module, "_CHUNK_ELEMENTS", 2 * images[0].numel())
+    d_col = torch.tensor([3.0, 0.0, 3.0, 6.0, 0.0, 3.0, 17.0], dtype=torch.float64)
+    d_row = torch.tensor([3.0, 5.0, 3.0, 0.0, 5.0, 3.0, 17.0], dtype=torch.float64)
+    out = ultrasound_blur_module.ultrasound_blur_float(images, d_col, d_row)
+    for i in range(7):
+        d = (float(d_row[i]), float(d_col[i]))
+        assert _linear_geometry(33, 41, *d)[1] is not None  # a box path
+        expected = torch.round(_general_blur(images[i : i + 1].double(), *d, 0.0, 0.0)).to(torch.uint8)
+        assert torch.equal(out[i : i + 1], expected), f"sample {i} (d_row, d_col = {d})"
