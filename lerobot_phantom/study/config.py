@@ -100,6 +100,8 @@ class BeyondSettings:
     leave_one_out: tuple[str, ...] = ()
     # Directory of calibrated.json: AT with the calibrated physics, and both ATs evaluated under both physics.
     calibration: str | None = None
+    # Intensities of the calibrated-physics sweeps (default: the sweep's); e.g. [medium,strong] to save time.
+    calibration_intensities: tuple[str, ...] | None = None
     # Instruction attacks mixed into AT (e.g. [voice_dos,voice_spoofing]) at this instruction rate.
     instruction_attacks: tuple[str, ...] = ()
     instruction_rate: float = 0.3
@@ -146,7 +148,11 @@ class StudyConfig:
                 raise ValueError(
                     f"--beyond.instruction_attacks takes {', '.join(INSTRUCTION_ATTACKS)}, got {name!r}"
                 )
-        for level in (*self.sweep.intensities, self.lora.intensity):
+        for level in (
+            *self.sweep.intensities,
+            *(self.beyond.calibration_intensities or ()),
+            self.lora.intensity,
+        ):
             parse_intensity(level)
         if self.sweep.n_episodes < 1 or self.sweep.batch_size < 1:
             raise ValueError("--sweep.n_episodes and --sweep.batch_size must be >= 1")

@@ -315,7 +315,13 @@ class Planner:
         )
 
     def sweep(
-        self, role: str, policy_stage: str, attacks=None, *extra: str, inputs: tuple[str, ...] = ()
+        self,
+        role: str,
+        policy_stage: str,
+        attacks=None,
+        *extra: str,
+        intensities=None,
+        inputs: tuple[str, ...] = (),
     ) -> None:
         s = self.cfg.sweep
         args = [
@@ -325,7 +331,7 @@ class Planner:
             f"--eval.batch_size={min(s.batch_size, s.n_episodes)}",
             f"--seed={s.seed}",
             f"--phantom.attacks={flag_list(s.attacks if attacks is None else attacks)}",
-            f"--phantom.intensities={flag_list(s.intensities)}",
+            f"--phantom.intensities={flag_list(s.intensities if intensities is None else intensities)}",
             f"--output_dir=sweeps/{role}",
             *extra,
             *s.extra_args,
@@ -356,13 +362,21 @@ class Planner:
             camera = [a for a in self.cfg.sweep.attacks if a in CAMERA_ATTACKS]
             calibrated = list(calibrated_attack_names(camera, calibration))
             self.lora("at_calibrated", lo.rate, lo.attacks, physics, inputs=inputs)
-            self.sweep("at_calibrated", "train_at_calibrated", calibrated)
+            levels = b.calibration_intensities
+            self.sweep("at_calibrated", "train_at_calibrated", calibrated, intensities=levels)
             for role, policy in (
                 ("before", self.start_stage),
                 ("after", "train_at"),
                 ("at_calibrated", "train_at_calibrated"),
             ):
-                self.sweep(f"{role}_calibrated_physics", policy, calibrated, physics, inputs=inputs)
+                self.sweep(
+                    f"{role}_calibrated_physics",
+                    policy,
+                    calibrated,
+                    physics,
+                    intensities=levels,
+                    inputs=inputs,
+                )
         if b.instruction_attacks:
             self.lora(
                 "at_instruction",

@@ -189,6 +189,18 @@ def changed_stages(before: StudyConfig, after: StudyConfig) -> set[str]:
     return {name for name in new if old.get(name) != new[name]}
 
 
+def test_calibrated_sweeps_can_run_fewer_intensities(tmp_path):
+    beyond = BeyondSettings(
+        calibration=str(calibration_set(tmp_path)), calibration_intensities=("medium", "strong")
+    )
+    s = by_name(plan(micro_config(tmp_path, beyond=beyond)))
+    for role in ("at_calibrated", "before_calibrated_physics", "at_calibrated_calibrated_physics"):
+        assert json.loads(flag(s[f"sweep_{role}"], "phantom.intensities")) == ["medium", "strong"]
+    assert json.loads(flag(s["sweep_before"], "phantom.intensities")) == list(
+        micro_config(tmp_path).sweep.intensities
+    )
+
+
 def test_a_recalibration_reruns_the_calibrated_stages_only(tmp_path):
     cfg = micro_config(tmp_path, beyond=BeyondSettings(calibration=str(calibration_set(tmp_path))))
     old = fingerprints(plan(cfg))
