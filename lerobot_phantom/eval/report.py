@@ -442,7 +442,7 @@ def before_after(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dict
         for b, a in pairs:
             for suite in b.suites:
                 before_eps, after_eps = b.episodes(condition, suite), a.episodes(condition, suite)
-                if not before_eps:
+                if not before_eps or not after_eps:  # e.g. a leave-one-out sweep of the held-out attack only
                     cells.append("-")
                     continue
                 test = paired(before_eps, after_eps)

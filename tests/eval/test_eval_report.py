@@ -334,6 +334,32 @@ def test_at_is_compared_with_before_and_with_the_control(evals, tmp_path):
     assert len(tests) == 1 + 2 * 2 * 4
 
 
+def test_a_pair_whose_after_ran_a_subset_of_the_conditions_gets_dashes(evals, tmp_path):
+    # The study's beyond stages sweep a subset (the held-out attack, the instruction attacks) against the full before.
+    base, trained = evals
+    subset = {k: v for k, v in TRAINED.items() if k[0] in ("clean", "voice_dos")}
+    held_out = write_eval(tmp_path / "held_out" / "eval.json", subset)
+    out = tmp_path / "r"
+    make_report(
+        [base, trained, held_out],
+        out,
+        labels=["before", "AT", "held_out"],
+        before=[base, base],
+        after=[trained, held_out],
+        figures=False,
+    )
+    rows = {
+        line.split(" | ")[0]: line
+        for line in (out / "before_after.md").read_text().splitlines()
+        if line.startswith("| ")
+    }
+    strong = rows["| Laser blinding (LB), strong"].split(" | ")
+    assert strong[1:3] == ["100.0 (+100.0)*", "16.7 (+16.7)"] and strong[3:] == ["-", "- |"]
+    assert "-" not in rows["| Voice DoS (VD)"].split(" | ")[1:]
+    tests = (out / "before_after_tests.csv").read_text().splitlines()
+    assert len(tests) == 1 + 2 * 4 + 2 * 2
+
+
 def test_per_task_table_when_episodes_ran_several_tasks(tmp_path):
     path = write_eval(
         tmp_path / "tasks" / "eval.json", {("clean", "goal"): "110100", ("voice_dos", "goal"): "100000"}
