@@ -145,9 +145,18 @@ CASES = [
         "projection_clipping",
         "light_projection",
         "effect",
-        lambda rng, cam: cs.light_projection_pairs(rng, cam, N_PAIRS, power=rng.uniform(3.0, 5.0)),
+        # the emitted frame as pattern: a board capture of a projector bright enough to saturate the camera is
+        # itself saturated where the light is strongest, so it records the clip instead of the light
+        lambda rng, cam: cs.light_projection_pairs(
+            rng, cam, N_PAIRS, power=rng.uniform(3.0, 5.0), pattern_record="emitted"
+        ),
         planted=frozenset({"additive_light", "albedo_modulation", "clipping"}),
         tolerated=LINEAR_LIGHT,
+        # the full well fills 75-92% of the ADC's range (camsim.Camera.well_share_of_adc), so a saturated pixel is
+        # written at 225-246 under sRGB. Saturation at the file's maximum (share 1) is in every model: nothing to
+        # find. The camera is sRGB because a filmic shoulder writes that headroom within 2 grey levels of the
+        # maximum (aces(3.2) / aces(4) = 0.985), a clip no data can show
+        camera={"tone": "srgb", "well_share_of_adc": lambda rng: rng.uniform(0.75, 0.92)},
     ),
     Case(
         "projection_sensor_gamma",
@@ -204,7 +213,10 @@ CASES = [
         "em_strip_bayer_flip",
         "em_color_strip",
         "effect",
-        lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS),
+        # the library's bayer_phase_flip is one lost line whose wrong phase runs to the frame's end; bands of
+        # flipped rows (a second lost line restoring the phase) are the paper's geometry with the demosaicing
+        # colours, which the base (band period, phase and colour map fitted) already is: em_strip_bayer_bands
+        lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS, lost_lines="single"),
         planted=frozenset({"bayer_phase_flip"}),
     ),
     # EM truncation
@@ -255,6 +267,13 @@ CASES = [
         "ultrasound_blur",
         "unexplained",
         lambda rng, cam: cs.ultrasound_blur_pairs(rng, cam, N_PAIRS, path="rotation"),
+    ),
+    # appended, so every earlier case keeps its seed under a given master seed
+    Case(
+        "em_strip_bayer_bands",
+        "em_color_strip",
+        "null",
+        lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS, lost_lines="banded"),
     ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
