@@ -9,7 +9,8 @@ forms, chosen from camera physics rather than from the library:
 * exposure: fixed, or auto-exposure that meters the clipped linear frame (centre-weighted) and solves for the
   exposure that brings it to a target grey, so a bright light source in view darkens the rest of the scene;
 * sensor: RGGB Bayer mosaic, Poisson photon shot noise, Gaussian read noise, full-well clipping in linear
-  electrons, 12-bit ADC;
+  electrons, 12-bit ADC (optionally with headroom above the full well, so a saturated pixel is written below the
+  file's maximum);
 * ISP: bilinear demosaic, a tone curve (sRGB transfer function, a filmic ACES-like curve, or a pure power law),
   8-bit quantisation and a JPEG round trip (PIL) at a given quality.
 
@@ -21,8 +22,8 @@ Each of the six camera attacks of the paper (Phantom Menace, Method and Appendix
   ambient light *before* reflection, so what the camera sees is scaled by the surface reflectance;
 * laser colour strip: a rolling shutter integrates a pulsed laser; each row's energy is the overlap of its exposure
   window with the pulse train, whose phase is random per frame;
-* EM colour strip: lines lost on the bus shift the raw Bayer rows of a band by one, so the ISP demosaics them with
-  the wrong colour-filter phase;
+* EM colour strip: lines lost on the bus shift the raw Bayer rows by one, so the ISP demosaics them with the wrong
+  colour-filter phase: in bands (a second lost line restores the phase) or from one row to the frame's end;
 * EM truncation: a corrupted buffer address drops a band of rows and stitches rows from the frame's end below;
 * ultrasound blur: the image moves along a path during the exposure (linear, resonant sinusoidal whose dwell time is
   arcsine-distributed, or rotational), averaged in linear irradiance.
@@ -50,6 +51,12 @@ class Camera:
     width: int = 64
     # electrons at saturation; small wells make photon shot noise large
     full_well_e: float = 20000.0
+    # the full well's signal as a share of the ADC's maximum code. Raw white levels of real sensors sit below the
+    # ADC's maximum (headroom for offsets and gain spread, ISO-dependent digital gain), and an ISP that scales by
+    # the ADC's range rather than by the white level writes a saturated pixel below the file's maximum, at
+    # tone(well_share_of_adc): a clip the data can show, unlike saturation at the file's maximum, which no
+    # frame can tell apart from the file's own range
+    well_share_of_adc: float = 1.0
     read_noise_e: float = 3.0
     adc_bits: int = 12
     psf_sigma_px: float = 0.5
@@ -68,6 +75,8 @@ class Camera:
     def __post_init__(self) -> None:
         if self.tone not in TONE_CURVES:
             raise ValueError(f"tone {self.tone!r}; valid: {', '.join(TONE_CURVES)}")
+        if not 0.0 < self.well_share_of_adc <= 1.0:
+            raise ValueError(f"well_share_of_adc {self.well_share_of_adc}; valid: (0, 1]")
 
 
 @dataclass
@@ -200,8 +209,8 @@ def sensor(
     *,
     extra_exposure: np.ndarray | None = None,
 ) -> np.ndarray:
-    """Raw frame in [0, 1] of full well: photons (+ ``extra_exposure``, already in full-well units), shot and
-    read noise, clipping, ADC."""
+    """Raw frame in [0, 1] of the ADC's range: photons (+ ``extra_exposure``, already in full-well units), shot and
+    read noise, clipping at the full well, ADC (the well fills ``well_share_of_adc`` of its range)."""
     signal = exposure * irradiance
     if extra_exposure is not None:
         signal = signal + extra_exposure
@@ -209,7 +218,8 @@ def sensor(
     electrons = rng.poisson(np.clip(electrons, 0, 50 * cam.full_well_e)).astype(float)
     electrons += rng.normal(0.0, cam.read_noise_e, electrons.shape)
     levels = 2**cam.adc_bits - 1
-    return np.round(np.clip(electrons / cam.full_well_e, 0.0, 1.0) * levels) / levels
+    code = np.clip(electrons / cam.full_well_e, 0.0, 1.0) * cam.well_share_of_adc
+    return np.round(code * levels) / levels
 
 
 def develop(raw: np.ndarray, cam: Camera) -> np.ndarray:
@@ -297,16 +307,20 @@ def laser_blinding_pairs(
     Physical (``digital_alpha=None``): attacked irradiance = scene + power * spot; the sensor saturates and, when the
     camera has auto-exposure, the metered exposure drops as the laser gets brighter. The pattern is one capture of
     the laser alone (dark room, the first clean scene's exposure, kept for the session unless the camera has
-    auto-exposure) at a reference power: the peak power of the pairs
-    without a glare tail; 3% of it with one, so the faint tail is lost in the pattern's quantisation and only
-    shows at high power. ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha *
-    intensity, in 8-bit output space (the null case)."""
+    auto-exposure) at a reference power: the peak power of the pairs without a glare tail; with one, the power at
+    which the capture's core fills 50-90% of the full well, as a beam-profile measurement is exposed (a
+    saturated core hides the profile). The tail, 0.5-1.5% of the core and falling as a power of the distance, then
+    sinks into the capture's dark noise and 8-bit steps a few pixels out, while at the attack's tens of times that
+    power it lights the scene far around the spot: glare the pattern does not hold. (A capture at a few percent
+    of the attack's power still saturates its core and keeps the tail where the attack shows it.)
+    ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha * intensity, in 8-bit
+    output space (the null case)."""
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))]
     centre = (rng.uniform(0.3, 0.7) * cam.height, rng.uniform(0.3, 0.7) * cam.width)
     halo_params = (rng.uniform(5e-3, 1.5e-2), rng.uniform(1.0, 2.5), rng.uniform(1.4, 2.4)) if halo else None
     spot = laser_spot(cam, centre, colour, core_px=rng.uniform(2.5, 4.0), halo=halo_params)
     peak_power = rng.uniform(40, 120)  # full wells per unit exposure at the core, at intensity 1
-    reference = peak_power * (0.03 if halo else 1.0)
+    core_fill = rng.uniform(0.5, 0.9) if halo else None
     pairs = []
     dark = 0.01 * ambient_light(rng, cam.height, cam.width)
     pattern_exposure = None
@@ -322,6 +336,8 @@ def laser_blinding_pairs(
             clean, exposure = capture(refl * light, cam, rng, exposure=fixed)
         if pattern_exposure is None:
             pattern_exposure = exposure
+            at_core = float(optics(spot, cam).max()) * pattern_exposure
+            reference = peak_power if core_fill is None else core_fill / at_core
             pattern, _ = capture(dark + reference * spot, cam, rng, exposure=pattern_exposure)
             pattern_u8 = encode(pattern, cam)
         if digital_alpha is not None:
@@ -499,19 +515,33 @@ def paper_colour_map(image01: np.ndarray) -> np.ndarray:
 
 
 def em_strip_pairs(
-    rng: np.random.Generator, cam: Camera, n_pairs: int, *, paper_map: bool = False
+    rng: np.random.Generator,
+    cam: Camera,
+    n_pairs: int,
+    *,
+    paper_map: bool = False,
+    lost_lines: str = "banded",
 ) -> list[FramePair]:
-    """EM colour strip: bands of rows with a period fixed per case and a random phase per frame. Physical: a lost
-    line at each band start shifts the raw rows by one, so the band is demosaiced with the wrong Bayer phase (a
-    second lost line at the band end restores it). ``paper_map``: the paper's fixed colour map on the bands in
-    output space (null)."""
+    """EM colour strip: rows demosaiced with the wrong Bayer phase because lines were lost on the bus.
+
+    ``lost_lines="banded"``: bands of rows with a period fixed per case and a random phase per frame; a lost line
+    at each band start shifts the raw rows by one, so the band is demosaiced with the wrong Bayer phase, and a
+    second lost line at the band end restores it. ``"single"``: the interference hits once per frame, at a
+    uniformly random row; one lost line shifts every later raw row by one, so the wrong phase runs to the frame's
+    end (nothing restores it before the next frame's sync). ``paper_map``: the paper's fixed colour map on the
+    bands in output space (null)."""
+    if lost_lines not in ("banded", "single"):
+        raise ValueError(f"lost_lines {lost_lines!r}; valid: banded, single")
     h = cam.height
     period = float(rng.integers(h // 5, h // 2)) // 2 * 2
     pairs = []
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
         clean, exposure = clean_capture(refl * light, cam, rng)
-        band = band_rows(h, period, rng.uniform(0, period))
+        if lost_lines == "single":
+            band = np.arange(h) >= rng.integers(0, h)
+        else:
+            band = band_rows(h, period, rng.uniform(0, period))
         if paper_map:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             attacked = quantised(attacked)

@@ -1,0 +1,28 @@
+"""The independent camera simulator's own physics where a calibration case depends on it."""
+
+from __future__ import annotations
+
+import camsim as cs
+import numpy as np
+import pytest
+
+
+def test_a_full_well_below_the_adc_maximum_clips_below_the_files_white():
+    cam = cs.Camera(well_share_of_adc=0.8, tone="srgb", jpeg_quality=95)
+    levels = 2**cam.adc_bits - 1
+    raw = cs.sensor(np.full((cam.height, cam.width, 3), 10.0), 1.0, cam, np.random.default_rng(0))
+    assert np.allclose(raw, np.round(0.8 * levels) / levels)  # saturated everywhere, at the well's code
+    white = cs.encode(cs.develop(raw, cam), cam)
+    expected = 255 * cs.tone_curve(np.array(np.round(0.8 * levels) / levels), cam)
+    assert np.abs(white.astype(float) - expected).max() <= 1.0
+    assert white.max() < 240  # sRGB(0.8) = 231: visibly below the file's maximum
+
+
+def test_well_share_outside_its_range_is_rejected():
+    with pytest.raises(ValueError, match=r"well_share_of_adc 1.2; valid: \(0, 1\]"):
+        cs.Camera(well_share_of_adc=1.2)
+
+
+def test_unknown_lost_line_mode_is_rejected():
+    with pytest.raises(ValueError, match="lost_lines 'twice'; valid: banded, single"):
+        cs.em_strip_pairs(np.random.default_rng(0), cs.Camera(), 2, lost_lines="twice")
