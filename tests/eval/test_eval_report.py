@@ -314,18 +314,24 @@ def test_summary_lists_every_condition_tied_at_the_largest_drop():
     assert "Ultrasound" not in text  # the next value down is not a tie
 
 
+def three_run_report(tmp_path, base, trained, third, label, before, after):
+    """The report of before, AT and a third run, with the given before/after pairs; returns its directory."""
+    out = tmp_path / "r"
+    make_report(
+        [base, trained, third],
+        out,
+        labels=["before", "AT", label],
+        before=before,
+        after=after,
+        figures=False,
+    )
+    return out
+
+
 def test_at_is_compared_with_before_and_with_the_control(evals, tmp_path):
     base, trained = evals
     control = write_eval(tmp_path / "control" / "eval.json", BASE)
-    out = tmp_path / "r"
-    make_report(
-        [base, trained, control],
-        out,
-        labels=["before", "AT", "control"],
-        before=[base, control],
-        after=[trained, trained],
-        figures=False,
-    )
+    out = three_run_report(tmp_path, base, trained, control, "control", [base, control], [trained, trained])
     header = (out / "before_after.md").read_text().splitlines()[0]
     assert header == (
         "| Attack | AT vs before spatial | AT vs before goal | AT vs control spatial | AT vs control goal |"
@@ -339,15 +345,7 @@ def test_a_pair_whose_after_ran_a_subset_of_the_conditions_gets_dashes(evals, tm
     base, trained = evals
     subset = {k: v for k, v in TRAINED.items() if k[0] in ("clean", "voice_dos")}
     held_out = write_eval(tmp_path / "held_out" / "eval.json", subset)
-    out = tmp_path / "r"
-    make_report(
-        [base, trained, held_out],
-        out,
-        labels=["before", "AT", "held_out"],
-        before=[base, base],
-        after=[trained, held_out],
-        figures=False,
-    )
+    out = three_run_report(tmp_path, base, trained, held_out, "held_out", [base, base], [trained, held_out])
     rows = {
         line.split(" | ")[0]: line
         for line in (out / "before_after.md").read_text().splitlines()
