@@ -117,7 +117,7 @@ def test_calibrated_kwargs_errors(tmp_path):
     (tmp_path / "calibrated.json").write_text(
         json.dumps({"format": 1, "attack": "light_projection", "kwargs": {}})
     )
-    with pytest.raises(ValueError, match="calibrates 'light_projection', not 'laser_blinding'"):
+    with pytest.raises(ValueError, match=r"calibrates \['light_projection'\], not 'laser_blinding'"):
         calibrated_kwargs("laser_blinding", tmp_path)
     (tmp_path / "calibrated.json").write_text("{not json")
     with pytest.raises(ValueError, match="not valid JSON"):
