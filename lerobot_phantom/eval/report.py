@@ -23,6 +23,7 @@ mean, so that they read without this documentation.
 import csv
 import io
 import json
+import textwrap
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -688,7 +689,9 @@ def before_after_figure(records: list[dict[str, Any]]):
             mark = "*" if significant[i, j] else ""
             ax.text(j, i, f"{value:+.0f}{mark}", ha="center", va="center", fontsize=7, color=colour)
     ax.set_yticks(range(len(conditions)), [condition_label(c) for c in conditions], fontsize=7)
-    ax.set_xticks(range(len(columns)), [f"{a} vs {b}\n{s}" for a, b, s in columns], fontsize=8)
+    # Wrapped, so that long run labels (the study's beyond-the-paper roles) do not overlap their neighbours.
+    ticks = ["\n".join(textwrap.wrap(f"{a} vs {b}", 16)) + f"\n{s}" for a, b, s in columns]
+    ax.set_xticks(range(len(columns)), ticks, fontsize=8)
     ax.set_title(
         f"Paired TSR change after - before (pp); * p < {SIGNIFICANCE}, exact McNemar on matched seeds",
         fontsize=9,

@@ -62,6 +62,23 @@ class Stage:
         raise ValueError(f"stage {self.name} ({self.kind}) cannot resume; it re-runs")
 
 
+def role_label(role: str) -> str:
+    """How the report names a sweep role (``at_without_laser_blinding`` -> ``AT without laser blinding``)."""
+    named = {
+        "before": "before",
+        "after": "AT",
+        "control": "control",
+        "at_calibrated": "measured-physics AT",
+        "at_instruction": "AT + instruction attacks",
+    }
+    policy = role.removesuffix("_calibrated_physics")
+    if policy.startswith("at_without_"):
+        label = "AT without " + policy.removeprefix("at_without_").replace("_", " ")
+    else:
+        label = named.get(policy, policy)
+    return f"{label} under measured physics" if policy != role else label
+
+
 def file_digest(path: str | Path) -> str:
     return hashlib.sha256(Path(path).read_bytes()).hexdigest()
 
@@ -390,8 +407,7 @@ class Planner:
 
     def report(self) -> None:
         sweeps = {s.role: s for s in self.stages if s.kind == SWEEP and s.role is not None}
-        labels = {"before": "before", "after": "AT", "control": "control"}
-        inputs = [role for role in sweeps if role in labels or not role.endswith("_calibrated_physics")]
+        inputs = [role for role in sweeps if not role.endswith("_calibrated_physics")]
         pairs = [("before", "after"), ("control", "after")]
         pairs += [
             ("before", role)
@@ -407,7 +423,7 @@ class Planner:
         path = {role: f"sweeps/{role}/{EVAL_FILE}" for role in sweeps}
         args = [
             f"--inputs={flag_list(path[r] for r in inputs)}",
-            f"--labels={flag_list(labels.get(r, r) for r in inputs)}",
+            f"--labels={flag_list(role_label(r) for r in inputs)}",
             f"--before={flag_list(path[b] for b, _ in pairs)}",
             f"--after={flag_list(path[a] for _, a in pairs)}",
             "--output_dir=report",

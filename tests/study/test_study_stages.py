@@ -176,6 +176,17 @@ def test_optional_stages(tmp_path):
         "sweeps/before_calibrated_physics/eval.json",
         "sweeps/at_calibrated_calibrated_physics/eval.json",
     ) in pairs
+    assert json.loads(flag(report, "labels")) == [
+        "before",
+        "AT",
+        "control",
+        "AT without laser blinding",
+        "measured-physics AT",
+        "AT + instruction attacks",
+        "before under measured physics",
+        "AT under measured physics",
+        "measured-physics AT under measured physics",
+    ]
     # Calibrated-physics sweeps are compared with each other only, never with a naive-physics sweep.
     for b, a in pairs:
         assert b.endswith("_calibrated_physics/eval.json") == a.endswith("_calibrated_physics/eval.json"), (
