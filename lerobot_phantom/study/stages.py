@@ -17,6 +17,7 @@ from typing import Any
 
 import lerobot_phantom
 from lerobot_phantom.envs.suites import SUITES
+from lerobot_phantom.eval.report import ATTACK_TITLES
 from lerobot_phantom.study.config import StudyConfig
 from lerobot_phantom.transforms.calibrated import calibration_files
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS, calibrated_attack_names
@@ -63,7 +64,7 @@ class Stage:
 
 
 def role_label(role: str) -> str:
-    """How the report names a sweep role (``at_without_laser_blinding`` -> ``AT without laser blinding``)."""
+    """How the report names a sweep role (``at_without_em_color_strip`` -> ``AT without EM color strip``)."""
     named = {
         "before": "before",
         "after": "AT",
@@ -73,7 +74,7 @@ def role_label(role: str) -> str:
     }
     policy = role.removesuffix("_calibrated_physics")
     if policy.startswith("at_without_"):
-        label = "AT without " + policy.removeprefix("at_without_").replace("_", " ")
+        label = "AT without " + ATTACK_TITLES[policy.removeprefix("at_without_")]
     else:
         label = named.get(policy, policy)
     return f"{label} under measured physics" if policy != role else label

@@ -180,7 +180,7 @@ def test_optional_stages(tmp_path):
         "before",
         "AT",
         "control",
-        "AT without laser blinding",
+        "AT without Laser blinding",
         "measured-physics AT",
         "AT + instruction attacks",
         "before under measured physics",
