@@ -26,13 +26,9 @@ from lerobot.utils.constants import OBS_IMAGE as OBSERVATION_IMAGE_PREFIX
 from lerobot_phantom.eval.config import EvalPhantomConfig
 from lerobot_phantom.eval.results import CLEAN
 from lerobot_phantom.transforms.base import derive_seed
+from lerobot_phantom.transforms.calibrated import calibrated_options
 from lerobot_phantom.transforms.intensity import parse_intensity
-from lerobot_phantom.transforms.registry import (
-    ATTACK_NAMES,
-    calibrated_attack_names,
-    is_camera_attack,
-    make_attack,
-)
+from lerobot_phantom.transforms.registry import ATTACK_NAMES, is_camera_attack, make_attack
 
 
 @dataclass(frozen=True)
@@ -151,9 +147,9 @@ def frames_to_video_frames(observation: dict[str, Any], keys: Sequence[str], cou
 def attack_steps(phantom: EvalPhantomConfig) -> list[AttackStep]:
     """One attacker per condition (clean first), all built now so that a bad name or calibration fails before any
     rollout; ``--phantom.calibration`` gives its measured physics to the attacks it calibrates."""
-    calibrated = calibrated_attack_names(phantom.attacks, phantom.calibration)
+    options = calibrated_options(phantom.attacks, phantom.calibration)
     return [
-        AttackStep(condition, phantom, calibrated=condition.attack in calibrated)
+        AttackStep(condition, phantom, options.get(condition.attack))
         for condition in build_conditions(phantom)
     ]
 
@@ -161,17 +157,23 @@ def attack_steps(phantom: EvalPhantomConfig) -> list[AttackStep]:
 class AttackStep(ProcessorStep):
     """The attacker, as the last step of the env preprocessor. ``arm()`` before each batch of episodes."""
 
-    def __init__(self, condition: Condition, phantom: EvalPhantomConfig, calibrated: bool = False) -> None:
+    def __init__(
+        self,
+        condition: Condition,
+        phantom: EvalPhantomConfig,
+        calibrated_options: dict[str, Any] | None = None,
+    ) -> None:
+        """``calibrated_options``: the attack's measured physics (``attack_steps`` reads them once for all steps)."""
         self.condition = condition
         self.phantom = phantom
-        self.calibrated = calibrated
+        self.calibrated = calibrated_options is not None
         attack = None
         if condition.attack != CLEAN:
             extra = {} if condition.is_camera else {"mode": phantom.instruction_mode}
             attack = make_attack(
                 condition.attack,
                 intensity=condition.sampled_intensity,
-                calibration=phantom.calibration if calibrated else None,
+                **(calibrated_options or {}),
                 **extra,
             )
         self.attack = attack

@@ -19,8 +19,8 @@ import lerobot_phantom
 from lerobot_phantom.envs.suites import SUITES
 from lerobot_phantom.eval.report import ATTACK_TITLES
 from lerobot_phantom.study.config import StudyConfig
-from lerobot_phantom.transforms.calibrated import calibration_files
-from lerobot_phantom.transforms.registry import CAMERA_ATTACKS, calibrated_attack_names
+from lerobot_phantom.transforms.calibrated import calibrated_options, calibration_set
+from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
 COLLECT, VLM, TRAIN, SWEEP, SELECT, REPORT = "collect", "vlm", "train", "sweep", "select", "report"
 PRETRAINED = "checkpoints/last/pretrained_model"
@@ -374,11 +374,11 @@ class Planner:
         if b.calibration is not None:
             calibration = str(Path(b.calibration).resolve())
             physics = f"--phantom.calibration={calibration}"
-            inputs = tuple(str(path) for path in calibration_files(calibration).values())
+            inputs = tuple(str(path) for path, _ in calibration_set(calibration).values())
             # Only the attacks the calibration changes: under the others both physics, and so the outcomes on the
             # same seeds, are the same.
             camera = [a for a in self.cfg.sweep.attacks if a in CAMERA_ATTACKS]
-            calibrated = list(calibrated_attack_names(camera, calibration))
+            calibrated = list(calibrated_options(camera, calibration))
             self.lora("at_calibrated", lo.rate, lo.attacks, physics, inputs=inputs)
             levels = b.calibration_intensities
             self.sweep("at_calibrated", "train_at_calibrated", calibrated, intensities=levels)

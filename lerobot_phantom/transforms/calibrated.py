@@ -16,8 +16,8 @@ CALIBRATED_FILE = "calibrated.json"
 SUPPORTED_FORMATS = (1,)
 
 
-def calibration_files(calibration_dir: str | Path) -> dict[str, Path]:
-    """Attack name -> ``calibrated.json`` of every attack ``calibration_dir`` calibrates.
+def calibration_set(calibration_dir: str | Path) -> dict[str, tuple[Path, dict[str, Any]]]:
+    """Attack name -> (``calibrated.json``, its checked payload) for every attack ``calibration_dir`` calibrates.
 
     ``calibration_dir`` is what one ``lerobot-phantom-calibrate --out DIR`` wrote (``DIR/calibrated.json``, one
     attack), that file itself, or a calibration set: one such directory per attack (``DIR/<attack>/calibrated.json``),
@@ -35,15 +35,16 @@ def calibration_files(calibration_dir: str | Path) -> dict[str, Path]:
             f"no {CALIBRATED_FILE} in {directory} or its subdirectories; write one per attack with "
             f"`lerobot-phantom-calibrate --attack NAME --measured PATH --out {directory}/NAME`"
         )
-    files: dict[str, Path] = {}
+    found: dict[str, tuple[Path, dict[str, Any]]] = {}
     for path in candidates:
-        attack = read_calibration(path)["attack"]
-        if attack in files:
-            raise ValueError(f"{files[attack]} and {path} both calibrate {attack!r}; keep one")
+        payload = read_calibration(path)
+        attack = payload["attack"]
+        if attack in found:
+            raise ValueError(f"{found[attack][0]} and {path} both calibrate {attack!r}; keep one")
         if path.parent != directory and path.parent.name != attack:
             raise ValueError(f"{path} calibrates {attack!r}: move it to {directory / attack}")
-        files[attack] = path
-    return files
+        found[attack] = (path, payload)
+    return found
 
 
 def read_calibration(path: Path) -> dict[str, Any]:
@@ -65,12 +66,23 @@ def read_calibration(path: Path) -> dict[str, Any]:
     return payload
 
 
-def calibrated_kwargs(name: str, calibration_dir: str | Path) -> dict[str, Any]:
-    """Constructor options for attack ``name`` from ``calibration_dir`` (see ``calibration_files``)."""
-    files = calibration_files(calibration_dir)
-    if name not in files:
+def calibrated_options(names: Any, calibration_dir: str | Path | None) -> dict[str, dict[str, Any]]:
+    """Constructor options of each of ``names`` that ``calibration_dir`` calibrates, read once (``{}`` without a
+    directory); the directory must calibrate at least one of ``names``, and the error names what it holds."""
+    if calibration_dir is None:
+        return {}
+    available = calibration_set(calibration_dir)
+    names = tuple(dict.fromkeys(names))
+    options = {name: dict(available[name][1]["kwargs"]) for name in names if name in available}
+    if names and not options:
+        asked = repr(names[0]) if len(names) == 1 else f"any of {', '.join(names)}"
         raise ValueError(
-            f"{calibration_dir} calibrates {sorted(files)}, not {name!r}; calibrate it with "
-            f"`lerobot-phantom-calibrate --attack {name} --measured PATH --out DIR/{name}`"
+            f"{calibration_dir} calibrates {sorted(available)}, not {asked}; calibrate it with "
+            f"`lerobot-phantom-calibrate --attack NAME --measured PATH --out {calibration_dir}/NAME`"
         )
-    return dict(read_calibration(files[name])["kwargs"])
+    return options
+
+
+def calibrated_kwargs(name: str, calibration_dir: str | Path) -> dict[str, Any]:
+    """Constructor options for attack ``name`` from ``calibration_dir`` (see ``calibration_set``)."""
+    return calibrated_options([name], calibration_dir)[name]

@@ -68,31 +68,15 @@ def make_attack(
     return cls(intensity=intensity, **kwargs)
 
 
-def calibrated_attack_names(names: Any, calibration: str | None) -> tuple[str, ...]:
-    """Which of ``names`` ``calibration`` calibrates (none without one); it must calibrate at least one of them."""
-    if calibration is None:
-        return ()
-    from lerobot_phantom.transforms.calibrated import calibration_files
-
-    available = calibration_files(calibration)
-    names = tuple(dict.fromkeys(names))
-    covered = tuple(name for name in names if name in available)
-    if names and not covered:
-        raise ValueError(
-            f"{calibration} calibrates {sorted(available)}, none of the attacks asked for ({', '.join(names)}); "
-            f"calibrate one with `lerobot-phantom-calibrate --attack NAME --measured PATH --out {calibration}/NAME`"
-        )
-    return covered
-
-
 def make_attacks(names: Any, intensity: Any = "medium", *, calibration: str | None = None) -> dict[str, Any]:
     """Build every attack in ``names`` (order kept, duplicates dropped), e.g. for mixing them in training.
 
     ``calibration`` (a calibration directory or set, see ``transforms.calibrated``) gives the measured physics to
     the attacks it calibrates; the others keep the paper's formulas.
     """
-    calibrated = calibrated_attack_names(names, calibration)
+    from lerobot_phantom.transforms.calibrated import calibrated_options
+
+    options = calibrated_options(names, calibration)
     return {
-        name: make_attack(name, intensity=intensity, calibration=calibration if name in calibrated else None)
-        for name in dict.fromkeys(names)
+        name: make_attack(name, intensity=intensity, **options.get(name, {})) for name in dict.fromkeys(names)
     }

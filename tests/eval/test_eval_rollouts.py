@@ -254,7 +254,7 @@ def test_a_calibration_set_gives_its_physics_to_the_attacks_it_calibrates(tmp_pa
     meta = json.loads((cfg.output_dir / EVAL_FILENAME).read_text())["metadata"]
     assert meta["calibrated_attacks"] == ["laser_blinding"]
     assert "physical" in meta["attacks"]["laser_blinding@strong"]
-    with pytest.raises(ValueError, match="none of the attacks asked for"):
+    with pytest.raises(ValueError, match=r"calibrates \['laser_blinding'\], not 'em_truncation'"):
         evaluate(
             make_cfg(tmp_path / "b", attacks=["em_truncation"], calibration=str(folder.parent)),
             policy=kit.make_toy_policy("oracle"),
