@@ -283,10 +283,9 @@ def final_progress_states(log: bytes) -> bytes:
             if cursor == len(rows):
                 rows.append(b"")
         for part in segment.split(b"\r"):
+            # A part is written from the line's start (after a newline or a carriage return); an empty one leaves it.
             text = part.replace(CURSOR_UP, b"")
-            if (
-                text
-            ):  # written from the line's start (after a newline or a carriage return); nothing: left as is
+            if text:
                 rows[cursor] = text
             cursor = max(0, cursor - part.count(CURSOR_UP))
     return b"\n".join(rows)

@@ -287,6 +287,23 @@ def test_figures_name_the_interval_plot_voice_attacks_and_spell_out_attacks(eval
     assert [t.get_text() for t in ax.get_yticklabels()] == ["Clean", "Voice DoS (VD)"]
     assert "McNemar" in ax.get_title() and "pp" in ax.get_title()
     assert "-50*" in [t.get_text() for t in ax.texts]
+    # Long run labels (the study's beyond-the-paper roles) wrap instead of running into their neighbours.
+    long = "measured-physics AT under measured physics"
+    wrapped = before_after_figure(
+        [
+            {
+                "before": "before",
+                "after": long,
+                "suite": "goal",
+                "condition": "clean",
+                "delta": 0.1,
+                "p_value": 1.0,
+            }
+        ]
+    )
+    (tick,) = [t.get_text() for t in wrapped.axes[0].get_xticklabels()]
+    assert tick.replace("\n", " ") == f"{long} vs before goal"
+    assert max(len(line) for line in tick.splitlines()) <= 16
 
 
 def test_summary_lists_every_condition_tied_at_the_largest_drop():
