@@ -415,11 +415,17 @@ def test_case(name, root):
     "in 6 of 10 core effect cases on master seed 31337 and 7 of 10 on 27182 (4 and 6 of 10 before the session's "
     "changes on the same seeds; session 3: 5 of 10 on 555). Named: auto-exposure, clipping (a full well below the "
     "ADC's maximum; 5 of 5 fresh seeds 60001-60005 run alone), stripe period, Bayer phase flip, free band, "
-    "sinusoidal blur, sensor_gamma on 27182. Missed: blinding_halo (with a beam-profile pattern the halo is "
-    "selected, 24-27% lower validation error, but its exponent runs to the bound 8: it stands in for the pattern's "
-    "noise that the model amplifies by the power ratio, not for a power law), projection_crosstalk under the filmic "
+    "sinusoidal blur, sensor_gamma on 27182. Session 6 (master seeds 4242, 90210): 8 of 10 and 7 of 11 before and "
+    "after reading the laser capture as a denoised beam profile continued below its noise floor (laser cases only "
+    "re-run after; fresh seed 7919, laser cases: same outcome). Missed: blinding_halo (the halo is selected, its "
+    "exponent at the bound 8: it stood in for the capture's noise and for the beam's outskirts below the capture's "
+    "noise floor; on 90210, with the beam read from a noise-free oracle of the rendered spot, the planted glare "
+    "tail lowers "
+    "the validation error by 1%, under the 5% margin: the drawn glare lies under the spot's own bloom over the "
+    "frame), projection_crosstalk under the filmic "
     "tone curve (albedo not named), truncation_shot_noise on filmic cameras, projection_sensor_gamma on 31337 "
-    "(sensor_gamma not named, cross-talk named instead); see the README, 'Tested against an independent camera "
+    "(sensor_gamma not named, cross-talk named instead; on 4242 and 90210 selected but its cross-validated error-ratio "
+    "interval over 6 fit pairs includes 1); see the README, 'Tested against an independent camera "
     "simulator'",
     strict=False,
 )

@@ -1,7 +1,7 @@
 """Laser blinding frame pairs: the scene, a capture of the laser alone, and the blinded frame.
 
 Base: the paper's alpha blend of the scene and the encoded pattern. ``linear_light_saturation`` reads the pattern
-as laser irradiance instead, which needs two corrections any capture of a laser "alone" calls for:
+as laser irradiance instead, which needs three corrections any capture of a laser "alone" calls for:
 
 * the capture's dark level (the dark room's residual light and the sensor's black level) is not laser light and
   does not grow with the laser's power: the per-channel median of the capture's outer half (far from the spot) is
@@ -12,7 +12,12 @@ as laser irradiance instead, which needs two corrections any capture of a laser 
   sigma^2))``, the Gaussian's ``exp((R^2 - r^2) / (2 sigma^2))`` written with the distance ``d`` (reference pixels)
   to the nearest unsaturated pixel, so that saturated areas of any shape are followed. This matters whenever the
   blinded frame is exposed less than the capture (auto-exposure, a weaker beam): the saturated disc then
-  shrinks, and a model holding the core at the full well would paint it grey instead.
+  shrinks, and a model holding the core at the full well would paint it grey instead;
+* the capture's noise is not laser light either, and the beam goes on below the capture's noise floor: the
+  capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge
+  (:func:`beam_profile`). A capture exposed for the beam's profile is tens of times weaker than the attack, and
+  that ratio would otherwise multiply its noise into the frames and drop the beam's faint outskirts, which the
+  ``halo_power_law`` then stood in for with its exponent at the bound (measured on the independent simulator).
 
 ``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
@@ -75,6 +80,63 @@ def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tens
     return pattern.reshape(3, -1)[:, outer].median(dim=1).values
 
 
+# the capture's noise is estimated, and removed, on the scale of a few pixels: a beam profile is smooth there
+BEAM_SMOOTHING_PX = 1.0
+# a value counts as laser light when it stands this many noise deviations above the capture's dark level
+NOISE_FLOOR_SIGMAS = 3.0
+# the beam's edge whose fall-off is continued below the noise floor: measured light between these many floors
+# (from twice the floor: pixels just above it are the ones noise lifted there, a fall-off read from them is too flat)
+EDGE_FLOORS = (2.0, 16.0)
+
+
+def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
+    """The laser's beam profile as the capture measured it, without the capture's noise (encoded values).
+
+    The capture records the beam plus its own dark noise (photon noise of the dark room's light, read noise, 8-bit
+    steps, compression). Only the beam grows with the laser's power: read as laser light and scaled by the power
+    ratio between the frames and the capture (tens, for a beam-profile exposure), the noise would be amplified
+    into the frames too. So the capture is smoothed over ``BEAM_SMOOTHING_PX`` (a beam profile varies slowly on
+    that scale, pixel noise does not), and values within ``NOISE_FLOOR_SIGMAS`` noise deviations of the dark level
+    (the robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read
+    as measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
+    the frames far around the spot. There it is continued with the fall-off of its measured edge (light
+    ``EDGE_FLOORS`` floors above the dark level): a Gaussian in the distance from the spot, ``exp(a - r^2 /
+    (2 s^2))``, fitted in linear light (sRGB) per channel and capped at the floor. A power-law glare beyond that
+    is the halo's to model."""
+    _, height, width = pattern.shape
+    smooth = torch.from_numpy(
+        ndimage.gaussian_filter(
+            pattern.numpy(), sigma=(0, BEAM_SMOOTHING_PX, BEAM_SMOOTHING_PX), mode="nearest"
+        )
+    )
+    ys, xs = torch.meshgrid(
+        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
+    )
+    radius = torch.hypot(xs - centre[0], ys - centre[1])
+    flat_radius = radius.reshape(-1)
+    # pixel noise: the robust spread of the capture about its smoothed self in the outer half (a smooth beam
+    # there, whether faint or bright, leaves only the noise)
+    detail = (pattern - smooth).reshape(3, -1)[:, flat_radius >= flat_radius.median()]
+    spread = 1.4826 * (detail - detail.median(dim=1, keepdim=True).values).abs().median(dim=1).values
+    noise = torch.sqrt(spread**2 + 1.0 / (12.0 * 255.0**2))
+    dark_linear = physics.srgb_to_linear(dark).reshape(3, 1, 1)
+    light = physics.srgb_to_linear(smooth) - dark_linear
+    floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise).reshape(3, 1, 1) - dark_linear
+    measured = light > floor
+    beam = torch.where(measured, light, torch.zeros_like(light))
+    for c in range(3):
+        low, high = EDGE_FLOORS[0] * floor[c], EDGE_FLOORS[1] * floor[c]
+        edge = (light[c] > low) & (light[c] < high) & (smooth[c] < SATURATED)
+        if int(edge.sum()) < 6:
+            continue
+        r2 = radius[edge] ** 2
+        slope, offset = np.polyfit(r2.numpy(), torch.log(light[c][edge]).numpy(), 1)
+        if slope < 0.0:
+            tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[c]))
+            beam[c] = torch.where(measured[c], beam[c], tail)
+    return physics.linear_to_srgb(beam + dark_linear)
+
+
 def saturated_depth(pattern: torch.Tensor) -> torch.Tensor:
     """(3, H, W): per channel, the distance (working pixels) from each saturated pixel of the capture to the
     nearest unsaturated one (0 outside the saturated area)."""
@@ -113,6 +175,10 @@ class BlindingFrames(PixelProblem):
         super().__init__(pairs, seed)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
         self.dark_levels = [dark_level(p.pattern, c) for p, c in zip(pairs, self.centres, strict=True)]
+        self.beams = [
+            beam_profile(p.pattern, d, c)
+            for p, d, c in zip(pairs, self.dark_levels, self.centres, strict=True)
+        ]
         self.core_depths = [saturated_depth(p.pattern) * p.to_reference for p in pairs]
         # equivalent radius (reference pixels) of each channel's saturated area
         self.core_radii = [
@@ -152,6 +218,7 @@ class BlindingFrames(PixelProblem):
         return {
             "scene": flat_pixels(pair.clean, pixels),
             "pattern": flat_pixels(pair.pattern, pixels),
+            "beam": flat_pixels(self.beams[index], pixels),
             "dark": self.dark_levels[index].reshape(1, 3).expand(n, 3),
             "core_depth": flat_pixels(self.core_depths[index], pixels),
             "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
@@ -205,7 +272,7 @@ class BlindingFrames(PixelProblem):
         s = f["strength"]
         if "linear_light_saturation" in effects:
             laser = laser_irradiance(
-                physics.decode(f["pattern"], gamma),
+                physics.decode(f["beam"], gamma),
                 physics.decode(f["dark"], gamma),
                 f["core_depth"],
                 f["core_radius"],

@@ -1,0 +1,67 @@
+"""The laser's beam profile read from a noisy capture (``frame_models.laser_blinding.beam_profile``).
+
+A capture of the laser alone holds the beam plus the capture's own dark noise. Scaled by the power ratio between
+the blinded frames and the capture, the noise must not be scaled with it, and the beam's light below the capture's
+noise floor must not be lost (at tens of times the capture's power it lights the frame far around the spot).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import torch
+
+from lerobot_phantom.calibration.frame_models.laser_blinding import beam_profile, dark_level, pattern_centre
+from lerobot_phantom.transforms import physics
+
+HEIGHT, WIDTH = 48, 64
+CENTRE = (30.0, 22.0)  # (x, y)
+DARK = 0.006  # linear light of the dark room
+BLOOM_SIGMA = 8.0
+
+
+def beam(radius: np.ndarray) -> np.ndarray:
+    """Linear light of a beam with a Gaussian core and a wider Gaussian bloom, 0.7 of the full well at its peak."""
+    return 0.7 * (np.exp(-(radius**2) / (2 * 3.0**2)) + 0.15 * np.exp(-(radius**2) / (2 * BLOOM_SIGMA**2)))
+
+
+def capture(rng: np.random.Generator, noise: float) -> tuple[torch.Tensor, np.ndarray]:
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH].astype(float)
+    radius = np.hypot(xs - CENTRE[0], ys - CENTRE[1])
+    light = beam(radius)[None] * np.array([0.1, 1.0, 0.2])[:, None, None] + DARK
+    noisy = np.clip(light + rng.normal(0.0, noise, light.shape), 0.0, 1.0)
+    encoded = np.round(physics.linear_to_srgb(torch.from_numpy(noisy)).numpy() * 255) / 255
+    return torch.from_numpy(encoded), radius
+
+
+def read_beam(pattern: torch.Tensor) -> np.ndarray:
+    """Green channel of the read beam profile, linear light above the dark level."""
+    centre = pattern_centre(pattern)
+    dark = dark_level(pattern, centre)
+    profile = beam_profile(pattern, dark, centre)
+    return (physics.srgb_to_linear(profile) - physics.srgb_to_linear(dark).reshape(3, 1, 1))[1].numpy()
+
+
+def test_capture_noise_is_not_read_as_laser_light():
+    pattern, radius = capture(np.random.default_rng(3), noise=6e-4)
+    far = radius > 35  # the beam is below 1e-5 of the full well there: what the capture holds is noise
+    raw = physics.srgb_to_linear(pattern)[1].numpy() - physics.srgb_to_linear(pattern)[1].numpy()[far].mean()
+    read = read_beam(pattern)
+    # scaled by a power ratio of 50, the raw capture's noise would be 50 x its spread in the blinded frame
+    assert read[far].std() < 0.2 * raw[far].std()
+    assert np.abs(read[far]).max() < 3 * 6e-4
+
+
+def test_beam_is_continued_below_the_noise_floor():
+    pattern, radius = capture(np.random.default_rng(4), noise=6e-4)
+    read = read_beam(pattern)
+    true = beam(radius)
+    # where the beam has sunk to 0.5-1.5 times the capture's noise it cannot be read pixel by pixel; the read
+    # profile continues the measured fall-off: within a factor 2 of the truth on average, where a clamp at the
+    # dark level would hold 0 (or the noise's positive half)
+    below = (true > 0.5 * 6e-4) & (true < 1.5 * 6e-4)
+    assert below.sum() > 20
+    ratio = read[below].mean() / true[below].mean()
+    assert 0.5 < ratio < 2.0, ratio
+    # and the measured beam itself is kept where it stands well above the noise
+    bright = true > 0.05
+    assert np.allclose(read[bright], true[bright], rtol=0.15)
