@@ -65,3 +65,17 @@ def test_beam_is_continued_below_the_noise_floor():
     # and the measured beam itself is kept where it stands well above the noise
     bright = true > 0.05
     assert np.allclose(read[bright], true[bright], rtol=0.15)
+
+
+def test_a_channel_without_a_measurable_edge_is_named_not_skipped_silently(caplog):
+    pattern, radius = capture(np.random.default_rng(5), noise=6e-4)
+    # the blue channel holds only the dark room: no beam, so no edge to continue below the floor
+    pattern[2] = physics.linear_to_srgb(torch.full_like(pattern[2], DARK))
+    centre = pattern_centre(pattern)
+    with caplog.at_level("WARNING", logger="lerobot_phantom.calibration.frame_models.laser_blinding"):
+        profile = beam_profile(pattern, dark_level(pattern, centre), centre)
+    warned = [record.getMessage() for record in caplog.records]
+    assert any("channel 2" in message for message in warned), warned
+    assert not any("channel 1" in message for message in warned), warned
+    # the dark channel reads as no laser light at all
+    assert torch.allclose(profile[2], pattern[2], atol=1e-6)

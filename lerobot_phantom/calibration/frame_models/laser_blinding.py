@@ -28,13 +28,17 @@ average, as centre-weighted meters do when the spot is central).
 
 from __future__ import annotations
 
+import logging
+
 import numpy as np
 import torch
-from scipy import ndimage
+from scipy import ndimage, stats
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, Pair, PixelProblem, flat_pixels
 from lerobot_phantom.transforms import physics
+
+logger = logging.getLogger(__name__)
 
 BLINDING_EFFECTS = (
     Effect(
@@ -87,6 +91,8 @@ NOISE_FLOOR_SIGMAS = 3.0
 # the beam's edge whose fall-off is continued below the noise floor: measured light between these many floors
 # (from twice the floor: pixels just above it are the ones noise lifted there, a fall-off read from them is too flat)
 EDGE_FLOORS = (2.0, 16.0)
+# fewest edge pixels a fall-off is fitted to (a line through log light vs r^2 from fewer is noise)
+MIN_EDGE_PIXELS = 6
 
 
 def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
@@ -117,7 +123,7 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     # pixel noise: the robust spread of the capture about its smoothed self in the outer half (a smooth beam
     # there, whether faint or bright, leaves only the noise)
     detail = (pattern - smooth).reshape(3, -1)[:, flat_radius >= flat_radius.median()]
-    spread = 1.4826 * (detail - detail.median(dim=1, keepdim=True).values).abs().median(dim=1).values
+    spread = torch.from_numpy(stats.median_abs_deviation(detail.numpy(), axis=1, scale="normal"))
     noise = torch.sqrt(spread**2 + 1.0 / (12.0 * 255.0**2))
     dark_linear = physics.srgb_to_linear(dark).reshape(3, 1, 1)
     light = physics.srgb_to_linear(smooth) - dark_linear
@@ -127,13 +133,27 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     for c in range(3):
         low, high = EDGE_FLOORS[0] * floor[c], EDGE_FLOORS[1] * floor[c]
         edge = (light[c] > low) & (light[c] < high) & (smooth[c] < SATURATED)
-        if int(edge.sum()) < 6:
+        if int(edge.sum()) < MIN_EDGE_PIXELS:
+            logger.warning(
+                "laser capture channel %d: %d pixels on the beam's edge (fewer than %d), so the beam is not continued "
+                "below the noise floor; the frames see no laser light there",
+                c,
+                int(edge.sum()),
+                MIN_EDGE_PIXELS,
+            )
             continue
         r2 = radius[edge] ** 2
         slope, offset = np.polyfit(r2.numpy(), torch.log(light[c][edge]).numpy(), 1)
-        if slope < 0.0:
-            tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[c]))
-            beam[c] = torch.where(measured[c], beam[c], tail)
+        if slope >= 0.0:
+            logger.warning(
+                "laser capture channel %d: its edge does not fall off with distance from the spot (slope %.3g), so "
+                "the beam is not continued below the noise floor",
+                c,
+                slope,
+            )
+            continue
+        tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[c]))
+        beam[c] = torch.where(measured[c], beam[c], tail)
     return physics.linear_to_srgb(beam + dark_linear)
 
 
