@@ -220,7 +220,12 @@ class Study:
         record = record or {"wall_s": 0.0, "runs": []}
         record.update(status="running", fingerprint=fp, argv=stage.argv, output=stage.output)
         record.update(log=f"logs/{stage.name}.log", depends=list(stage.depends))
-        record["runs"] = [*record["runs"], {"argv": argv, "action": decision}]
+        # a study resumed from another checkout runs its later stages with other code: each run names its own
+        run = {"argv": argv, "action": decision, "git_commit": self.manifest["git_commit"]}
+        record["runs"] = [
+            *record["runs"],
+            {**run, "started": datetime.now(UTC).isoformat(timespec="seconds")},
+        ]
         self.records[stage.name] = record
         self.save()
         started = time.time()

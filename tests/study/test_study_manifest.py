@@ -77,6 +77,9 @@ def test_manifest_records_every_stage_and_maps_roles_to_relative_eval_files(micr
         assert record["argv"][0].startswith("lerobot-phantom-")
         assert record["wall_s"] >= 0 and len(record["fingerprint"]) == 16
         assert (micro_dir(micro) / record["log"]).is_file()
+        # each run of a stage names the code that ran it (a resumed study may span commits)
+        assert [run["git_commit"] for run in record["runs"]] == [manifest["git_commit"]]
+        assert record["runs"][0]["started"] >= manifest["started"]
     assert manifest["results"] == {
         "before": "sweeps/before/eval.json",
         "after": "sweeps/after/eval.json",
