@@ -17,7 +17,7 @@ from typing import Any
 
 import lerobot_phantom
 from lerobot_phantom.envs.suites import SUITES
-from lerobot_phantom.eval.report import ATTACK_TITLES
+from lerobot_phantom.eval.tables import ATTACK_TITLES
 from lerobot_phantom.study.config import StudyConfig
 from lerobot_phantom.transforms.calibrated import calibrated_options, calibration_set
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS

@@ -68,7 +68,7 @@ def test_beam_is_continued_below_the_noise_floor():
 
 
 def test_a_channel_without_a_measurable_edge_is_named_not_skipped_silently(caplog):
-    pattern, radius = capture(np.random.default_rng(5), noise=6e-4)
+    pattern, _ = capture(np.random.default_rng(5), noise=6e-4)
     # the blue channel holds only the dark room: no beam, so no edge to continue below the floor
     pattern[2] = physics.linear_to_srgb(torch.full_like(pattern[2], DARK))
     centre = pattern_centre(pattern)

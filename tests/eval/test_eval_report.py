@@ -5,8 +5,6 @@ import json
 import pytest
 
 from lerobot_phantom.eval.report import (
-    ABBREVIATIONS,
-    ATTACK_TITLES,
     BEFORE_AFTER_NOTE,
     INTERVAL,
     ROBUSTNESS_NOTE,
@@ -18,6 +16,7 @@ from lerobot_phantom.eval.report import (
     tsr_figure,
 )
 from lerobot_phantom.eval.results import EVAL_FORMAT, pooled_summary, summarize
+from lerobot_phantom.eval.tables import ABBREVIATIONS, ATTACK_TITLES
 
 SEEDS = [0, 1, 2, 3, 4, 5]
 BASE = {
