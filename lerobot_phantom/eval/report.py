@@ -11,6 +11,9 @@
   McNemar test on matched episodes (same suite, task and env seed); pairs whose seeds, env or conditions do not
   match are refused. Several pairs (e.g. AT vs before and AT vs a clean-training control) get one column group
   each, labelled "<after> vs <before>".
+* ``level_costs.{md,csv,tex}`` / ``level_changes.{md,csv,tex}``: the camera attacks averaged per level (weak, medium,
+  strong), paired per episode, with bootstrap intervals: their mean cost per run, and per before/after pair the change
+  with the share of the loss won back (``level_costs.csv``, ``level_changes_tests.csv`` hold every number).
 * ``tsr_vs_intensity.png`` (TSR against intensity per attack, voice attacks as clean vs on, Wilson bands) and
   ``before_after_heatmap.png``.
 * ``summary.md``: the largest drops under attack and the largest gains/losses after training (every condition tied
@@ -27,6 +30,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from lerobot_phantom.eval.level_effects import level_changes, level_costs
 from lerobot_phantom.eval.results import CLEAN, EVAL_FILENAME, EVAL_FORMAT, episode_task
 from lerobot_phantom.eval.stats import PairedTest, mcnemar_exact, wilson_interval
 from lerobot_phantom.eval.tables import (
@@ -640,6 +644,9 @@ def make_report(
         writer.table("robustness", robustness_table(runs))
         results = results_rows(runs)
         writer.records("results.csv", results)
+        table, costs = level_costs(runs)
+        writer.table("level_costs", table)
+        writer.records("level_costs.csv", costs)
         if any(len({c[2] for c in task_columns([run])}) > 1 for run in runs):
             table, per_task = per_task_table(runs)
             writer.table("per_task", table)
@@ -651,6 +658,9 @@ def make_report(
         table, changes = before_after(pairs)
         writer.table("before_after", table)
         writer.records("before_after_tests.csv", changes)
+        table, level_records = level_changes(pairs)
+        writer.table("level_changes", table)
+        writer.records("level_changes_tests.csv", level_records)
         if figures:
             writer.figure("before_after_heatmap.png", plot_before_after, changes)
     deviations: list[dict[str, Any]] = []
