@@ -29,7 +29,7 @@ RESAMPLES = 10_000
 BOOTSTRAP_SEED = 0
 COST_NOTE = (
     "Cells: mean drop of task success rate (TSR) from clean to attacked, in percentage points (pp), averaged over the "
-    f"camera attacks evaluated at that level (their number in the CSV), with its {INTERVAL}. The clean row is TSR %."
+    f"camera attacks evaluated at that level (all six unless the cell names fewer), with its {INTERVAL}. The clean row is TSR %."
 )
 CHANGE_NOTE = (
     "Cells: paired change after - before of the TSR averaged over the level's camera attacks, in pp with its "
@@ -83,6 +83,11 @@ def per_episode_level_tsr(run: EvalRun, suite: str, keys: list) -> dict[str, tup
     return out
 
 
+def attack_count(n_attacks: int) -> str:
+    """Marks an average over fewer than all camera attacks (a leave-one-out or calibrated-physics sweep)."""
+    return "" if n_attacks == len(CAMERA_ATTACKS) else f" ({n_attacks} of {len(CAMERA_ATTACKS)} attacks)"
+
+
 def pp_cell(mean: float, low: float, high: float) -> str:
     return f"{100 * mean:+.1f} [{100 * low:+.1f}, {100 * high:+.1f}]"
 
@@ -109,7 +114,7 @@ def level_costs(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
                     continue
                 attacked, n_attacks = tsr[level]
                 mean, low, high = mean_interval(clean - attacked)
-                cells[level].append(pp_cell(mean, low, high))
+                cells[level].append(pp_cell(mean, low, high) + attack_count(n_attacks))
                 records.append(
                     {
                         "run": run.label,
@@ -156,6 +161,7 @@ def level_changes(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dic
                 cell = pp_cell(mean, low, high)
                 if level != CLEAN:
                     cell += f" of {100 * drop:.1f}" + (f" ({100 * share:.0f}%)" if share is not None else "")
+                    cell += attack_count(n_before)
                 cells[level].append(cell)
                 records.append(
                     {

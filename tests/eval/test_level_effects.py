@@ -72,6 +72,9 @@ def test_mean_cost_is_the_paired_per_episode_average_with_an_interval_over_episo
     rows = dict(table.rows)
     assert rows["camera attacks, weak"] == ["-"]
     assert rows["camera attacks, strong"][0].startswith(f"{100 * by_level['strong']['drop']:+.1f} [")
+    assert rows["camera attacks, strong"][0].endswith(
+        "(3 of 6 attacks)"
+    )  # an average over fewer than all six
 
 
 def test_change_and_share_won_back_against_the_drop_before(tmp_path):
@@ -97,7 +100,9 @@ def test_change_and_share_won_back_against_the_drop_before(tmp_path):
     assert medium["drop_before"] == pytest.approx(drop) and drop > 0.4
     assert medium["change"] == pytest.approx(drop)  # the whole loss won back
     assert medium["share_recovered"] == pytest.approx(1.0)
-    assert dict(table.rows)["camera attacks, medium"][0].endswith(f"of {100 * drop:.1f} (100%)")
+    assert dict(table.rows)["camera attacks, medium"][0].endswith(
+        f"of {100 * drop:.1f} (100%) (3 of 6 attacks)"
+    )
 
 
 def test_identical_policies_change_nothing(tmp_path):
