@@ -92,6 +92,10 @@ def pp_cell(mean: float, low: float, high: float) -> str:
     return f"{100 * mean:+.1f} [{100 * low:+.1f}, {100 * high:+.1f}]"
 
 
+def level_rows(cells: dict[str, list[str]]) -> list[tuple[str, list[str]]]:
+    return [(CLEAN, cells[CLEAN])] + [(f"camera attacks, {level}", cells[level]) for level in LEVELS]
+
+
 def level_costs(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
     """Rows clean + levels, one column per run x suite: the mean cost of the camera attacks with its interval."""
     groups, columns, records = [], [], []
@@ -122,15 +126,11 @@ def level_costs(runs: list[EvalRun]) -> tuple[Table, list[dict[str, Any]]]:
                         "level": level,
                         "attacks": n_attacks,
                         "episodes": len(keys),
-                        "clean_tsr": float(clean.mean()),
-                        "attacked_tsr": float(attacked.mean()),
-                        "drop": mean,
-                        "ci_low": low,
-                        "ci_high": high,
                     }
+                    | {"clean_tsr": float(clean.mean()), "attacked_tsr": float(attacked.mean())}
+                    | {"drop": mean, "ci_low": low, "ci_high": high}
                 )
-    rows = [(CLEAN, cells[CLEAN])] + [(f"camera attacks, {level}", cells[level]) for level in LEVELS]
-    table = Table(groups=groups, columns=columns, rows=rows, corner="Level", notes=(COST_NOTE,), unit="pp")
+    table = Table(groups, columns, level_rows(cells), corner="Level", notes=(COST_NOTE,), unit="pp")
     return table, records
 
 
@@ -164,25 +164,13 @@ def level_changes(pairs: list[tuple[EvalRun, EvalRun]]) -> tuple[Table, list[dic
                     cell += attack_count(n_before)
                 cells[level].append(cell)
                 records.append(
-                    {
-                        "before": before.label,
-                        "after": after.label,
-                        "suite": suite,
-                        "level": level,
-                        "attacks": n_before,
-                        "episodes": len(keys),
-                        "tsr_before": float(b.mean()),
-                        "tsr_after": float(a.mean()),
-                        "change": mean,
-                        "ci_low": low,
-                        "ci_high": high,
-                        "drop_before": None if level == CLEAN else drop,
-                        "share_recovered": share,
-                    }
+                    {"before": before.label, "after": after.label, "suite": suite, "level": level}
+                    | {"attacks": n_before, "episodes": len(keys), "tsr_before": float(b.mean())}
+                    | {"tsr_after": float(a.mean()), "change": mean, "ci_low": low, "ci_high": high}
+                    | {"drop_before": None if level == CLEAN else drop, "share_recovered": share}
                 )
-    rows = [(CLEAN, cells[CLEAN])] + [(f"camera attacks, {level}", cells[level]) for level in LEVELS]
     compared = "; ".join(f"before = {b.label}, after = {a.label}" for b, a in pairs)
     table = Table(
-        groups=groups, columns=columns, rows=rows, corner="Level", notes=(CHANGE_NOTE, compared), unit="pp"
+        groups, columns, level_rows(cells), corner="Level", notes=(CHANGE_NOTE, compared), unit="pp"
     )
     return table, records
