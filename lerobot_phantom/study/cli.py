@@ -221,11 +221,14 @@ class Study:
         record.update(status="running", fingerprint=fp, argv=stage.argv, output=stage.output)
         record.update(log=f"logs/{stage.name}.log", depends=list(stage.depends))
         # a study resumed from another checkout runs its later stages with other code: each run names its own
-        run = {"argv": argv, "action": decision, "git_commit": self.manifest["git_commit"]}
-        record["runs"] = [
-            *record["runs"],
-            {**run, "started": datetime.now(UTC).isoformat(timespec="seconds")},
-        ]
+        started_at = datetime.now(UTC).isoformat(timespec="seconds")
+        run = {
+            "argv": argv,
+            "action": decision,
+            "git_commit": self.manifest["git_commit"],
+            "started": started_at,
+        }
+        record["runs"] = [*record["runs"], run]
         self.records[stage.name] = record
         self.save()
         started = time.time()
