@@ -1,7 +1,8 @@
 """lerobot-phantom-collect: record scripted-expert demonstrations as a LeRobotDataset v3.
 
     lerobot-phantom-collect --suite goal --episodes 100 --repo-id local/phantom_goal --root DIR \\
-        [--video] [--seed 0] [--overwrite] [--task-id K] [--image-size 96] [--action-noise 0.3]
+        [--video] [--seed 0] [--overwrite] [--task-id K] [--image-size 96] [--action-noise 0.3] \\
+        [--grasp-miss-rate 0.5]
 
 Episodes cycle round-robin over the selected (suite, task) pairs, so ``--episodes`` is the total count and every
 task gets an equal share; ``--suite all`` cycles over every task of every suite (interleaving the suites) into one
@@ -10,6 +11,12 @@ discarded attempts is reported). Episode seeds are drawn from ``numpy.random.def
 ``--seed`` always produces the same dataset. Features: ``observation.images.front`` / ``observation.images.wrist``
 (images, or AV1 videos with ``--video``), ``observation.state`` (TCP xyz + finger opening), ``action``
 (normalised [dx, dy, dz, grip]); the task string is the instruction.
+
+``--grasp-miss-rate P`` makes a share P of the episodes miss their first grasp on purpose: the executed approach aims
+``--grasp-miss-min-m``..``--grasp-miss-max-m`` off the object in xy (beyond the env's grasp tolerance by default),
+closes on nothing, and the expert re-opens and grasps again. The recorded action stays the unshifted expert's at every
+step, so the data holds what relative action noise cannot give: frames near the object but centimetres off, labelled
+with the correction, and the recovery from a close on nothing.
 """
 
 from __future__ import annotations
@@ -24,7 +31,7 @@ import numpy as np
 from tqdm import tqdm
 
 from lerobot_phantom._cli import normalize_argv as normalize_cli_argv
-from lerobot_phantom.envs.interface import ACTION_NAMES, CAMERAS, CONTROL_HZ, STATE_NAMES
+from lerobot_phantom.envs.interface import ACTION_NAMES, CAMERAS, CONTROL_HZ, GRASP_XY_TOL, STATE_NAMES
 from lerobot_phantom.envs.suites import SUITE_NAMES, SUITES
 
 ALL_SUITES = "all"
@@ -43,6 +50,11 @@ class CollectConfig:
     action_noise: float = (
         0.0  # relative std of noise on the executed (not the recorded) motion; 0.3 is a good start
     )
+    grasp_miss_rate: float = 0.0  # share of episodes whose first grasp is aimed off the object on purpose
+    grasp_miss_min_m: float = (
+        GRASP_XY_TOL + 0.002
+    )  # xy distance of the missed grasp from the object, drawn uniformly
+    grasp_miss_max_m: float = 0.04
     image_size: int = 96
     vcodec: str = "libsvtav1"
     image_writer_threads: int = 2  # PNG writing overlaps the simulation; 2 threads suit a 2-core machine
@@ -97,20 +109,43 @@ def dataset_features(image_size: int, video: bool) -> dict:
     }
 
 
+def grasp_miss_offset(rng: np.random.Generator, rate: float, min_m: float, max_m: float) -> np.ndarray | None:
+    """The xy offset of an episode's deliberately missed first grasp, or None (probability ``1 - rate``)."""
+    if rate <= 0.0 or rng.random() >= rate:
+        return None
+    angle = rng.uniform(0.0, 2.0 * np.pi)
+    return rng.uniform(min_m, max_m) * np.array([np.cos(angle), np.sin(angle)])
+
+
 def _record_episode(
-    env, expert, seed: int, task_id: int, dataset, action_noise: float = 0.0
+    env,
+    expert,
+    seed: int,
+    task_id: int,
+    dataset,
+    action_noise: float = 0.0,
+    miss_offset: np.ndarray | None = None,
 ) -> tuple[bool, int]:
     """Roll the expert out once, adding every frame to the dataset's episode buffer; returns (success, frames).
 
     With ``action_noise`` the executed motion is perturbed (each axis scaled by ``1 + N(0, action_noise)``) while
     the recorded action stays the expert's, so the data shows how to recover from small drifts (DART-style).
+    With ``miss_offset`` (xy, metres) the executed motion aims the first grasp that far off the object until the
+    gripper closes; the recorded action stays the unshifted expert's.
     """
     obs, info = env.reset(seed=seed, options={"task_id": task_id})
     noise_rng = np.random.default_rng(seed)
     language = env.task_description
     for step in range(env.max_episode_steps):
         action = np.asarray(expert(obs), dtype=np.float32)
-        executed = action.copy()
+        if miss_offset is not None and env.gripper_closed:
+            miss_offset = (
+                None  # the aimed-off close happened: from here on the expert executes its own actions
+            )
+        if miss_offset is None:
+            executed = action.copy()
+        else:
+            executed = np.asarray(expert(obs, aim_offset=miss_offset), dtype=np.float32)
         if action_noise > 0:
             # Relative noise: large during transit, vanishing as the expert homes in, so it still converges.
             executed[:3] = np.clip(
@@ -142,6 +177,15 @@ def collect(cfg: CollectConfig) -> CollectResult:
         raise ValueError("--episodes must be at least 1")
     if not 0.0 <= cfg.action_noise <= 1.0:
         raise ValueError(f"--action-noise must be in [0, 1] (relative std), got {cfg.action_noise}")
+    if not 0.0 <= cfg.grasp_miss_rate <= 1.0:
+        raise ValueError(
+            f"--grasp-miss-rate must be in [0, 1] (a share of episodes), got {cfg.grasp_miss_rate}"
+        )
+    if not 0.0 < cfg.grasp_miss_min_m <= cfg.grasp_miss_max_m:
+        raise ValueError(
+            "--grasp-miss-min-m and --grasp-miss-max-m must satisfy 0 < min <= max (metres), got "
+            f"{cfg.grasp_miss_min_m} and {cfg.grasp_miss_max_m}"
+        )
     plan = _task_plan(cfg)
     repo_id = cfg.repo_id or f"local/phantom_{cfg.suite}"
     root = Path(cfg.root) if cfg.root is not None else HF_LEROBOT_HOME / repo_id
@@ -178,8 +222,15 @@ def collect(cfg: CollectConfig) -> CollectResult:
                 env, expert = envs[suite]
                 while True:
                     episode_seed = int(rng.integers(2**31 - 1))
+                    # its own stream, so that a dataset without misses is the one collected before they existed
+                    miss_offset = grasp_miss_offset(
+                        np.random.default_rng([episode_seed, 1]),
+                        cfg.grasp_miss_rate,
+                        cfg.grasp_miss_min_m,
+                        cfg.grasp_miss_max_m,
+                    )
                     success, length = _record_episode(
-                        env, expert, episode_seed, task_id, dataset, cfg.action_noise
+                        env, expert, episode_seed, task_id, dataset, cfg.action_noise, miss_offset
                     )
                     if success:
                         break

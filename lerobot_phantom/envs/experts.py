@@ -3,6 +3,8 @@
 The expert re-plans from the current state at every step (which object is held, where everything is), so it
 recovers from small perturbations: for each unmet goal in order it moves above the object at a safe travel height,
 descends, closes, lifts, carries the object above the target, descends to just above the support and opens.
+``aim_offset`` shifts the grasp point in xy, which lets a recorder execute a deliberate miss while it records the
+unshifted expert's actions as labels.
 """
 
 from __future__ import annotations
@@ -50,7 +52,7 @@ class ScriptedExpert:
             return self._action(np.array([*goal_xy, goal_z]), close)
         return None
 
-    def __call__(self, observation=None) -> np.ndarray:
+    def __call__(self, observation=None, aim_offset: np.ndarray | None = None) -> np.ndarray:
         env = self.env
         for relation, obj, target in env.goals():
             if env.goal_holds(relation, obj, target):
@@ -69,6 +71,8 @@ class ScriptedExpert:
             if env.gripper_closed:
                 return self._action(None, close=False)  # closed on nothing: re-open before grasping
             obj_pos = env.position(obj)
+            if aim_offset is not None:
+                obj_pos[:2] += aim_offset
             action = self._go_via_travel_height(obj_pos[:2], float(obj_pos[2]), close=False)
             return self._action(None, close=True) if action is None else action
         # Every goal holds (the env terminates on that); stay put with the gripper open.

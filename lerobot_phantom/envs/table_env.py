@@ -23,7 +23,15 @@ import gymnasium as gym
 import numpy as np
 from gymnasium import spaces
 
-from lerobot_phantom.envs.interface import ACTION_DIM, CAMERAS, CONTROL_HZ, MAX_STEP_M, OBS_TYPES
+from lerobot_phantom.envs.interface import (
+    ACTION_DIM,
+    CAMERAS,
+    CONTROL_HZ,
+    GRASP_XY_TOL,
+    GRASP_Z_TOL,
+    MAX_STEP_M,
+    OBS_TYPES,
+)
 from lerobot_phantom.envs.rendering import select_gl_backend
 from lerobot_phantom.envs.scene import (
     BASKET_FLOOR_TOP,
@@ -45,8 +53,6 @@ PHYSICS_SUBSTEPS = 20  # 20 x 5 ms = one 100 ms control step
 TCP_LOW = np.array([-0.25, -0.3, 0.015])
 TCP_HIGH = np.array([0.25, 0.3, 0.25])
 HOME_TCP = np.array([-0.2, 0.0, 0.2])
-GRASP_XY_TOL = 0.02
-GRASP_Z_TOL = 0.02
 SETTLED_SPEED = 0.05  # m/s; a placed object must be at rest to count
 HEIGHT_TOL = 0.01
 

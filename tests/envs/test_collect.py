@@ -123,3 +123,75 @@ def test_action_noise_perturbs_execution_but_keeps_successful_expert_labels(goal
     assert set(np.unique(actions[:, 3])) <= {-1.0, 1.0}  # the recorded gripper command is the expert's
     with pytest.raises(ValueError, match="action-noise"):
         _collect(tmp_path / "bad", action_noise=2.0)
+
+
+class _FrameLog:
+    """Stands in for a LeRobotDataset's episode buffer: keeps the frames a recorder adds."""
+
+    def __init__(self):
+        self.frames = []
+
+    def add_frame(self, frame):
+        self.frames.append(frame)
+
+
+@pytest.mark.parametrize("task_id", [0, 2])
+def test_grasp_miss_closes_off_target_then_recovers_with_expert_labels(task_id):
+    from lerobot_phantom.envs import make_phantom_env, scripted_expert
+    from lerobot_phantom.envs.collect import _record_episode
+    from lerobot_phantom.envs.interface import GRASP_XY_TOL
+    from lerobot_phantom.envs.scene import FINGER_CLOSED_HALF_GAP
+
+    env = make_phantom_env("goal")
+    try:
+        offset = np.array([0.0, 0.03])
+        log = _FrameLog()
+        success, length = _record_episode(env, scripted_expert(env), 7, task_id, log, miss_offset=offset)
+        reference = _FrameLog()
+        _record_episode(env, scripted_expert(env), 7, task_id, reference)
+    finally:
+        env.close()
+    assert success and length == len(log.frames) > len(reference.frames)
+    states = np.stack([f["observation.state"] for f in log.frames])
+    labels = np.stack([f["action"] for f in log.frames])
+    # a frame with the fingers closed on nothing exists, and the label there re-opens the gripper
+    empty = np.flatnonzero(np.isclose(states[:, 3], 2 * FINGER_CLOSED_HALF_GAP))
+    assert empty.size >= 1 and labels[empty[0], 3] == -1.0
+    # the frame before it is where the close was executed: more than the grasp tolerance away from where the expert
+    # grasps (its own first close in the reference run); its label is the expert's there: gripper open, and the
+    # xy error is corrected the expert's way, up to the travel height first
+    reference_states = np.stack([f["observation.state"] for f in reference.frames])
+    reference_labels = np.stack([f["action"] for f in reference.frames])
+    grasp_xy = reference_states[np.flatnonzero(reference_labels[:, 3] > 0)[0], :2]
+    miss_xy = states[empty[0] - 1, :2]
+    assert np.linalg.norm(miss_xy - grasp_xy) > GRASP_XY_TOL
+    assert labels[empty[0] - 1, 3] == -1.0 and labels[empty[0] - 1, 2] > 0
+    assert set(np.unique(labels[:, 3])) <= {-1.0, 1.0}
+
+
+def test_grasp_miss_offsets_follow_rate_and_range(tmp_path):
+    from lerobot_phantom.envs.collect import grasp_miss_offset
+
+    rng = np.random.default_rng(0)
+    assert all(grasp_miss_offset(rng, 0.0, 0.02, 0.04) is None for _ in range(100))
+    drawn = [grasp_miss_offset(rng, 0.5, 0.022, 0.04) for _ in range(400)]
+    misses = [d for d in drawn if d is not None]
+    assert 160 < len(misses) < 240
+    norms = np.linalg.norm(misses, axis=1)
+    assert norms.min() >= 0.022 and norms.max() <= 0.04
+    with pytest.raises(ValueError, match="grasp-miss-rate"):
+        _collect(tmp_path / "bad", grasp_miss_rate=1.5)
+    with pytest.raises(ValueError, match="min <= max"):
+        _collect(tmp_path / "bad", grasp_miss_rate=0.5, grasp_miss_min_m=0.05, grasp_miss_max_m=0.03)
+    assert not (tmp_path / "bad").exists()
+
+
+def test_grasp_miss_episodes_are_collected(tmp_path):
+    result = _collect(tmp_path / "miss", seed=3, episodes=2, grasp_miss_rate=1.0)
+    states = np.asarray(
+        LeRobotDataset(REPO_ID, root=result.root).hf_dataset.with_format(None)["observation.state"]
+    )
+    assert result.episodes == 2 and result.failed_attempts == 0
+    from lerobot_phantom.envs.scene import FINGER_CLOSED_HALF_GAP
+
+    assert np.isclose(states[:, 3], 2 * FINGER_CLOSED_HALF_GAP).sum() >= 2
