@@ -113,3 +113,26 @@ def test_smolvla_lora_config_targets_vision_tower_connector_and_expert(tiny_vlm)
     assert any("connector" in n for n in matched)
     assert "model.vlm_with_expert.lm_expert.layers.0.self_attn.q_proj" in matched
     assert not any(".text_model." in n for n in matched)
+
+
+def test_make_vlm_patch_size_sets_the_image_token_grid(tmp_path):
+    import json
+
+    import torch
+    from transformers import AutoConfig, AutoProcessor, SmolVLMModel
+
+    path = make_vlm(tmp_path / "p8", "tiny", patch_size=8)
+    config = AutoConfig.from_pretrained(path)
+    assert config.vision_config.patch_size == 8
+    side = VLM_SIZES["tiny"]["image_size"] // 8 // 2  # the connector folds 2x2 patches into a token
+    assert AutoProcessor.from_pretrained(path).image_seq_len == side**2
+    assert json.loads((path / "phantom_vlm.json").read_text())["patch_size"] == 8
+    model = SmolVLMModel(config).eval()
+    size = VLM_SIZES["tiny"]["image_size"]
+    with torch.no_grad():
+        patches = model.vision_model(pixel_values=torch.zeros(1, 3, size, size)).last_hidden_state
+        tokens = model.connector(patches)
+    assert tokens.shape[1] == side**2  # 16 tokens per image instead of the 16 px patches' 4
+    with pytest.raises(ValueError, match=r"valid: 1, 2, 4, 8, 16, 32"):
+        make_vlm(tmp_path / "p5", "tiny", patch_size=5)
+    assert not (tmp_path / "p5").exists()
