@@ -23,6 +23,8 @@ class CollectSettings:
     suite: str = "goal"  # phantom_table suite: the demonstrations' tasks and the evaluated env
     episodes: int = 100  # scripted-expert demonstrations, round-robin over the suite's tasks
     action_noise: float = 0.3  # relative noise on the executed motion (recovery data)
+    # share of demonstrations that miss their first grasp on purpose and recover (docs/recipe, run G: 84% vs 50%)
+    grasp_miss_rate: float = 0.5
     image_size: int = 96  # camera resolution of the dataset and of the evaluated env
     seed: int = 0
     extra_args: tuple[str, ...] = ()  # further lerobot-phantom-collect flags

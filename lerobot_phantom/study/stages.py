@@ -209,6 +209,7 @@ class Planner:
             "--root=data/demos",
             f"--seed={c.seed}",
             f"--action-noise={c.action_noise}",
+            f"--grasp-miss-rate={c.grasp_miss_rate}",
             f"--image-size={c.image_size}",
             *c.extra_args,
         ]
