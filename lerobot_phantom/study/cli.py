@@ -20,8 +20,10 @@ import shlex
 import shutil
 import subprocess
 import sys
+import threading
 import time
 from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import asdict
 from datetime import UTC, datetime
 from pathlib import Path
@@ -157,6 +159,8 @@ class Study:
         self.cfg = cfg
         # runner(argv, study_dir, log, cfg) runs one command line; tests may pass their own.
         self.runner = runner or (run_in_process if cfg.in_process else run_subprocess)
+        # stages running side by side (--jobs) update the records and write the manifest one at a time
+        self.lock = threading.RLock()
         self.dir = Path(cfg.output_dir).resolve()
         self.stages = plan(cfg)
         self.fingerprints = fingerprints(self.stages)
@@ -214,32 +218,34 @@ class Study:
     def run_stage(self, stage: Stage, decision: str) -> None:
         fp = self.fingerprints[stage.name]
         argv = stage.resume_argv() if decision == RESUME else stage.argv
-        if decision == RUN:
-            clear(self.dir / stage.output)
-        record = self.records.get(stage.name) if decision == RESUME else None
-        record = record or {"wall_s": 0.0, "runs": []}
-        record.update(status="running", fingerprint=fp, argv=stage.argv, output=stage.output)
-        record.update(log=f"logs/{stage.name}.log", depends=list(stage.depends))
-        # a study resumed from another checkout runs its later stages with other code: each run names its own
-        started_at = datetime.now(UTC).isoformat(timespec="seconds")
-        run = {
-            "argv": argv,
-            "action": decision,
-            "git_commit": self.manifest["git_commit"],
-            "started": started_at,
-        }
-        record["runs"] = [*record["runs"], run]
-        self.records[stage.name] = record
-        self.save()
+        with self.lock:
+            if decision == RUN:
+                clear(self.dir / stage.output)
+            record = self.records.get(stage.name) if decision == RESUME else None
+            record = record or {"wall_s": 0.0, "runs": []}
+            record.update(status="running", fingerprint=fp, argv=stage.argv, output=stage.output)
+            record.update(log=f"logs/{stage.name}.log", depends=list(stage.depends))
+            # a study resumed from another checkout runs its later stages with other code: each run names its own
+            started_at = datetime.now(UTC).isoformat(timespec="seconds")
+            run = {
+                "argv": argv,
+                "action": decision,
+                "git_commit": self.manifest["git_commit"],
+                "started": started_at,
+            }
+            record["runs"] = [*record["runs"], run]
+            self.records[stage.name] = record
+            self.save()
         started = time.time()
         with open(self.dir / record["log"], "ab") as log:
             log.write(f"\n$ {shlex.join(argv)}\n".encode())
             log.flush()
             self.runner(argv, self.dir, log, self.cfg)
         wall = time.time() - started
-        record["runs"][-1]["wall_s"] = round(wall, 3)
-        record.update(status="done", wall_s=round(record["wall_s"] + wall, 3))
-        self.save()
+        with self.lock:
+            record["runs"][-1]["wall_s"] = round(wall, 3)
+            record.update(status="done", wall_s=round(record["wall_s"] + wall, 3))
+            self.save()
 
     def decisions(self) -> dict[str, str]:
         """What this invocation would do with each stage (--dry_run), assuming every stage that runs succeeds."""
@@ -251,23 +257,31 @@ class Study:
             )
         return out
 
+    def decide(self, stage: Stage, done: dict[str, str]) -> str:
+        """Skip, resume or run ``stage``, given what this invocation did with the stages before it."""
+        upstream_ran = any(done.get(d) in (RUN, RESUME) for d in stage.depends)
+        decision = decide(
+            stage, self.fingerprints[stage.name], self.records.get(stage.name), self.dir, upstream_ran
+        )
+        done[stage.name] = self.manifest["last_invocation"][stage.name] = decision
+        return decision
+
     def run(self) -> dict[str, Any]:
         started = time.time()
         (self.dir / "logs").mkdir(parents=True, exist_ok=True)
         (self.dir / CONFIG_FILE).write_text(json.dumps(asdict(self.cfg), indent=2))
-        done: dict[str, str] = {}
         progress = tqdm(self.stages, desc="study", unit="stage", disable=not self.cfg.verbose)
-        for stage in progress:
-            progress.set_postfix_str(stage.name)
-            upstream_ran = any(done.get(d) in (RUN, RESUME) for d in stage.depends)
-            decision = decide(
-                stage, self.fingerprints[stage.name], self.records.get(stage.name), self.dir, upstream_ran
-            )
-            done[stage.name] = self.manifest["last_invocation"][stage.name] = decision
-            if decision == SKIP:
-                self.save()
-                continue
-            self.run_stage(stage, decision)
+        if self.cfg.jobs > 1:
+            self.run_side_by_side(progress)
+        else:
+            done: dict[str, str] = {}
+            for stage in progress:
+                progress.set_postfix_str(stage.name)
+                decision = self.decide(stage, done)
+                if decision == SKIP:
+                    self.save()
+                    continue
+                self.run_stage(stage, decision)
         progress.close()
         # Records of stages no longer in the plan (e.g. an optional stage switched off) are kept but marked.
         for name, record in self.records.items():
@@ -275,6 +289,51 @@ class Study:
         self.manifest["wall_s"] = round(time.time() - started, 3)
         self.save()
         return self.manifest
+
+    def run_side_by_side(self, progress: tqdm) -> None:
+        """Up to ``jobs`` stages at once, each started (in plan order) once every stage it depends on has finished.
+
+        A failing stage stops new starts; the stages still running finish (and are recorded) before its error is
+        raised, so a second invocation resumes exactly what is missing."""
+        done: dict[str, str] = {}
+        finished: set[str] = set()
+        waiting = list(self.stages)
+        running: dict[Future, Stage] = {}
+        failure: BaseException | None = None
+        with ThreadPoolExecutor(max_workers=self.cfg.jobs) as pool:
+            while (waiting and failure is None) or running:
+                ready = [s for s in waiting if all(d in finished for d in s.depends)]
+                skipped = False
+                for stage in ready if failure is None else []:
+                    if len(running) >= self.cfg.jobs:
+                        break
+                    waiting.remove(stage)
+                    with self.lock:
+                        decision = self.decide(stage, done)
+                        if decision == SKIP:
+                            self.save()
+                    if decision == SKIP:
+                        finished.add(stage.name)
+                        progress.update()
+                        skipped = True
+                        continue
+                    running[pool.submit(self.run_stage, stage, decision)] = stage
+                if not running:
+                    if skipped:
+                        continue  # only skipped stages were ready: their dependants may be ready now
+                    blocked = {s.name: [d for d in s.depends if d not in finished] for s in waiting}
+                    raise RuntimeError(f"stages wait for stages that never finish: {blocked}")
+                completed, _ = wait(running, return_when=FIRST_COMPLETED)
+                for future in completed:
+                    stage = running.pop(future)
+                    if future.exception() is not None:
+                        failure = failure or future.exception()
+                        continue
+                    finished.add(stage.name)
+                    progress.update()
+                    progress.set_postfix_str(", ".join(s.name for s in running.values()))
+        if failure is not None:
+            raise failure
 
 
 CURSOR_UP = b"\x1b[A"  # what tqdm writes after a nested bar to return to the line above

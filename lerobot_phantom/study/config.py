@@ -122,6 +122,9 @@ class StudyConfig:
     beyond: BeyondSettings = field(default_factory=BeyondSettings)
     # Torch/OpenMP threads per stage process (one is fastest on a busy 2-core machine; issue 11).
     threads: int = 1
+    # Stages run at once, each as soon as the stages it depends on are done (2 on 2 cores: the AT and control
+    # trainings side by side, then their sweeps). Subprocesses only; 1 runs the stages one after another.
+    jobs: int = 1
     # Run each stage in this process instead of a subprocess (tests; the manifest's commands are the same).
     in_process: bool = False
     # Stream each stage's output (progress bars included) to the terminal as well as to logs/<stage>.log.
@@ -170,6 +173,12 @@ class StudyConfig:
             )
         if self.threads < 1:
             raise ValueError(f"--threads must be >= 1, got {self.threads}")
+        if self.jobs < 1:
+            raise ValueError(f"--jobs must be >= 1, got {self.jobs}")
+        if self.jobs > 1 and self.in_process:
+            raise ValueError(
+                "--jobs > 1 runs stages side by side as subprocesses; it cannot be combined with --in_process"
+            )
         if not 0.0 <= self.lora.rate <= 1.0:
             raise ValueError(f"--lora.rate must lie in [0, 1], got {self.lora.rate}")
         if self.vlm.size not in VLM_SIZES:

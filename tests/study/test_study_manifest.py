@@ -211,3 +211,73 @@ def test_publish_refuses_the_study_dir_and_a_foreign_non_empty_dir(micro, tmp_pa
     assert (foreign / "notes.txt").read_text() == "mine"
     with pytest.raises(FileNotFoundError, match="nothing to publish"):
         main([f"--output_dir={tmp_path / 'empty'}", f"--publish_to={tmp_path / 'out'}"])
+
+
+class TimedRunner(FakeRunner):
+    """FakeRunner that takes a moment per stage and records when each stage started and ended."""
+
+    def __init__(self, cfg, fail=None):
+        super().__init__(cfg, fail)
+        self.spans: dict[str, tuple[float, float]] = {}
+
+    def __call__(self, argv, study_dir, log, cfg):
+        import time
+
+        start = time.monotonic()
+        time.sleep(0.05)
+        try:
+            super().__call__(argv, study_dir, log, cfg)
+        finally:
+            self.spans[self.stage_of(argv).name] = (start, time.monotonic())
+
+
+def test_jobs_run_independent_stages_side_by_side_after_their_dependencies(micro):
+    sequential = run_study(micro, runner=FakeRunner(micro))
+    parallel_cfg = dataclasses.replace(micro, output_dir=micro.output_dir + "_jobs", jobs=2, in_process=False)
+    runner = TimedRunner(parallel_cfg)
+    manifest = run_study(parallel_cfg, runner=runner)
+    stages = plan(parallel_cfg)
+    assert set(runner.spans) == {s.name for s in stages}
+    assert {k: r["status"] for k, r in manifest["stages"].items()} == {
+        k: r["status"] for k, r in sequential["stages"].items()
+    }
+    assert manifest["results"] == sequential["results"]
+    for stage in stages:  # nothing starts before what it depends on has ended
+        for dependency in stage.depends:
+            assert runner.spans[dependency][1] <= runner.spans[stage.name][0], (dependency, stage.name)
+    before, at = runner.spans["sweep_before"], runner.spans["train_at"]
+    assert before[0] < at[1] and at[0] < before[1]  # both wait only for the selection: they ran side by side
+    assert (
+        max(  # never more than two at once
+            sum(1 for s, e in runner.spans.values() if s <= t < e) for t, _ in runner.spans.values()
+        )
+        <= 2
+    )
+    again = FakeRunner(parallel_cfg)
+    assert set(run_study(parallel_cfg, runner=again)["last_invocation"].values()) == {"skip"}
+    assert again.calls == []
+
+
+def test_jobs_a_failing_stage_lets_the_running_one_finish_then_resumes(micro):
+    cfg = dataclasses.replace(micro, jobs=2, in_process=False)
+    first = TimedRunner(cfg, fail="train_at")
+    with pytest.raises(KeyboardInterrupt):
+        run_study(cfg, runner=first)
+    manifest = json.loads((micro_dir(cfg) / MANIFEST).read_text())
+    assert manifest["stages"]["train_at"]["status"] == "running"
+    assert manifest["stages"]["sweep_before"]["status"] == "done"  # started beside it, finished and recorded
+    assert "sweep_after" not in manifest["stages"] and "report" not in manifest["stages"]
+    second = FakeRunner(cfg)
+    manifest = run_study(cfg, runner=second)
+    assert manifest["last_invocation"]["train_at"] == "resume"
+    assert manifest["last_invocation"]["sweep_before"] == "skip"
+    assert manifest["stages"]["report"]["status"] == "done"
+
+
+def test_jobs_must_be_positive_and_run_subprocesses(tmp_path):
+    from lerobot_phantom.study.config import StudyConfig
+
+    with pytest.raises(ValueError, match="--jobs must be >= 1"):
+        StudyConfig(output_dir=str(tmp_path), jobs=0)
+    with pytest.raises(ValueError, match="in_process"):
+        StudyConfig(output_dir=str(tmp_path), jobs=2, in_process=True)
