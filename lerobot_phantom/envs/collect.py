@@ -51,9 +51,8 @@ class CollectConfig:
         0.0  # relative std of noise on the executed (not the recorded) motion; 0.3 is a good start
     )
     grasp_miss_rate: float = 0.0  # share of episodes whose first grasp is aimed off the object on purpose
-    grasp_miss_min_m: float = (
-        GRASP_XY_TOL + 0.002
-    )  # xy distance of the missed grasp from the object, drawn uniformly
+    # xy distance of the missed grasp from the object, drawn uniformly between the two
+    grasp_miss_min_m: float = GRASP_XY_TOL + 0.002
     grasp_miss_max_m: float = 0.04
     image_size: int = 96
     vcodec: str = "libsvtav1"
@@ -138,7 +137,7 @@ def _record_episode(
     language = env.task_description
     for step in range(env.max_episode_steps):
         action = np.asarray(expert(obs), dtype=np.float32)
-        if miss_offset is not None and env.gripper_closed:
+        if env.gripper_closed:
             miss_offset = (
                 None  # the aimed-off close happened: from here on the expert executes its own actions
             )

@@ -122,8 +122,8 @@ class StudyConfig:
     beyond: BeyondSettings = field(default_factory=BeyondSettings)
     # Torch/OpenMP threads per stage process (one is fastest on a busy 2-core machine; issue 11).
     threads: int = 1
-    # Stages run at once, each as soon as the stages it depends on are done (2 on 2 cores: the AT and control
-    # trainings side by side, then their sweeps). Subprocesses only; 1 runs the stages one after another.
+    # Stages run at once, each as soon as the stages it depends on are done (2 on 2 cores: the before sweep beside
+    # the AT training, then the control training, then the after and control sweeps together). Subprocesses only.
     jobs: int = 1
     # Run each stage in this process instead of a subprocess (tests; the manifest's commands are the same).
     in_process: bool = False
