@@ -138,9 +138,8 @@ def _record_episode(
     for step in range(env.max_episode_steps):
         action = np.asarray(expert(obs), dtype=np.float32)
         if env.gripper_closed:
-            miss_offset = (
-                None  # the aimed-off close happened: from here on the expert executes its own actions
-            )
+            # the aimed-off close happened: from here on the expert executes its own actions
+            miss_offset = None
         if miss_offset is None:
             executed = action.copy()
         else:
