@@ -306,14 +306,17 @@ class StripeProblem(Problem):
             first.update({k: v for k, v in start.params.items() if k in first})
         grid = self.start_grid(specs, first)
         best = None
-        # every rule starts from the nested model's values and the grid's best point(s): three for a first fit
-        n_grid = 2 if start is not None and "frames" in start.extra else 3
+        # every rule starts from the nested model's values and the grid's best points of distinct row times (five
+        # for a first fit: neighbouring stripe-count regimes, e.g. a row time and its double, are separate minima)
+        n_grid = 2 if start is not None and "frames" in start.extra else 5
         for rule in self.frame_rules:
             with torch.no_grad():
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
                 sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
-            order = torch.argsort(torch.nan_to_num(sse, nan=float("inf")))
-            tries = [first] + [{k: float(v[i]) for k, v in grid.items()} for i in order[:n_grid].tolist()]
+            order = torch.argsort(torch.nan_to_num(sse, nan=float("inf"))).tolist()
+            tries = [first] + [
+                {k: float(v[i]) for k, v in grid.items()} for i in self.regime_starts(grid, order, n_grid)
+            ]
             for initial in tries:
                 params = fit_least_squares(
                     specs, lambda p, rule=rule: self.predict(effects, p, items, rule) - target, warm=initial
@@ -326,6 +329,19 @@ class StripeProblem(Problem):
         assert best is not None
         return Fit(effects, best[1], {"frames": best[2]})
 
+    @staticmethod
+    def regime_starts(grid: dict[str, np.ndarray], order: list[int], n: int) -> list[int]:
+        """The ``n`` best grid points (``order``: best first) with distinct row times."""
+        chosen, seen = [], set()
+        for i in order:
+            row_time = float(grid["row_time_s"][i])
+            if row_time not in seen:
+                seen.add(row_time)
+                chosen.append(i)
+            if len(chosen) == n:
+                break
+        return chosen
+
     def start_grid(self, specs: list[Param], first: dict[str, float]) -> dict[str, np.ndarray]:
         """Starting points: frame readouts 0.1 ms .. 200 ms (log grid) x offsets and thresholds in proportion to
         the table's exposures and pulse widths x spreads of 0 and 2 rows, for the parameters the model has."""
@@ -333,8 +349,8 @@ class StripeProblem(Problem):
         shorter = float(np.median(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
         axes = {
             "row_time_s": np.geomspace(specs[0].low, specs[0].high, 20)[1:-1],
-            "integration_offset_s": exposure * np.array([0.0, 0.3, 1.0]),
-            "threshold_s": shorter * np.array([0.03, 0.2, 1.0]),
+            "integration_offset_s": exposure * np.array([0.0, 0.1, 0.3, 0.6, 1.0]),
+            "threshold_s": shorter * np.array([0.01, 0.03, 0.1, 0.2, 0.4, 0.7, 1.0]),
             "noise_s": shorter * np.array([0.03, 0.3]),
             "spread_rows": np.array([0.0, 2.0]),
         }

@@ -22,7 +22,7 @@ from scipy.signal import lfilter
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
-from lerobot_phantom.calibration.core import Fit
+from lerobot_phantom.calibration.core import Fit, fit_least_squares
 from lerobot_phantom.calibration.stripes import StripeProblem, read_stripe_table
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
@@ -164,6 +164,45 @@ def test_lit_time_is_the_overlap_minus_twice_the_threshold():
     ) == pytest.approx(1e-2)
     with pytest.raises(ValueError, match="valid: all, lit, interior"):
         physics.rolling_shutter_rows_lit(period, on, window, 1e-5, image_rows=10, frames="every")
+
+
+@pytest.mark.parametrize(
+    ("seed", "frames"), [(3, "lit"), (2677795359, "lit"), (2, "interior"), (6, "interior")]
+)
+def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, seed, frames):
+    """Draws on which the fit once stopped in another stripe-count regime (a row time ~2-6x off, fit RMSE 10-20x
+    the one reached from the camera's own parameters): the fit must reach the minimum the truth reaches."""
+    rng = np.random.default_rng([seed, 2, len(frames)])
+    camera = draw_camera(rng, frames)
+    table = tmp_path / "table.csv"
+    write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
+    items = np.arange(problem.n_items)
+    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
+    truth = {
+        "row_time_s": camera["row_time"],
+        "integration_offset_s": camera["offset"] + 2 * camera["spread"] * camera["row_time"],
+        "threshold_s": camera["threshold_grey"] / camera["gain"],
+    }
+    target = torch.as_tensor(problem.rows)
+    from_truth = Fit(
+        effects,
+        fit_least_squares(
+            problem.param_specs(effects),
+            lambda p: problem.predict(effects, p, items, frames) - target,
+            warm=truth,
+        ),
+        {"frames": frames},
+    )
+    fitted = problem.fit(effects, items)
+
+    def rmse(fit):
+        return float(np.sqrt(np.mean(problem.residual(fit, items) ** 2)))
+
+    assert rmse(fitted) <= 1.1 * rmse(from_truth) + 0.5, (
+        f"{camera_summary(camera)}\nfitted {fitted.params} {fitted.extra}: {rmse(fitted):.2f} rows; "
+        f"from the camera's parameters {from_truth.params}: {rmse(from_truth):.2f} rows"
+    )
 
 
 # -- a second camera, end to end ---------------------------------------------------------------------------------
