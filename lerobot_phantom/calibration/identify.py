@@ -9,7 +9,11 @@ The rule (:func:`identify`): an extension is a named cause only if
 
 1. it was selected by the stated criterion on the fit items only (forward selection by inner cross-validation);
 2. its effect size on fit data is real: the bootstrap interval of the inner cross-validated error ratio
-   (model without it / model with it, paired over the same validation items) lies above 1;
+   (model without it / model with it, paired over the same validation items) lies above 1. An effect that hosts
+   others (their parameters live in its form: a stripe model's detection threshold needs the exposure overlap)
+   is compared with them: the model without it cannot have them either, so its gain is what it brings together
+   with those of its dependants that pass 2-5 on their own (an effect of no use alone is still not named unless
+   what it makes possible is);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
    range, not the camera);
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
@@ -254,17 +258,24 @@ def identify_selection(
     """Judge every extension forward selection kept by the module's rule; refit without those that fail."""
     selected_fit = chain[-1]
     intervals = parameter_intervals(problem, selected_fit, fit_items, draws=draws, rng=rng)
-    results, identified = [], []
+    # (effect, index of the step before it, index of the step with it) in the order selection added them
+    entries = []
     for k, (before, after) in enumerate(itertools.pairwise(steps)):
         (effect,) = set(after.effects) - set(before.effects)
         # an interacting pair (each useless alone) is judged by what the two bring together
-        if after.paired:
-            after = steps[k + 2]
-        elif before.paired:
-            before = steps[k - 1]
+        entries.append((effect, k - 1 if before.paired else k, k + 2 if after.paired else k + 1))
+    own: dict[str, dict] = {}
+    # leaves first: an effect that hosts others (the form their parameters live in) is judged with those of them
+    # that pass on their own, because the model without it cannot have them either
+    for effect, before, after in reversed(entries):
+        hosted = {d for d in dependants(problem, selected_fit.effects, effect) if own[d]["identified"]}
+        if hosted:
+            after = max(after, next(i for i, s in enumerate(steps) if set(s.effects) >= hosted | {effect}))
         ratio = None
-        if before.item_errors is not None and after.item_errors is not None:
-            ratio = error_ratio(before.item_errors, after.item_errors, draws=max(draws, 200), rng=rng)
+        if steps[before].item_errors is not None and steps[after].item_errors is not None:
+            ratio = error_ratio(
+                steps[before].item_errors, steps[after].item_errors, draws=max(draws, 200), rng=rng
+            )
         specs = own_params(problem, selected_fit.effects, effect)
         nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
         outcome = identify(
@@ -284,17 +295,22 @@ def identify_selection(
         if failed:
             result.update(identified=False, status="not identified")
             result["reasons"].extend(failed)
+        result.update(
+            validation_ratio=None if ratio is None else ratio.as_dict(),
+            judged_with=sorted(hosted),
+            params={p.name: selected_fit.params[p.name] for p in specs},
+            intervals={p.name: intervals[p.name].as_dict() for p in specs},
+            nulls=nulls,
+        )
+        own[effect] = result
+    results, identified = [], []
+    for effect, _before, _after in entries:
+        result = own[effect]
         requires = next((e.requires for e in problem.candidates if e.name == effect), ())
         missing = [r for r in requires if r not in identified]
         if missing and result["identified"]:
             result.update(identified=False, status="not identified")
             result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
-        result.update(
-            validation_ratio=None if ratio is None else ratio.as_dict(),
-            params={p.name: selected_fit.params[p.name] for p in specs},
-            intervals={p.name: intervals[p.name].as_dict() for p in specs},
-            nulls=nulls,
-        )
         results.append(result)
         if result["identified"]:
             identified.append(effect)

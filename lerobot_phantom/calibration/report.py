@@ -12,7 +12,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   [, noise_scale_ratio]};
 - ``selection`` {criterion, selected (forward selection on fit items), steps, rejected};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
-  validation_ratio (interval, fit items only), params, intervals, nulls} (rule: ``calibration/identify.py``);
+  validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio includes),
+  params, intervals, nulls} (rule: ``calibration/identify.py``);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}]} (``calibration/structure.py``);
@@ -95,10 +96,14 @@ def build_report(
         effect = result["effect"]
         step = next(s for s in steps if effect in s.effects)
         before = steps[steps.index(step) - 1]
+        hosted = result.get("judged_with", [])
+        if hosted:
+            step = next(s for s in steps if set(s.effects) >= {effect, *hosted})
         interval = result["validation_ratio"]
         evidence = (
             f"inner validation RMSE {before.validation_rmse:.3g} -> {step.validation_rmse:.3g} {problem.units} "
-            f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
+            + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
+            + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
             f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
         )
         if result["intervals"]:

@@ -219,3 +219,41 @@ def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame
     else:
         assert reasons and all("not one motion of the image" in r for r in reasons)
     assert problem.identification_checks("sensor_gamma", fit, items) == []
+
+
+class HostAndChild(ParentAndChild):
+    """As above, with the child's parameter inside its range unless ``child_at_bound``."""
+
+    def __init__(self, child_at_bound: bool) -> None:
+        self.child_at_bound = child_at_bound
+
+    def fit(self, effects, items, start=None) -> Fit:
+        fit = super().fit(effects, items, start)
+        if "threshold" in fit.params and not self.child_at_bound:
+            fit.params["threshold"] = 0.4 + 0.001 * float(np.mean(items))
+        return fit
+
+
+@pytest.mark.parametrize("child_at_bound", [False, True])
+def test_a_host_of_no_use_alone_is_judged_with_the_dependants_that_pass(child_at_bound):
+    """A stripe model's exposure overlap barely beats a fixed band until its threshold is fitted: the overlap is
+    then named for what the two bring together, but not for what a child that fails on its own would bring."""
+    problem = HostAndChild(child_at_bound)
+    items = np.arange(20)
+    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+    noise = np.random.default_rng(2).uniform(0.6, 1.6, 20)
+    steps = [
+        Step([], 2.0, {}, per_item),
+        Step(["parent"], 2.0, {}, per_item * noise),  # no gain alone: the ratio's interval spans 1
+        Step(["child", "parent"], 0.2, {}, 0.01 * per_item),
+    ]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=50, rng=np.random.default_rng(1))
+    parent, child = selection.results
+    assert child["identified"] is not child_at_bound
+    assert parent["identified"] is not child_at_bound, parent["reasons"]
+    assert parent["judged_with"] == ([] if child_at_bound else ["child"])
+    if child_at_bound:
+        assert any("does not exclude 1" in r for r in parent["reasons"])
+    else:
+        assert parent["validation_ratio"]["low"] > 5  # an RMSE ratio: sqrt(1 / 0.01)
