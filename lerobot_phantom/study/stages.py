@@ -383,9 +383,12 @@ class Planner:
             self.lora("at_calibrated", lo.rate, lo.attacks, physics, inputs=inputs)
             levels = b.calibration_intensities
             self.sweep("at_calibrated", "train_at_calibrated", calibrated, intensities=levels)
+            # the rate-0 control too: whether AT helps or hurts under the measured physics is judged against the
+            # same amount of clean fine-tuning, as under the paper's
             for role, policy in (
                 ("before", self.start_stage),
                 ("after", "train_at"),
+                ("control", "train_control"),
                 ("at_calibrated", "train_at_calibrated"),
             ):
                 self.sweep(
@@ -419,6 +422,10 @@ class Planner:
         if "before_calibrated_physics" in sweeps:
             pairs += [
                 ("before_calibrated_physics", r)
+                for r in ("after_calibrated_physics", "at_calibrated_calibrated_physics")
+            ]
+            pairs += [
+                ("control_calibrated_physics", r)
                 for r in ("after_calibrated_physics", "at_calibrated_calibrated_physics")
             ]
             inputs += [r for r in sweeps if r.endswith("_calibrated_physics")]

@@ -162,7 +162,7 @@ def test_optional_stages(tmp_path):
     assert len(json.loads(flag(s["train_at_calibrated"], "phantom.attacks"))) == len(CAMERA_ATTACKS)
     # Sweeps cover the attacks the set calibrates: under the others both physics are the same.
     assert json.loads(flag(s["sweep_at_calibrated"], "phantom.attacks")) == ["laser_blinding"]
-    for role in ("before", "after", "at_calibrated"):
+    for role in ("before", "after", "control", "at_calibrated"):
         sweep = s[f"sweep_{role}_calibrated_physics"]
         assert flag(sweep, "phantom.calibration") == str(calibration.resolve())
         assert json.loads(flag(sweep, "phantom.attacks")) == ["laser_blinding"]
@@ -176,6 +176,11 @@ def test_optional_stages(tmp_path):
         "sweeps/before_calibrated_physics/eval.json",
         "sweeps/at_calibrated_calibrated_physics/eval.json",
     ) in pairs
+    # AT under the measured physics is judged against the rate-0 control under it as well
+    assert (
+        "sweeps/control_calibrated_physics/eval.json",
+        "sweeps/after_calibrated_physics/eval.json",
+    ) in pairs
     assert json.loads(flag(report, "labels")) == [
         "before",
         "AT",
@@ -185,6 +190,7 @@ def test_optional_stages(tmp_path):
         "AT + instruction attacks",
         "before under measured physics",
         "AT under measured physics",
+        "control under measured physics",
         "measured-physics AT under measured physics",
     ]
     # Calibrated-physics sweeps are compared with each other only, never with a naive-physics sweep.
@@ -223,6 +229,7 @@ def test_a_recalibration_reruns_the_calibrated_stages_only(tmp_path):
         "sweep_at_calibrated",
         "sweep_before_calibrated_physics",
         "sweep_after_calibrated_physics",
+        "sweep_control_calibrated_physics",
         "sweep_at_calibrated_calibrated_physics",
         "report",
     }
