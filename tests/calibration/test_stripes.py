@@ -216,8 +216,8 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
             marks=pytest.mark.xfail(
                 strict=False,
                 reason="open (issue 12): on some draws the threshold brings no cross-validated gain and held-out "
-                "rows lie where no fit row is (seen: 124 and 139 rows held-out, STRIPES_SEED=16 and 19; 3 of 20 "
-                "cases of seeds 11-20 fail, 7 of 20 before the fit's wider start search)",
+                "rows lie where no fit row is (seen: 124 and 139 rows held-out, STRIPES_SEED=16 and 19; 4 of 20 "
+                "cases of seeds 11-20 fail, 7 of 20 before session 9: docs/bench/second_camera_stripes.md)",
             ),
         ),
         pytest.param(
