@@ -18,18 +18,25 @@ float32 and uint8 batches:
 * what the uint8 targets cost: single torch passes (widen, narrow, add, divide, ...), the sums of the passes the
   laser blinding, ultrasound blur and EM colour strip kernels need (``FLOORS``), the cost of one torch op before
   it touches any data (the budget of per-sample and per-group ops), and OpenCV's fused uint8 alternatives
-  (``cv2.addWeighted``, a ``cv2.boxFilter`` diagonal blur) with their share of values off the package's kernel.
+  (``cv2.addWeighted``, a ``cv2.boxFilter`` diagonal blur) with their share of values off the package's kernel;
+* what a compiled kernel would reach: one fused C loop per kernel (``FUSED_C_SOURCE``, built with the system C
+  compiler when there is one), the laser blend with three roundings and the blur's diagonal running sum, with
+  their share of values off the package's kernel.
 
 Timings are the best CPU time (``time.process_time``) of repeated calls after a warm-up: everything runs on one
 thread, and on a shared machine the wall clock mostly measures the run queue. The load average is printed and
 stored. Writes JSON to ``--out``.
 """
 
+import ctypes
 import json
 import math
 import os
 import platform
+import shutil
 import statistics
+import subprocess
+import tempfile
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -367,6 +374,182 @@ def cv2_alternatives(
     }
 
 
+# -- fused loops in C: what a compiled kernel would reach ----------------------------------------------------
+
+FUSED_C_SOURCE = r"""
+#include <stdint.h>
+#ifndef CLONES
+#define CLONES
+#endif
+/* x (batch * image values), q and counts (image values): one pass, one loop per kernel, vectorised by the compiler */
+CLONES void blend_float(const uint8_t *restrict x, const float *restrict q, float w, uint8_t *restrict out,
+                        long batch, long image) {
+  for (long b = 0; b < batch; b++)
+    for (long i = 0; i < image; i++) out[b * image + i] = (uint8_t)(int)((float)x[b * image + i] * w + q[i]);
+}
+CLONES void blend_fixed32(const uint8_t *restrict x, const int32_t *restrict q, int32_t w, uint8_t *restrict out,
+                          long batch, long image) {
+  for (long b = 0; b < batch; b++)
+    for (long i = 0; i < image; i++) out[b * image + i] = (uint8_t)((x[b * image + i] * w + q[i]) >> 16);
+}
+CLONES void blend_fixed16(const uint8_t *restrict x, const uint16_t *restrict q, uint16_t w, uint8_t *restrict out,
+                          long batch, long image) {
+  for (long b = 0; b < batch; b++)
+    for (long i = 0; i < image; i++)
+      out[b * image + i] = (uint8_t)((uint16_t)(x[b * image + i] * w + q[i]) >> 8);
+}
+/* the diagonal path of `length` samples, pixel (r, c) to (r + k, c + k), as a running sum from the bottom row:
+   S[r][c] = x[r][c] + S[r + 1][c + 1] - x[r + length][c + length]; the mean over the in-bounds samples rounded
+   as the package rounds it (float32 divide, + 1.5 * 2**23 leaves the rounded mean in the low byte) */
+CLONES void diagonal_blur(const uint8_t *restrict x, const float *restrict count, uint8_t *restrict out,
+                          int32_t *restrict sums, long planes, long h, long w, long length) {
+  for (long p = 0; p < planes; p++) {
+    const uint8_t *im = x + p * h * w;
+    uint8_t *o = out + p * h * w;
+    for (long r = h - 1; r >= 0; r--) {
+      int32_t *s = sums + (r % 2) * w;
+      const int32_t *below = sums + ((r + 1) % 2) * w;
+      const uint8_t *row = im + r * w;
+      if (r == h - 1) {
+        for (long c = 0; c < w; c++) s[c] = row[c];
+      } else {
+        const uint8_t *gone = r + length < h ? im + (r + length) * w + length : 0;
+        long last = gone ? w - length : 0;
+        for (long c = 0; c < last; c++) s[c] = row[c] + below[c + 1] - gone[c];
+        for (long c = last; c < w - 1; c++) s[c] = row[c] + below[c + 1];
+        s[w - 1] = row[w - 1];
+      }
+      const float *n = count + r * w;
+      for (long c = 0; c < w; c++) {
+        union { float f; uint32_t u; } v = {(float)s[c] / n[c] + 12582912.0f};
+        o[r * w + c] = (uint8_t)v.u;
+      }
+    }
+  }
+}
+"""
+
+
+def _compile_fused(folder: Path) -> ctypes.CDLL | str:
+    """The fused loops compiled with the system C compiler (``-O3``; on x86-64 an AVX2 clone chosen at load
+    time), or why they could not be."""
+    compiler = shutil.which(os.environ.get("CC", "cc"))
+    if compiler is None:
+        return "no C compiler (cc or $CC) on PATH"
+    source, library = folder / "fused.c", folder / "fused.so"
+    source.write_text(FUSED_C_SOURCE)
+    clones = (
+        ['-DCLONES=__attribute__((target_clones("avx2","default")))']
+        if platform.machine() == "x86_64"
+        else []
+    )
+    command = [compiler, "-O3", "-shared", "-fPIC", *clones, "-o", str(library), str(source)]
+    built = subprocess.run(command, capture_output=True, text=True)
+    if built.returncode != 0:
+        return f"{' '.join(command)} failed: {built.stderr.strip()}"
+    return ctypes.CDLL(str(library))
+
+
+def _pointer(tensor: torch.Tensor) -> ctypes.c_void_p:
+    return ctypes.c_void_p(tensor.data_ptr())
+
+
+def fused_c_alternatives(batch: int, size: int, min_time: float) -> dict[str, dict[str, float]] | str:
+    """One fused C loop per kernel (the bound a compiled extension could reach), timed as the attacks are (against
+    a uint8 clone of the batch alone and alternating with it, the faster clone used) and compared value by value with the package's kernel at the strong level:
+
+    * laser blinding three ways: the package's float32 rounding in one loop; 16 fractional bits in int32 lanes
+      (``(x W + Q) >> 16``); 8 fractional bits in 16-bit lanes (``(x (256 - A) + p A + 128) >> 8``, twice the
+      lanes per vector);
+    * the ultrasound blur's diagonal mean as a running sum, one row of sums from the next.
+
+    Returns why nothing was measured when no C compiler is available."""
+    with tempfile.TemporaryDirectory() as folder:
+        library = _compile_fused(Path(folder))
+        if isinstance(library, str):
+            return library
+        images = _batch(batch, size, "uint8")
+        image_values = images[0].numel()
+        out = torch.empty_like(images)
+        clone_ms = 1000 * _best(images.clone, min_time)[0] / batch
+
+        laser = make_attack("laser_blinding", intensity="strong", seed=0)
+        params = laser.sample_params(batch, size, size)
+        alpha = float(params["alpha"][0])
+        grey = (laser.patterns_for(params["position"], size, size, images.device)[0] * 255.0).contiguous()
+        as_long = ctypes.c_long
+        calls = {
+            "blend_float": (
+                torch.mul(grey, alpha).add_(0.5),
+                ctypes.c_float(1.0 - alpha),
+            ),
+            "blend_fixed32": (
+                torch.round(grey * (alpha * 65536)).to(torch.int32) + 32768,
+                ctypes.c_int32(round((1.0 - alpha) * 65536)),
+            ),
+            "blend_fixed16": (
+                torch.round(grey).to(torch.int32).mul_(round(alpha * 256)).add_(128).to(torch.int16),
+                ctypes.c_uint16(256 - round(alpha * 256)),
+            ),
+        }
+        exact = laser.apply_params(images, params)
+        results = {}
+        for name, (offset, weight) in calls.items():
+            kernel = getattr(library, name)
+
+            def run(kernel=kernel, offset=offset, weight=weight):
+                kernel(
+                    _pointer(images),
+                    _pointer(offset),
+                    weight,
+                    _pointer(out),
+                    as_long(batch),
+                    as_long(image_values),
+                )
+                return out
+
+            seconds, _, clone_s = _best_against(run, images.clone, min_time)
+            diff = run().int() - exact.int()
+            results[f"C {name} laser_blinding uint8 strong"] = {
+                "ms_per_image": 1000 * seconds / batch,
+                "clone_ratio": min(clone_ms, 1000 * clone_s / batch) / (1000 * seconds / batch),
+                "share_off_exact": float((diff != 0).double().mean()),
+                "max_off_exact": int(diff.abs().max()),
+            }
+
+        blur = make_attack("ultrasound_blur", intensity="strong", seed=0)
+        blur_params = blur.sample_params(batch, size, size)
+        length = int(float(blur_params["dx"][0])) + 1
+        r, c = torch.arange(size)[:, None], torch.arange(size)[None, :]
+        count = (
+            torch.minimum(torch.minimum(torch.full_like(r, length), size - r), size - c).float().contiguous()
+        )
+        sums = torch.empty(2, size, dtype=torch.int32)
+
+        def blur_run():
+            library.diagonal_blur(
+                _pointer(images),
+                _pointer(count),
+                _pointer(out),
+                _pointer(sums),
+                as_long(batch * 3),
+                as_long(size),
+                as_long(size),
+                as_long(length),
+            )
+            return out
+
+        seconds, _, clone_s = _best_against(blur_run, images.clone, min_time)
+        diff = blur_run().int() - blur.apply_params(images, blur_params).int()
+        results["C diagonal running sum ultrasound_blur uint8 strong"] = {
+            "ms_per_image": 1000 * seconds / batch,
+            "clone_ratio": min(clone_ms, 1000 * clone_s / batch) / (1000 * seconds / batch),
+            "share_off_exact": float((diff != 0).double().mean()),
+            "max_off_exact": int(diff.abs().max()),
+        }
+    return results
+
+
 # -- the run -------------------------------------------------------------------------------------------------
 
 
@@ -427,6 +610,7 @@ def run_benchmark(cfg: BenchConfig) -> dict:
         alternatives = cv2_alternatives(
             cfg.batch, cfg.size, cfg.min_time, _authors_patterns(cfg.patterns, cfg.size)[0]
         )
+        fused = fused_c_alternatives(cfg.batch, cfg.size, cfg.min_time)
         floors = {
             name: {"passes": steps, "ms_per_image": sum(passes[s] * share for s, share in steps)}
             for name, steps in FLOORS.items()
@@ -469,6 +653,7 @@ def run_benchmark(cfg: BenchConfig) -> dict:
         "floors": floors,
         "op_dispatch_ms": op_ms,
         "cv2_alternatives": alternatives,
+        "fused_c_alternatives": fused,
     }
 
 
@@ -525,6 +710,15 @@ def report(result: dict) -> str:
             f"{name}: {a['ms_per_image']:.4f} ms/img = {a['clone_ratio']:.3f}x uint8 clone; "
             f"{a['share_off_exact']:.1%} of values off the package's kernel (max {a['max_off_exact']})"
             for name, a in result["cv2_alternatives"].items()
+        ),
+        *(
+            [f"fused C loops: not measured ({result['fused_c_alternatives']})"]
+            if isinstance(result["fused_c_alternatives"], str)
+            else (
+                f"{name}: {a['ms_per_image']:.4f} ms/img = {a['clone_ratio']:.3f}x uint8 clone; "
+                f"{a['share_off_exact']:.1%} of values off the package's kernel (max {a['max_off_exact']})"
+                for name, a in result["fused_c_alternatives"].items()
+            )
         ),
         f"best-of-N CPU time per call (one thread); load average {tuple(round(v, 2) for v in meta['load_average'] or ())}",
     ]
