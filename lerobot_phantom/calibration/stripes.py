@@ -307,7 +307,8 @@ class StripeProblem(Problem):
         grid = self.start_grid(specs, first)
         best = None
         # every rule starts from the nested model's values and the grid's best points of distinct row times (five
-        # for a first fit: neighbouring stripe-count regimes, e.g. a row time and its double, are separate minima)
+        # for a first fit: neighbouring stripe-count regimes, e.g. a row time and its double, are separate minima),
+        # two points of each (offset/threshold minima within a regime)
         n_grid = 2 if start is not None and "frames" in start.extra else 5
         for rule in self.frame_rules:
             with torch.no_grad():
@@ -330,17 +331,20 @@ class StripeProblem(Problem):
         return Fit(effects, best[1], {"frames": best[2]})
 
     @staticmethod
-    def regime_starts(grid: dict[str, np.ndarray], order: list[int], n: int) -> list[int]:
-        """The ``n`` best grid points (``order``: best first) with distinct row times."""
-        chosen, seen = [], set()
+    def regime_starts(
+        grid: dict[str, np.ndarray], order: list[int], n: int, per_row_time: int = 2
+    ) -> list[int]:
+        """The best grid points (``order``: best first) of the ``n`` best distinct row times, ``per_row_time`` of
+        each: within one stripe-count regime the offset and threshold still have separate minima (a grid's best
+        point can lead to 4x the error its second-best reaches)."""
+        chosen: dict[float, list[int]] = {}
         for i in order:
             row_time = float(grid["row_time_s"][i])
-            if row_time not in seen:
-                seen.add(row_time)
-                chosen.append(i)
-            if len(chosen) == n:
-                break
-        return chosen
+            if row_time not in chosen and len(chosen) < n:
+                chosen[row_time] = []
+            if row_time in chosen and len(chosen[row_time]) < per_row_time:
+                chosen[row_time].append(i)
+        return [i for points in chosen.values() for i in points]
 
     def start_grid(self, specs: list[Param], first: dict[str, float]) -> dict[str, np.ndarray]:
         """Starting points: frame readouts 0.1 ms .. 200 ms (log grid) x offsets and thresholds in proportion to
