@@ -17,14 +17,11 @@ from pathlib import Path
 from tempfile import TemporaryDirectory
 
 import numpy as np
-import torch
 
 sys.path.insert(0, str(Path("tests/calibration").resolve()))
 
-from lerobot_phantom.calibration.core import Fit, fit_least_squares, seeded_split
+from lerobot_phantom.calibration.core import Fit, seeded_split
 from lerobot_phantom.calibration.stripes import StripeProblem
-
-EFFECTS = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
 
 
 def screen(seed: int, frames: str, folder: Path, sim) -> tuple[str, bool]:
@@ -36,19 +33,8 @@ def screen(seed: int, frames: str, folder: Path, sim) -> tuple[str, bool]:
     unit = None if style == "exposure_us" else 1e-6
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=unit)
     items, _ = seeded_split(problem.n_items, 0.2, seed % 1000)
-    target = torch.as_tensor(problem.rows[items])
-    truth = {
-        "row_time_s": camera["row_time"],
-        "integration_offset_s": camera["offset"] + 2 * camera["spread"] * camera["row_time"],
-        "threshold_s": camera["threshold_grey"] / camera["gain"],
-    }
-    params = fit_least_squares(
-        problem.param_specs(EFFECTS),
-        lambda p: problem.predict(EFFECTS, p, items, frames) - target,
-        warm=truth,
-    )
-    from_truth = Fit(EFFECTS, params, {"frames": frames})
-    fitted = problem.fit(EFFECTS, items)
+    from_truth = sim.truth_started_fit(problem, camera, items, frames)
+    fitted = problem.fit(from_truth.effects, items)
 
     def rmse(fit: Fit) -> float:
         return float(np.sqrt(np.mean(problem.residual(fit, items) ** 2)))
