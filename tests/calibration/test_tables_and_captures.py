@@ -139,9 +139,16 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
             "600",
             "--exposure-unit-s",
             "1e-4",
+            # one frame rule and a short bootstrap: this test is about the command line, not the fit
+            "--stripe-frames",
+            "all",
+            "--bootstrap",
+            "10",
         ]
     )
     assert "laser_color_strip: base held-out RMSE" in capsys.readouterr().out
     report = json.loads((tmp_path / "out" / "report.json").read_text())
     assert set(report) >= {"attack", "input", "n_fit", "n_heldout", "base", "findings", "extended", "gain"}
     assert calibrated_kwargs("laser_color_strip", tmp_path / "out")["frame_rows"] == 600
+    assert report["base"]["param_intervals"]["band_rows"]["draws"] == 10
+    assert report["extended"]["derived"]["frames_averaged"] == "all"
