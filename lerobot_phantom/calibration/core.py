@@ -3,8 +3,10 @@
 A *problem* is one kind of measured data with a base model (the paper's simulation) and a library of named
 physical extensions. Its data is cut into *items* (table rows, image tiles or whole images) so that splits never
 share an item between fitting and scoring. Selection is forward: starting from the base, the extension that most
-lowers the inner cross-validated RMSE is kept if it lowers it by a clear relative margin, or a pair of extensions
-when the pair beats every single one by that margin (interacting effects); repeat until nothing does.
+lowers the inner cross-validated error is kept if it lowers it by a clear relative margin, or a pair of extensions
+when the pair beats every single one by that margin (interacting effects); repeat until nothing does. The error is
+the problem's ``selection_score``: the RMSE over all values, or the mean of the items' own errors where one item that
+no fit can predict would otherwise decide every comparison.
 """
 
 from __future__ import annotations
@@ -132,6 +134,9 @@ class Problem:
     heldout_definition: str = (
         "RMSE of the model fitted on the fit items, predicting the held-out items from their inputs alone"
     )
+    # what inner cross-validation compares models by (``SELECTION_SCORES``); held-out figures are RMSE either way
+    selection_score: str = "rmse"
+    selection_score_reason: str = ""  # why, when it is not the RMSE (the report says it)
 
     @property
     def n_items(self) -> int:
@@ -195,6 +200,27 @@ class Problem:
         return []
 
 
+# "rmse": every value's squared error pooled over the items; "mean_item_error": the mean over items of each item's
+# own RMSE (an item's absolute error when it is one value), which a single unpredictable item cannot dominate
+SELECTION_SCORES = {"rmse": "RMSE", "mean_item_error": "mean per-item error"}
+
+
+def item_scores(kind: str, squared: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """Per-item terms of the selection score ``kind``: squared-error sums ("rmse") or each item's RMSE."""
+    if kind == "rmse":
+        return np.asarray(squared, np.float64)
+    if kind == "mean_item_error":
+        return np.sqrt(np.asarray(squared, np.float64) / np.maximum(np.asarray(counts, np.float64), 1.0))
+    raise ValueError(f"selection score {kind!r} unknown; valid: {', '.join(SELECTION_SCORES)}")
+
+
+def selection_value(kind: str, terms: np.ndarray, counts: np.ndarray) -> float:
+    """The score from its per-item terms (``item_scores``)."""
+    if kind == "rmse":
+        return math.sqrt(float(np.sum(terms)) / max(float(np.sum(counts)), 1.0))
+    return float(np.mean(terms))
+
+
 def seeded_split(n_items: int, heldout: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
     """(fit, held-out) item indices: a seeded random permutation; at least one item on each side."""
     if n_items < 2:
@@ -226,9 +252,9 @@ def kfold(
 @dataclass
 class Step:
     effects: list[str]
-    validation_rmse: float
+    validation_error: float  # the problem's selection score, inner cross-validated
     tried: dict[str, float]
-    # per fit item: inner cross-validated squared error of this model (the item scored in its validation fold)
+    # per fit item: this model's term of the selection score (``item_scores``), the item scored in its validation fold
     item_errors: np.ndarray | None = None
     # the first of an interacting pair kept together: its effect is judged with the pair (the next step)
     paired: bool = False
@@ -237,15 +263,17 @@ class Step:
 def cross_validated(
     problem: Problem, effects: frozenset[str], splits, parents: list[Fit] | None
 ) -> tuple[float, list[Fit], dict[int, float]]:
-    """Validation RMSE over the folds, the fold fits, and each validation item's squared error."""
-    total, count, fits, per_item = 0.0, 0, [], {}
+    """The selection score over the folds, the fold fits, and each validation item's term of the score."""
+    fits, per_item, counts = [], {}, []
     for k, (train, val) in enumerate(splits):
         fit = problem.fit(effects, train, None if parents is None else parents[k])
         sq, n = problem.item_squared_errors(fit, val)
-        per_item.update({int(i): float(e) for i, e in zip(val, sq, strict=True)})
-        total, count = total + float(sq.sum()), count + float(n.sum())
+        terms = item_scores(problem.selection_score, sq, n)
+        per_item.update({int(i): float(e) for i, e in zip(val, terms, strict=True)})
+        counts.append(n)
         fits.append(fit)
-    return math.sqrt(total / max(count, 1)), fits, per_item
+    terms = np.array(list(per_item.values()), np.float64)
+    return selection_value(problem.selection_score, terms, np.concatenate(counts)), fits, per_item
 
 
 def forward_select(
@@ -257,10 +285,10 @@ def forward_select(
     folds: int = 4,
     max_train_items: int = 2500,
 ) -> tuple[frozenset[str], list[Step]]:
-    """Forward selection of extensions by inner k-fold validation RMSE, each step needing a ``margin`` gain.
+    """Forward selection of extensions by the inner k-fold validation score, each step needing a ``margin`` gain.
 
-    Only ``fit_items`` are used. Every step keeps each fit item's validation squared error, so the effect size of
-    a step can be bootstrapped over items (``identify.error_ratio``)."""
+    Only ``fit_items`` are used. Every step keeps each fit item's term of the score, so the effect size of a step
+    can be bootstrapped over items (``identify.error_ratio``)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
     requires = {e.name: set(e.requires) for e in problem.candidates}
 

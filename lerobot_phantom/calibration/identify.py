@@ -97,14 +97,19 @@ def bootstrap(
     return {k: percentile_interval(estimate[k], samples[k], level) for k in estimate}
 
 
-def error_ratio(before: np.ndarray, after: np.ndarray, *, draws: int, rng: np.random.Generator) -> Interval:
-    """RMSE(before) / RMSE(after) from per-item squared-error sums, with a paired bootstrap over the items.
+def error_ratio(
+    before: np.ndarray, after: np.ndarray, *, draws: int, rng: np.random.Generator, score: str = "rmse"
+) -> Interval:
+    """score(before) / score(after) with a paired bootstrap over the items; ``score`` as in ``core.SELECTION_SCORES``.
 
-    ``before``, ``after``: per-item sums of squared errors of two models on the same items. A ratio above 1 means ``after`` predicts better."""
+    ``before``, ``after``: per-item terms of the score (``core.item_scores``) of two models on the same items: sums
+    of squared errors for "rmse", each item's own error for "mean_item_error". A ratio above 1 means ``after``
+    predicts better."""
     before, after = np.asarray(before, np.float64), np.asarray(after, np.float64)
+    power = {"rmse": 0.5, "mean_item_error": 1.0}[score]
 
     def ratio(index: np.ndarray) -> dict[str, float]:
-        return {"ratio": float(np.sqrt(before[index].sum() / max(after[index].sum(), 1e-300)))}
+        return {"ratio": float((before[index].sum() / max(after[index].sum(), 1e-300)) ** power)}
 
     return bootstrap(ratio, np.arange(len(before)), draws=draws, rng=rng)["ratio"]
 
@@ -274,7 +279,11 @@ def identify_selection(
         ratio = None
         if steps[before].item_errors is not None and steps[after].item_errors is not None:
             ratio = error_ratio(
-                steps[before].item_errors, steps[after].item_errors, draws=max(draws, 200), rng=rng
+                steps[before].item_errors,
+                steps[after].item_errors,
+                draws=max(draws, 200),
+                rng=rng,
+                score=problem.selection_score,
             )
         specs = own_params(problem, selected_fit.effects, effect)
         nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}

@@ -10,7 +10,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   identified ones only: what calibrated.json carries) and ``derived``;
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
-- ``selection`` {criterion, selected (forward selection on fit items), steps, rejected};
+- ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
+  rejected};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio includes),
   params, intervals, nulls} (rule: ``calibration/identify.py``);
@@ -29,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import Fit, Problem, Step
+from lerobot_phantom.calibration.core import SELECTION_SCORES, Fit, Problem, Step
 from lerobot_phantom.calibration.identify import Interval, Selection, error_ratio, rmse_interval
 from lerobot_phantom.calibration.structure import residual_structure
 
@@ -89,6 +90,7 @@ def build_report(
     ext_scores, ext_squared = heldout_scores(problem, extended, heldout_items, draws=max(draws, 200), rng=rng)
     ratio = error_ratio(base_squared, ext_squared, draws=max(draws, 200), rng=rng)
     causes = {e.name: e.cause for e in problem.candidates}
+    score_name = SELECTION_SCORES[problem.selection_score]
     findings = []
     for result in selection.results:
         if not result["identified"]:
@@ -101,7 +103,8 @@ def build_report(
             step = next(s for s in steps if set(s.effects) >= {effect, *hosted})
         interval = result["validation_ratio"]
         evidence = (
-            f"inner validation RMSE {before.validation_rmse:.3g} -> {step.validation_rmse:.3g} {problem.units} "
+            f"inner validation {score_name} {before.validation_error:.3g} -> {step.validation_error:.3g} "
+            f"{problem.units} "
             + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
             + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
             f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
@@ -146,14 +149,18 @@ def build_report(
             "selection_margin": margin,
         },
         "selection": {
-            "criterion": f"forward selection on the fit items by {folds}-fold cross-validated RMSE; each kept "
+            "score": score_name,
+            "criterion": f"forward selection on the fit items by {folds}-fold cross-validated {score_name}"
+            + (f" ({problem.selection_score_reason})" if problem.selection_score != "rmse" else "")
+            + "; each kept "
             f"extension must lower it by >= {100 * margin:.0f}% (a pair of interacting extensions by "
             f">= {200 * margin:.0f}%); then each kept extension must pass the identification rule "
             "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
             "bound, an interval excluding its null value",
             "selected": selection.selected,
             "steps": [
-                {"effects": s.effects, "validation_rmse": s.validation_rmse, "tried": s.tried} for s in steps
+                {"effects": s.effects, "validation_error": s.validation_error, "tried": s.tried}
+                for s in steps
             ],
             "rejected": dict(steps[-1].tried),
         },
@@ -325,8 +332,8 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
     for step in report["selection"]["steps"]:
         tried = ", ".join(f"{k}: {v:.3g}" for k, v in step["tried"].items())
         lines.append(
-            f"- {step['effects'] or ['base']}: validation RMSE {step['validation_rmse']:.3g}"
-            + (f"; candidates tried next: {tried}" if tried else "")
+            f"- {step['effects'] or ['base']}: validation {report['selection']['score']} "
+            f"{step['validation_error']:.3g}" + (f"; candidates tried next: {tried}" if tried else "")
         )
     lines += ["", "## Figures", ""]
     lines += [f"![{name}]({name})" for name in figures]

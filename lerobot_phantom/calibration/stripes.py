@@ -205,6 +205,15 @@ class StripeProblem(Problem):
     base_model = "fixed band of rows (the paper's laser color strip, band height fitted)"
     extended_model = "rolling shutter: phase-averaged pulse/exposure overlap over the row readout"
     candidates = EFFECTS
+    # A table is a sparse grid of conditions over a response that switches regime (pulses above or below the
+    # detection threshold, one or several pulses per exposure). A condition alone in its regime cannot be predicted
+    # by the fold that validates it, whatever the model: its error (hundreds of rows) would decide every squared-
+    # error comparison, while the rows each model can predict would not count.
+    selection_score = "mean_item_error"
+    selection_score_reason = (
+        "each table row's absolute error, averaged: a condition alone in its regime, which no fold that validates "
+        "it can predict, must not decide every comparison"
+    )
 
     def __init__(
         self,

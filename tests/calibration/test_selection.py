@@ -1,0 +1,71 @@
+"""Forward selection's score (``calibration/core.py``): the pooled RMSE, or the mean of the items' own errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from lerobot_phantom.calibration.core import (
+    Effect,
+    Fit,
+    Problem,
+    forward_select,
+    item_scores,
+    selection_value,
+)
+from lerobot_phantom.calibration.identify import error_ratio
+
+
+class LineWithALoneItem(Problem):
+    """y = 3 x + noise on every item but one, whose y no fit without it can predict (as a stripe table's only
+    sub-threshold condition). The base predicts a constant, ``slope`` a line through 0; both fit by medians, so
+    the lone item never moves a fit and its validation error is the same few hundred for both models."""
+
+    candidates = (Effect("slope", "a proportional response"),)
+
+    def __init__(self, score: str, seed: int) -> None:
+        rng = np.random.default_rng(seed)
+        self.selection_score = score
+        self.x = rng.uniform(1.0, 10.0, 24)
+        self.y = 3.0 * self.x + rng.normal(0.0, 0.1, 24)
+        self.y[5] = 1000.0
+
+    @property
+    def n_items(self) -> int:
+        return len(self.y)
+
+    def fit(self, effects, items, start=None) -> Fit:
+        if "slope" in effects:
+            return Fit(effects, {"slope": float(np.median(self.y[items] / self.x[items]))})
+        return Fit(effects, {"level": float(np.median(self.y[items]))})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        predicted = fit.params["slope"] * self.x[items] if "slope" in fit.params else fit.params["level"]
+        return float(np.sum((self.y[items] - predicted) ** 2)), len(items)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_one_item_no_model_predicts_decides_the_rmse_but_not_the_mean_item_error(seed):
+    items = np.arange(24)
+    pooled, steps = forward_select(LineWithALoneItem("rmse", seed), items, seed=seed, margin=0.05)
+    assert pooled == frozenset(), steps[0].tried  # the line's gain on 23 items is lost in one item's error
+    robust, steps = forward_select(LineWithALoneItem("mean_item_error", seed), items, seed=seed, margin=0.05)
+    assert robust == {"slope"}, steps[0].tried
+    # the step keeps each item's absolute error, and the identification ratio is a ratio of their means
+    before, after = steps[0].item_errors, steps[1].item_errors
+    assert before[5] > 900 and after[5] > 900 and np.median(after) < 0.5 < 5 < np.median(before)
+    ratio = error_ratio(before, after, draws=100, rng=np.random.default_rng(seed), score="mean_item_error")
+    assert ratio.estimate == pytest.approx(before.mean() / after.mean())
+    assert ratio.low > 1.0
+
+
+def test_the_two_scores_from_their_item_terms():
+    squared, counts = np.array([4.0, 36.0]), np.array([1.0, 4.0])
+    assert selection_value("rmse", item_scores("rmse", squared, counts), counts) == pytest.approx(
+        np.sqrt(8.0)
+    )
+    terms = item_scores("mean_item_error", squared, counts)
+    assert terms == pytest.approx([2.0, 3.0])
+    assert selection_value("mean_item_error", terms, counts) == pytest.approx(2.5)
+    with pytest.raises(ValueError, match="valid: rmse, mean_item_error"):
+        item_scores("median", squared, counts)
