@@ -106,7 +106,10 @@ def error_ratio(
     of squared errors for "rmse", each item's own error for "mean_item_error". A ratio above 1 means ``after``
     predicts better."""
     before, after = np.asarray(before, np.float64), np.asarray(after, np.float64)
-    power = {"rmse": 0.5, "mean_item_error": 1.0}[score]
+    powers = {"rmse": 0.5, "mean_item_error": 1.0}
+    if score not in powers:
+        raise ValueError(f"selection score {score!r} unknown; valid: {', '.join(powers)}")
+    power = powers[score]
 
     def ratio(index: np.ndarray) -> dict[str, float]:
         return {"ratio": float((before[index].sum() / max(after[index].sum(), 1e-300)) ** power)}

@@ -69,3 +69,5 @@ def test_the_two_scores_from_their_item_terms():
     assert selection_value("mean_item_error", terms, counts) == pytest.approx(2.5)
     with pytest.raises(ValueError, match="valid: rmse, mean_item_error"):
         item_scores("median", squared, counts)
+    with pytest.raises(ValueError, match="valid: rmse, mean_item_error"):
+        error_ratio(squared, squared, draws=2, rng=np.random.default_rng(0), score="median")
