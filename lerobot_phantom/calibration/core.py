@@ -205,17 +205,23 @@ class Problem:
 SELECTION_SCORES = {"rmse": "RMSE", "mean_item_error": "mean per-item error"}
 
 
+def _check_score(kind: str) -> None:
+    if kind not in SELECTION_SCORES:
+        raise ValueError(f"selection score {kind!r} unknown; valid: {', '.join(SELECTION_SCORES)}")
+
+
 def item_scores(kind: str, squared: np.ndarray, counts: np.ndarray) -> np.ndarray:
     """Per-item terms of the selection score ``kind``: squared-error sums ("rmse") or each item's RMSE."""
+    _check_score(kind)
+    squared = np.asarray(squared, np.float64)
     if kind == "rmse":
-        return np.asarray(squared, np.float64)
-    if kind == "mean_item_error":
-        return np.sqrt(np.asarray(squared, np.float64) / np.maximum(np.asarray(counts, np.float64), 1.0))
-    raise ValueError(f"selection score {kind!r} unknown; valid: {', '.join(SELECTION_SCORES)}")
+        return squared
+    return np.sqrt(squared / np.maximum(np.asarray(counts, np.float64), 1.0))
 
 
 def selection_value(kind: str, terms: np.ndarray, counts: np.ndarray) -> float:
-    """The score from its per-item terms (``item_scores``)."""
+    """The score from its per-item terms (``item_scores``) and the items' value counts."""
+    _check_score(kind)
     if kind == "rmse":
         return math.sqrt(float(np.sum(terms)) / max(float(np.sum(counts)), 1.0))
     return float(np.mean(terms))
@@ -264,16 +270,16 @@ def cross_validated(
     problem: Problem, effects: frozenset[str], splits, parents: list[Fit] | None
 ) -> tuple[float, list[Fit], dict[int, float]]:
     """The selection score over the folds, the fold fits, and each validation item's term of the score."""
-    fits, per_item, counts = [], {}, []
+    fits, per_item, terms, counts = [], {}, [], []
     for k, (train, val) in enumerate(splits):
         fit = problem.fit(effects, train, None if parents is None else parents[k])
         sq, n = problem.item_squared_errors(fit, val)
-        terms = item_scores(problem.selection_score, sq, n)
-        per_item.update({int(i): float(e) for i, e in zip(val, terms, strict=True)})
+        terms.append(item_scores(problem.selection_score, sq, n))
         counts.append(n)
+        per_item.update({int(i): float(e) for i, e in zip(val, terms[-1], strict=True)})
         fits.append(fit)
-    terms = np.array(list(per_item.values()), np.float64)
-    return selection_value(problem.selection_score, terms, np.concatenate(counts)), fits, per_item
+    score = selection_value(problem.selection_score, np.concatenate(terms), np.concatenate(counts))
+    return score, fits, per_item
 
 
 def forward_select(

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import Fit, Param, Problem, Step
+from lerobot_phantom.calibration.core import Fit, Param, Problem, Step, selection_value
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
 BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
@@ -106,13 +106,11 @@ def error_ratio(
     of squared errors for "rmse", each item's own error for "mean_item_error". A ratio above 1 means ``after``
     predicts better."""
     before, after = np.asarray(before, np.float64), np.asarray(after, np.float64)
-    powers = {"rmse": 0.5, "mean_item_error": 1.0}
-    if score not in powers:
-        raise ValueError(f"selection score {score!r} unknown; valid: {', '.join(powers)}")
-    power = powers[score]
+    counts = np.ones_like(before)  # both models score the same items: the value counts cancel in the ratio
 
     def ratio(index: np.ndarray) -> dict[str, float]:
-        return {"ratio": float((before[index].sum() / max(after[index].sum(), 1e-300)) ** power)}
+        value = selection_value(score, before[index], counts[index])
+        return {"ratio": value / max(selection_value(score, after[index], counts[index]), 1e-300)}
 
     return bootstrap(ratio, np.arange(len(before)), draws=draws, rng=rng)["ratio"]
 

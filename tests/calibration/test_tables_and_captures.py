@@ -152,3 +152,6 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
     assert calibrated_kwargs("laser_color_strip", tmp_path / "out")["frame_rows"] == 600
     assert report["base"]["param_intervals"]["band_rows"]["draws"] == 10
     assert report["extended"]["derived"]["frames_averaged"] == "all"
+    # stripe tables are compared row by row (StripeProblem.selection_score), and the report says so
+    assert report["selection"]["score"] == "mean per-item error"
+    assert "each table row's absolute error" in report["selection"]["criterion"]
