@@ -426,8 +426,10 @@ def test_case(name, root):
     "tone curve (albedo not named), truncation_shot_noise on filmic cameras, projection_sensor_gamma on 31337 "
     "(sensor_gamma not named, cross-talk named instead; on 4242 and 90210 selected but its cross-validated error-ratio "
     "interval over 6 fit pairs includes 1). Session 9 (master seed 424242): 8 of 10, missed blinding_halo and "
-    "projection_crosstalk (albedo). Session 10 (master seed 20261124): 9 of 11, the same two missed; see the README, "
-    "'Tested against an independent camera simulator'",
+    "projection_crosstalk (albedo). Session 10 (master seed 20261124): 9 of 11, the same two missed. Session 12, "
+    "the halo case redrawn so its glare is visible (it changed the frames by under 1 grey level before): 8 of 11 on "
+    "master seed 20261126, missed blinding_halo (glare scale at its bound), projection_sensor_gamma and "
+    "truncation_shot_noise; see the README, 'Tested against an independent camera simulator'",
     strict=False,
 )
 def test_planted_effects_are_named(root):

@@ -19,6 +19,12 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   that ratio would otherwise multiply its noise into the frames and drop the beam's faint outskirts, which the
   ``halo_power_law`` then stood in for with its exponent at the bound (measured on the independent simulator).
 
+``halo_power_law`` is glare, so it adds light and builds on ``linear_light_saturation``; it is fitted by its level
+at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it), its exponent and its scale. ``tone_shoulder``
+(also on linear light) composes in the log-logistic tone curve of ``calibration/tone.py`` instead of sRGB: a filmic
+camera stores the laser's light on a curve no power law follows (on the independent simulator, a power law fitted
+to one ran to its bound and a halo took over the laser's whole spot).
+
 ``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
 1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
@@ -29,6 +35,7 @@ average, as centre-weighted meters do when the spot is central).
 from __future__ import annotations
 
 import logging
+from functools import partial
 
 import numpy as np
 import torch
@@ -36,6 +43,12 @@ from scipy import ndimage, stats
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, Pair, PixelProblem, flat_pixels
+from lerobot_phantom.calibration.tone import (
+    SHOULDER_PARAMS,
+    equivalent_power_gamma,
+    shoulder_decode,
+    shoulder_encode,
+)
 from lerobot_phantom.transforms import physics
 
 logger = logging.getLogger(__name__)
@@ -50,6 +63,10 @@ BLINDING_EFFECTS = (
         "halo_power_law",
         "light scattered in the lens and on the sensor spreads glare far around the spot, falling off as a power "
         "of the distance (r^-k) rather than ending with the recorded pattern",
+        # glare is light: it adds to the laser's and the scene's irradiance. On a blend it would be the one term
+        # that adds light, and fitted there it took over the laser's whole spot (alpha 0) and was named in place
+        # of linear_light_saturation (independent simulator, session 12)
+        requires=("linear_light_saturation",),
     ),
     Effect(
         "auto_exposure",
@@ -57,6 +74,13 @@ BLINDING_EFFECTS = (
         "as the laser grows stronger",
     ),
     SENSOR_GAMMA,
+    Effect(
+        "tone_shoulder",
+        "the camera's tone curve rolls off towards white (a filmic / log-logistic shoulder, calibration/tone.py): "
+        "the laser's light and the scene's are stored on a curve far steeper in the shadows and flatter in the "
+        "highlights than sRGB, so light added in linear irradiance brightens dark pixels far more than sRGB predicts",
+        requires=("linear_light_saturation",),
+    ),
 )
 
 
@@ -181,6 +205,19 @@ def laser_irradiance(
     return (pattern - dark).clamp(min=0.0) * torch.exp(rise.clamp(max=50.0))
 
 
+# reference pixels from the spot at which the glare's level is fitted: a quarter of the reference frame's side
+GLARE_REFERENCE_PX = 64.0
+
+
+def halo_amplitude(params: dict):
+    """The power-law glare's amplitude at the spot's centre (``physics.power_law_halo``) from its fitted level at
+    ``GLARE_REFERENCE_PX``: ``level * (1 + R / scale) ** exponent``."""
+    return (
+        params["halo_level"]
+        * (1.0 + GLARE_REFERENCE_PX / params["halo_scale_ref_px"]) ** params["halo_exponent"]
+    )
+
+
 class BlindingFrames(PixelProblem):
     attack = "laser_blinding"
     base_model = "alpha blend of the scene and the laser pattern (the paper's laser blinding)"
@@ -260,8 +297,12 @@ class BlindingFrames(PixelProblem):
         else:
             specs.append(Param("alpha", 0.5, 0.0, 1.0, scale=0.3))
         if "halo_power_law" in effects:
+            # the glare's level where the frames show it, at GLARE_REFERENCE_PX from the spot (linear light per
+            # unit intensity, 1 = the full well), not its amplitude at the centre: the centre sits in the clipped
+            # core, so an amplitude there is unseen and trades against the scale (fitted to the independent
+            # simulator it ran to its bound, 50, on every draw)
             specs += [
-                Param("halo_amplitude", 0.3, 0.0, 50.0, scale=0.3),
+                Param("halo_level", 0.02, 0.0, 5.0, scale=0.02),
                 Param("halo_exponent", 2.0, 0.2, 8.0, scale=1.0),
                 Param("halo_scale_ref_px", 8.0, 0.3, 200.0, scale=8.0),
             ]
@@ -271,29 +312,44 @@ class BlindingFrames(PixelProblem):
             specs.append(Param("auto_exposure", 0.5, 0.0, 4.0, scale=0.5))
         if "sensor_gamma" in effects:
             specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+        if "tone_shoulder" in effects:
+            specs += list(SHOULDER_PARAMS)
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
         # the tone curve has no null here: the base composes encoded values, the linear model sRGB
-        return {"halo_power_law": {"halo_amplitude": 0.0}, "auto_exposure": {"auto_exposure": 0.0}}.get(
+        return {"halo_power_law": {"halo_level": 0.0}, "auto_exposure": {"auto_exposure": 0.0}}.get(
             effect, {}
         )
 
     @staticmethod
     def tone(effects, params):
-        """Tone curve the light is composed in: fitted, sRGB (linear light), or the encoded values (the paper)."""
+        """Power-law tone curve the light is composed in: fitted, sRGB (linear light), or the encoded values (the
+        paper); under a fitted shoulder (which builds on linear light), its display gamma (None: 1)."""
         if "sensor_gamma" in effects:
             return params["gamma"]
         return None if "linear_light_saturation" in effects else 1.0
 
-    def compose(self, effects, params, f, gamma) -> torch.Tensor:
-        """Scene plus laser light (linear in the tone curve ``gamma``), before exposure changes and clipping."""
-        scene = physics.decode(f["scene"], gamma)
+    @classmethod
+    def tone_curve(cls, effects, params):
+        """(decode, encode) between pixel values and the light the model composes: the fitted log-logistic
+        shoulder (``calibration/tone.py``, the convention the noise model reads), else a power law or sRGB."""
+        gamma = cls.tone(effects, params)
+        if "tone_shoulder" in effects:
+            return partial(shoulder_decode, params=params, gamma=gamma), partial(
+                shoulder_encode, params=params, gamma=gamma
+            )
+        return partial(physics.decode, gamma=gamma), partial(physics.encode, gamma=gamma)
+
+    def compose(self, effects, params, f, decode) -> torch.Tensor:
+        """Scene plus laser light (linear in the tone curve ``decode`` inverts), before exposure changes and
+        clipping."""
+        scene = decode(f["scene"])
         s = f["strength"]
         if "linear_light_saturation" in effects:
             laser = laser_irradiance(
-                physics.decode(f["beam"], gamma),
-                physics.decode(f["dark"], gamma),
+                decode(f["beam"]),
+                decode(f["dark"]),
                 f["core_depth"],
                 f["core_radius"],
                 params,
@@ -301,21 +357,21 @@ class BlindingFrames(PixelProblem):
             light, scene_weight = s * params["gain"] * laser, 1.0
         else:
             opacity = (params["alpha"] * s).clamp(0.0, 1.0)
-            light, scene_weight = opacity * physics.decode(f["pattern"], gamma), 1.0 - opacity
+            light, scene_weight = opacity * decode(f["pattern"]), 1.0 - opacity
         if "halo_power_law" in effects:
             halo = physics.power_law_halo(
-                f["radius"], params["halo_amplitude"], params["halo_exponent"], params["halo_scale_ref_px"]
+                f["radius"], halo_amplitude(params), params["halo_exponent"], params["halo_scale_ref_px"]
             )
             light = light + s * halo * f["colour"]
         return scene_weight * scene + light
 
-    def exposure_factor(self, effects, params, gamma) -> torch.Tensor:
+    def exposure_factor(self, effects, params, decode) -> torch.Tensor:
         """Per pair: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
         steps on the concave, piecewise-linear meter reading; differentiable through the iterations)."""
         f = self.probe_features
         n = len(self.pairs)
-        total = self.compose(effects, params, f, gamma).mean(1).reshape(n, -1)
-        target = physics.decode(f["scene"], gamma).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
+        total = self.compose(effects, params, f, decode).mean(1).reshape(n, -1)
+        target = decode(f["scene"]).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
         k = torch.ones(n, dtype=total.dtype)
         for _ in range(12):
             lit = (k[:, None] * total < 1.0).to(total.dtype)
@@ -325,27 +381,23 @@ class BlindingFrames(PixelProblem):
         return k ** params["auto_exposure"]
 
     def predict_features(self, effects, params, f):
-        gamma = self.tone(effects, params)
-        total = self.compose(effects, params, f, gamma)
+        decode, encode = self.tone_curve(effects, params)
+        total = self.compose(effects, params, f, decode)
         if "auto_exposure" in effects:
-            total = total * self.exposure_factor(effects, params, gamma)[f["pair"]].unsqueeze(1)
-        return physics.encode(total.clamp(0.0, 1.0), gamma)
+            total = total * self.exposure_factor(effects, params, decode)[f["pair"]].unsqueeze(1)
+        return encode(total.clamp(0.0, 1.0))
 
     def divisor_auto_exposure(self, fit: Fit) -> float:
         """The transform's auto-exposure ``1 / (1 + a * mean injected light)`` (``physics.inject_linear_light``)
         closest, over the fit's frames, to the metered exposure factors (least squares in ``1 / factor - 1``).
         The core extrapolation has no counterpart in the transform, whose spot pattern is not clipped."""
         p, effects = fit.params, fit.effects
-        gamma = self.tone(effects, p)
+        decode, _ = self.tone_curve(effects, p)
         with torch.no_grad():
-            factor = self.exposure_factor(effects, p, gamma)
+            factor = self.exposure_factor(effects, p, decode)
             level = p["gain"] if "linear_light_saturation" in effects else p["alpha"]
             f = self.probe_features
-            light = (
-                level
-                * f["strength"]
-                * (physics.decode(f["pattern"], gamma) - physics.decode(f["dark"], gamma))
-            )
+            light = level * f["strength"] * (decode(f["pattern"]) - decode(f["dark"]))
             metered = light.clamp(min=0.0).mean(1).reshape(len(self.pairs), -1).mean(1)
             excess = 1.0 / factor.clamp(min=1e-6) - 1.0
         return float(max((metered * excess).sum() / (metered**2).sum().clamp(min=1e-12), 0.0))
@@ -360,10 +412,15 @@ class BlindingFrames(PixelProblem):
         return {
             "model": "physical",
             "gain": p["gain"] if linear else p["alpha"],
-            "glare_amplitude": p.get("halo_amplitude", 0.0),
+            "glare_amplitude": float(halo_amplitude(p)) if "halo_power_law" in effects else 0.0,
             "glare_exponent": p.get("halo_exponent", 2.0),
             "glare_scale_ref_px": p.get("halo_scale_ref_px", 8.0),
             "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
-            # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0)
-            "gamma": p["gamma"] if "sensor_gamma" in effects else (None if linear else 1.0),
+            # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); the
+            # transform knows power laws only, so a fitted shoulder gives it the closest one
+            "gamma": equivalent_power_gamma(p, p.get("gamma"))
+            if "tone_shoulder" in effects
+            else p["gamma"]
+            if "sensor_gamma" in effects
+            else (None if linear else 1.0),
         }

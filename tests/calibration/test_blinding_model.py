@@ -1,0 +1,63 @@
+"""The laser blinding frame model's parametrisation: glare fitted by its level where the frames show it, and the
+tone curves the laser's light is composed in (``calibration/frame_models/laser_blinding.py``)."""
+
+from __future__ import annotations
+
+import pytest
+import torch
+
+from lerobot_phantom.calibration.frame_models.laser_blinding import (
+    GLARE_REFERENCE_PX,
+    BlindingFrames,
+    halo_amplitude,
+)
+from lerobot_phantom.transforms import physics
+
+
+@pytest.mark.parametrize(
+    ("level", "exponent", "scale"), [(0.02, 2.0, 8.0), (0.7, 4.5, 40.0), (3.0, 8.0, 0.3)]
+)
+def test_glare_level_is_the_glare_at_the_reference_distance(level, exponent, scale):
+    params = {"halo_level": level, "halo_exponent": exponent, "halo_scale_ref_px": scale}
+    radius = torch.tensor([0.0, GLARE_REFERENCE_PX, 4 * GLARE_REFERENCE_PX], dtype=torch.float64)
+    glare = physics.power_law_halo(radius, halo_amplitude(params), exponent, scale)
+    assert float(glare[1]) == pytest.approx(level, rel=1e-9)
+    # and it is the transform's power law: brighter inside, fainter outside
+    assert float(glare[0]) > level > float(glare[2])
+
+
+def test_glare_and_tone_shoulder_build_on_linear_light():
+    requires = {e.name: e.requires for e in BlindingFrames.candidates}
+    assert requires["halo_power_law"] == ("linear_light_saturation",)
+    assert requires["tone_shoulder"] == ("linear_light_saturation",)
+    assert requires["linear_light_saturation"] == ()
+
+
+@pytest.mark.parametrize(
+    ("effects", "params"),
+    [
+        ({"linear_light_saturation"}, {}),
+        ({"linear_light_saturation", "sensor_gamma"}, {"gamma": 2.6}),
+        ({"linear_light_saturation", "tone_shoulder"}, {"shoulder": 30.0, "shoulder_exponent": 1.2}),
+        (
+            {"linear_light_saturation", "tone_shoulder", "sensor_gamma"},
+            {"shoulder": 5.0, "shoulder_exponent": 0.8, "gamma": 1.4},
+        ),
+    ],
+)
+def test_tone_curves_invert(effects, params):
+    decode, encode = BlindingFrames.tone_curve(frozenset(effects), params)
+    pixels = torch.linspace(0.02, 0.98, 49, dtype=torch.float64)
+    assert torch.allclose(encode(decode(pixels)), pixels, atol=1e-9)
+    assert bool((decode(pixels).diff() > 0).all())
+
+
+def test_a_shoulder_lifts_the_shadows_above_srgb():
+    # a filmic curve stores faint light far brighter than sRGB: 1% of the full well at ~50 grey levels, not 25
+    srgb_decode, _ = BlindingFrames.tone_curve(frozenset({"linear_light_saturation"}), {})
+    _, shoulder_encode = BlindingFrames.tone_curve(
+        frozenset({"linear_light_saturation", "tone_shoulder"}), {"shoulder": 24.0, "shoulder_exponent": 1.0}
+    )
+    faint = torch.tensor([0.01], dtype=torch.float64)
+    assert float(shoulder_encode(faint)) > 1.8 * float(physics.encode(faint, None))
+    assert float(srgb_decode(physics.encode(faint, None))) == pytest.approx(0.01, rel=1e-9)
