@@ -290,7 +290,9 @@ class PixelProblem(FrameProblem):
             self.param_specs(effects),
             lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
             warm=self.warm(start, effects),
-            starts=[{}] if start is not None else [],  # also from the defaults: saturated starts can stall
+            # also from the defaults when extending a model (saturated starts can stall); a refit of the same
+            # model on resampled items (the bootstrap) starts from its own optimum only, as capture refits do
+            starts=[{}] if start is not None and start.effects != effects else [],
         )
         return Fit(effects, params)
 
