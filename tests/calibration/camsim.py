@@ -312,7 +312,7 @@ def laser_blinding_pairs(
     saturated core hides the profile). The tail, 0.2-0.8% of the core's peak a quarter of the frame's diagonal out
     and falling as a power (1.5-2.2) of the distance beyond 3-6 px, then sinks into the capture's dark noise and
     8-bit steps, while at the attack's tens of times that power it lights the scene far around the spot (on
-    average 1-9 grey levels over the frame at intensity 0.6, measured over 20 draws): glare the pattern does not
+    average 1-14 grey levels over the frame at intensity 0.6 over 20 draws, docs/bench/camsim_glare_size.py): glare the pattern does not
     hold. (A capture at a few percent of the attack's power still saturates its core and keeps the tail where the
     attack shows it.)
     ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha * intensity, in 8-bit
@@ -323,7 +323,7 @@ def laser_blinding_pairs(
     if halo:
         # the glare is drawn by where it shows: its level a quarter of the frame's diagonal from the spot, as a
         # share of the core's peak. Drawn as an amplitude of 0.5-1.5% of the core at 1-2.5 px scales (until
-        # session 12), the tail changed the blinded frames by 0.01-0.9 grey levels on average (measured over 13
+        # session 12), the tail changed the blinded frames by at most 0.43 grey levels on average (measured over 13
         # draws), under the spot's own bloom and the frames' noise: a planted effect no calibration could see
         scale_px, exponent = rng.uniform(3.0, 6.0), rng.uniform(1.5, 2.2)
         at_quarter = np.exp(rng.uniform(np.log(2e-3), np.log(8e-3)))
