@@ -7,12 +7,21 @@ that falls off as a power law. Items are square tiles of the capture; held-out t
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.core import (
+    Effect,
+    Fit,
+    Param,
+    Problem,
+    binned_rmse,
+    fit_least_squares,
+    further_starts,
+)
 from lerobot_phantom.calibration.frame_models.common import REFERENCE_SIZE, SENSOR_GAMMA, load_rgb
 from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms import physics
@@ -192,7 +201,7 @@ class CaptureProblem(Problem):
             self.param_specs(effects, self.initial_guess(items)),
             lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
-            starts=[{}] if warm and not refit else [],  # also from the defaults: saturated starts can stall
+            starts=further_starts(start, effects),
             max_nfev=20 if refit else 60,
         )
         return Fit(effects, params)
@@ -351,7 +360,7 @@ class MultiCapture(Problem):
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         return [
-            Param(f"{c.path.name}.{p.name}", p.init, p.low, p.high, p.scale)
+            dataclasses.replace(p, name=f"{c.path.name}.{p.name}")
             for c in self.captures
             for p in c.param_specs(effects)
         ]

@@ -62,6 +62,16 @@ class Fit:
     extra: dict = field(default_factory=dict)  # per-item nuisance values etc.
 
 
+def further_starts(start: Fit | None, effects: frozenset[str]) -> list[dict[str, float]]:
+    """Starts of a warm-started fit beside the warm one (``fit_least_squares(starts=...)``).
+
+    A model extending a nested fit also starts from the defaults: a warm start from a nested model's optimum can
+    stall (a saturated spot's fit at the blend's values). A refit of the same model on resampled items (the
+    bootstrap of identify.py) starts from its own estimate only: the defaults would double its cost and, when
+    they win, measure the optimiser's other basin rather than the items' variation."""
+    return [{}] if start is not None and start.effects != effects and start.params else []
+
+
 def fit_least_squares(
     params: Sequence[Param],
     residuals: Callable[[dict[str, torch.Tensor]], torch.Tensor],

@@ -18,7 +18,15 @@ import numpy as np
 import pandas as pd
 import torch
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.core import (
+    Effect,
+    Fit,
+    Param,
+    Problem,
+    binned_rmse,
+    fit_least_squares,
+    further_starts,
+)
 from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
@@ -241,7 +249,7 @@ class TripleProblem(Problem):
             projection_specs(effects),
             lambda p: (self.predict(effects, p, items) - target).ravel(),
             warm=projection_warm(start, effects),
-            starts=[{}] if start is not None else [],  # also from the defaults: saturated starts can stall
+            starts=further_starts(start, effects),
         )
         return Fit(effects, params)
 

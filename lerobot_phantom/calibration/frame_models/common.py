@@ -18,7 +18,15 @@ import torch
 from PIL import Image
 from scipy.special import logsumexp
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
+from lerobot_phantom.calibration.core import (
+    Effect,
+    Fit,
+    Param,
+    Problem,
+    binned_rmse,
+    fit_least_squares,
+    further_starts,
+)
 from lerobot_phantom.calibration.structure import LAG, ResidualSample
 
 REFERENCE_SIZE = 256
@@ -290,9 +298,7 @@ class PixelProblem(FrameProblem):
             self.param_specs(effects),
             lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
             warm=self.warm(start, effects),
-            # also from the defaults when extending a model (saturated starts can stall); a refit of the same
-            # model on resampled items (the bootstrap) starts from its own optimum only, as capture refits do
-            starts=[{}] if start is not None and start.effects != effects else [],
+            starts=further_starts(start, effects),
         )
         return Fit(effects, params)
 
