@@ -15,7 +15,9 @@ The rule (:func:`identify`): an extension is a named cause only if
    with those of its dependants that pass 2-5 on their own (an effect of no use alone is still not named unless
    what it makes possible is);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
-   range, not the camera);
+   range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare's
+   inner scale below a pixel is a pure power law outside the clipped core); a value there is reported in the
+   result's ``notes`` as at its limit, an upper bound on the quantity, and the effect is judged by the rest;
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
    least one such parameter excludes its null value;
@@ -142,6 +144,7 @@ class Identification:
     effect: str
     identified: bool
     reasons: tuple[str, ...]
+    notes: tuple[str, ...] = ()  # parameters at their physical limit (rule 3): said, but not a reason
 
     def as_dict(self) -> dict:
         return {
@@ -149,6 +152,7 @@ class Identification:
             "status": "identified" if self.identified else "not identified",
             "identified": self.identified,
             "reasons": list(self.reasons),
+            "notes": list(self.notes),
         }
 
 
@@ -161,14 +165,18 @@ def identify(
     bounds: Mapping[str, tuple[float, float]],
     intervals: Mapping[str, Interval],
     nulls: Mapping[str, float],
+    limits: Mapping[str, str] | None = None,
 ) -> Identification:
     """Apply the module's rule to one extension.
 
     ``params``/``bounds``: the extension's own fitted parameters and their search ranges; ``intervals``: their
     bootstrap intervals; ``nulls``: the parameter values at which the extension reduces to the model without it
     (empty when it has none: a change of functional form); ``validation_ratio``: the paired bootstrap interval
-    of the inner cross-validated error ratio without / with the extension (None if it was never scored)."""
-    reasons = []
+    of the inner cross-validated error ratio without / with the extension (None if it was never scored);
+    ``limits``: parameter -> what the model is at its low bound, for bounds that are the form's physical limit
+    (``Param.low_limit``)."""
+    limits = limits or {}
+    reasons, notes = [], []
     if not selected:
         reasons.append("not selected by the inner cross-validation on the fit items")
     if validation_ratio is None:
@@ -181,7 +189,12 @@ def identify(
         )
     for name, value in params.items():
         side = at_bound(value, *bounds[name])
-        if side is not None:
+        if side == "low" and limits.get(name):
+            notes.append(
+                f"{name} = {value:.4g} sits at its low bound, the form's physical limit: {limits[name]}; the value "
+                "is an upper bound, not a measurement"
+            )
+        elif side is not None:
             reasons.append(
                 f"{name} = {value:.4g} sits at its {side} bound {bounds[name][side == 'high']:.4g}"
             )
@@ -197,7 +210,7 @@ def identify(
                 + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
                 + " at which the extension reduces to the model without it"
             )
-    return Identification(effect, not reasons, tuple(reasons))
+    return Identification(effect, not reasons, tuple(reasons), tuple(notes))
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -296,6 +309,7 @@ def identify_selection(
             bounds={p.name: (p.low, p.high) for p in specs},
             intervals={p.name: intervals[p.name] for p in specs},
             nulls=nulls,
+            limits={p.name: p.low_limit for p in specs if p.low_limit},
         )
         result = outcome.as_dict()
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
@@ -307,6 +321,8 @@ def identify_selection(
             result["reasons"].extend(failed)
         result.update(
             validation_ratio=None if ratio is None else ratio.as_dict(),
+            # the selection steps the ratio compares (an interacting pair: from the step before the pair)
+            compared_steps=[before, after],
             judged_with=sorted(hosted),
             params={p.name: selected_fit.params[p.name] for p in specs},
             intervals={p.name: intervals[p.name].as_dict() for p in specs},

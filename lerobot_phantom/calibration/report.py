@@ -13,7 +13,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
   rejected};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
-  validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio includes),
+  notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
+  compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio includes),
   params, intervals, nulls} (rule: ``calibration/identify.py``);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
@@ -96,16 +97,17 @@ def build_report(
         if not result["identified"]:
             continue
         effect = result["effect"]
-        step = next(s for s in steps if effect in s.effects)
-        before = steps[steps.index(step) - 1]
+        before, step = (steps[k] for k in result["compared_steps"])
         hosted = result.get("judged_with", [])
-        if hosted:
-            step = next(s for s in steps if set(s.effects) >= {effect, *hosted})
+        # a pair taken in one selection step (or effects selected between it and those it hosts) are in the
+        # ratio too: the evidence names them
+        together = sorted(set(step.effects) - set(before.effects) - {effect} - set(hosted))
         interval = result["validation_ratio"]
         evidence = (
             f"inner validation {score_name} {before.validation_error:.3g} -> {step.validation_error:.3g} "
             f"{problem.units} "
             + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
+            + (f"together with {', '.join(together)}, in the same comparison " if together else "")
             + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
             f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
         )
@@ -114,6 +116,8 @@ def build_report(
                 f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
                 for k, v in result["intervals"].items()
             )
+        if result.get("notes"):
+            evidence += "; " + "; ".join(result["notes"])
         detail = problem.evidence(effect, base, extended, fit_items)  # the base's residual on the fit items
         if detail:
             evidence += "; " + detail

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 import torch
@@ -120,6 +122,26 @@ def test_each_condition_alone_makes_it_not_identified(override, reason):
     assert any(reason in r for r in result.reasons), result.reasons
 
 
+def test_a_parameter_at_its_declared_physical_limit_is_a_note_not_a_reason():
+    """A glare's inner scale at its low bound is the form's limit (a pure power law): said, not disqualifying.
+    The same value without the declaration, or at the other bound, is still a parameter pinned at a bound."""
+    arguments = {
+        "params": {"halo_amplitude": 0.5, "halo_exponent": 2.5, "halo_scale": 0.3},
+        "bounds": {"halo_amplitude": (0.0, 50.0), "halo_exponent": (0.2, 8.0), "halo_scale": (0.3, 200.0)},
+    }
+    limit = {"halo_scale": "a pure power law"}
+    at_limit = identified(**arguments, limits=limit)
+    assert at_limit.identified and at_limit.reasons == ()
+    assert len(at_limit.notes) == 1 and "halo_scale = 0.3" in at_limit.notes[0]
+    assert "a pure power law" in at_limit.as_dict()["notes"][0]
+    undeclared = identified(**arguments)
+    assert not undeclared.identified and "halo_scale = 0.3 sits at its low bound" in undeclared.reasons[0]
+    at_high = identified(
+        **{**arguments, "params": {**arguments["params"], "halo_scale": 200.0}}, limits=limit
+    )
+    assert not at_high.identified and "sits at its high bound" in at_high.reasons[0]
+
+
 def test_a_change_of_functional_form_needs_no_null_value():
     assert identified(nulls={}).identified
 
@@ -169,6 +191,51 @@ def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
     assert any("threshold = 0 sits at its low bound" in r for r in child["reasons"])
     assert selection.identified == ["parent"]
     assert selection.fit.effects == {"parent"} and set(selection.fit.params) == {"rate"}
+
+
+def test_a_pair_taken_in_one_step_is_compared_with_the_model_before_the_pair():
+    """Selection took parent and child as one step (``paired``): both are judged against the model before the
+    pair, and the result says which steps its ratio compares (the report quotes those steps' errors)."""
+    problem = ChildAtItsLimit()
+    items = np.arange(20)
+    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+    steps = [
+        Step([], 2.0, {}, 4.0 * per_item),
+        Step(["parent"], 1.9, {}, 3.8 * per_item, paired=True),
+        Step(["child", "parent"], 0.9, {}, per_item),
+    ]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    for result in selection.results:
+        assert result["compared_steps"] == [0, 2], result["effect"]
+        assert result["validation_ratio"]["estimate"] == pytest.approx(2.0)  # sqrt(4): RMSE from squared sums
+
+
+class ChildAtItsLimit(ParentAndChild):
+    """The same, with the child's low bound declared the form's physical limit."""
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        return [
+            dataclasses.replace(p, low_limit="no threshold at all") if p.name == "threshold" else p
+            for p in super().param_specs(effects)
+        ]
+
+
+def test_a_child_at_its_declared_limit_is_identified_with_a_note():
+    problem = ChildAtItsLimit()
+    items = np.arange(20)
+    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+    steps = [
+        Step([], 2.0, {}, 4.0 * per_item),
+        Step(["parent"], 1.0, {}, per_item),
+        Step(["child", "parent"], 0.9, {}, 0.8 * per_item),
+    ]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    parent, child = selection.results
+    assert parent["identified"] and child["identified"], child["reasons"]
+    assert child["notes"] and "no threshold at all" in child["notes"][0] and not parent["notes"]
+    assert sorted(selection.identified) == ["child", "parent"]
 
 
 def rotation_blur(image: torch.Tensor, max_deg: float, samples: int = 16) -> torch.Tensor:

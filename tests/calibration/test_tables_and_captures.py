@@ -43,6 +43,20 @@ def test_colour_triples_find_additive_light(tmp_path):
     assert {"additive_light", "albedo_modulation"} <= set(report["extended"]["effects"])
     assert report["extended"]["heldout_rmse"] < 3.0
     assert report["gain"]["rmse_ratio"] >= 1.5
+    assert_evidence_quotes_the_compared_steps(report)
+
+
+def assert_evidence_quotes_the_compared_steps(report: dict) -> None:
+    """Each finding's evidence quotes the validation errors of the two steps its error ratio compares, and the
+    ratio is theirs (RMSE scores: the ratio of the two inner-validation RMSEs)."""
+    steps = report["selection"]["steps"]
+    evidence = {f["effect"]: f["evidence"] for f in report["findings"]}
+    for result in report["identification"]:
+        if not result["identified"]:
+            continue
+        before, after = (steps[k]["validation_error"] for k in result["compared_steps"])
+        assert f"{before:.3g} -> {after:.3g}" in evidence[result["effect"]]
+        assert result["validation_ratio"]["estimate"] == pytest.approx(before / after, rel=1e-6)
 
 
 def test_capture_pixel_samples_follow_the_seed(tmp_path):

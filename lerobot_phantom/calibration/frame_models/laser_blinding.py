@@ -304,7 +304,17 @@ class BlindingFrames(PixelProblem):
             specs += [
                 Param("halo_level", 0.02, 0.0, 5.0, scale=0.02),
                 Param("halo_exponent", 2.0, 0.2, 8.0, scale=1.0),
-                Param("halo_scale_ref_px", 8.0, 0.3, 200.0, scale=8.0),
+                Param(
+                    "halo_scale_ref_px",
+                    8.0,
+                    0.3,
+                    200.0,
+                    scale=8.0,
+                    # an inner scale far inside the clipped core is unseen, and as it shrinks the form converges
+                    # to level * (R / r) ** exponent: the glare is then a pure power law where the frames show it
+                    low_limit="an inner scale far inside the clipped core (0.3 reference px), where the glare is a "
+                    "pure power law, level x (reference distance / r) ^ exponent",
+                ),
             ]
         if "auto_exposure" in effects:
             # power of the meter's exposure factor (module docstring): 0 = no reaction; a central spot can
