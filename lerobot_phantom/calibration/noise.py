@@ -33,8 +33,13 @@ term is *there*; how *much* it matters is its share of the modelled residual var
 only if (1) the inner k-fold validation on the fit pairs shows a ratio above 1 (it predicts the variance of pairs
 it was not fitted on better than without it), (2) the bootstrap interval (over fit pairs) of ``shot`` excludes its
 null value 0, and (3) photon noise is the main part of the residual: at least ``SHOT_SHARE`` of its modelled
-variance, averaged over the fit pairs' residuals. A camera's photon noise is always present; it is named as a
-cause of the residual only where it is what the residual mostly is. It runs after the mean
+variance, averaged over the fit pairs' residuals, and (4) the model follows the residual's variance across the
+signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
+not above ``TREND_FACTOR``; read noise is the steepest fall any sensor noise has under a curve, so a faster one
+means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it is named as a cause of the residual only
+where it is what the residual mostly is. When (4) fails the curve the residuals were read through is not the
+camera's, and the report says "not identifiable" with why, instead of dividing the variance between two terms that
+the frames cannot tell apart. It runs after the mean
 model is selected, on that model's residuals, and changes no prediction: it is reported under ``noise`` and in the
 findings, never as an effect of the written (mean) model.
 """
@@ -58,6 +63,11 @@ SAMPLES_PER_PAIR = 4000
 CLIP_GUARD = 3.0  # grey levels: clipped pixels have no noise, so pixels near 0 or 255 say nothing about it
 QUANTISATION_VARIANCE = 2.0 / 12.0  # grey levels^2: the residual of two frames each rounded to 8 bits
 SHOT_SHARE = 0.5  # photon noise must be at least this share of the residual's modelled variance to be named
+# the residual's variance may fall with the signal at most this factor faster than the noise model says (darkest
+# vs brightest quarter, its interval above it): otherwise the tone curve it is read through is not the camera's.
+# Measured on the independent simulator's EM truncation frames (docs/bench/camsim_session13.md): 0.75-1.02 under
+# sRGB and power-law cameras, 2.1-4.5 under a filmic shoulder read as sRGB
+TREND_FACTOR = 1.5
 TERMS = ("detail", "read_var", "shot")
 
 
@@ -183,6 +193,23 @@ def shot_share(sample: NoiseSample, coef: dict[str, float]) -> float:
     return float(np.mean(shot / model_variance(sample, coef))) if len(shot) else 0.0
 
 
+def variance_trend(sample: NoiseSample, coef: dict[str, float], bins: int = 4) -> float:
+    """How much faster the residual's variance falls with the signal than the noise model says: the ratio of
+    measured to modelled variance in the darkest ``1 / bins`` of the sample over that in the brightest (1: the
+    model follows the variance across the signal)."""
+    order = np.argsort(sample.signal)
+    if len(order) < 2 * bins:
+        return float("nan")
+    darkest, brightest = order[: len(order) // bins], order[-(len(order) // bins) :]
+    variance = model_variance(sample, coef)
+
+    def ratio(index: np.ndarray) -> float:
+        return float(np.mean(sample.residual[index] ** 2) / np.mean(variance[index]))
+
+    bright = ratio(brightest)
+    return ratio(darkest) / bright if bright > 0 else float("nan")  # no residual at all: nothing to follow
+
+
 def select_shot_noise(
     problem,
     fit: Fit,
@@ -222,7 +249,7 @@ def select_shot_noise(
     def statistic(items: np.ndarray) -> dict[str, float]:
         sample = joined(items)
         coef = fit_variance(sample, True)
-        return {**coef, "share": shot_share(sample, coef)}
+        return {**coef, "share": shot_share(sample, coef), "trend": variance_trend(sample, coef)}
 
     intervals: dict[str, Interval] = bootstrap(
         statistic, np.asarray(fit_items), draws=draws, rng=np.random.default_rng([seed, 4])
@@ -238,6 +265,20 @@ def select_shot_noise(
             f"the interval of shot ({intervals['shot'].low:.3g}-{intervals['shot'].high:.3g}) includes the null "
             "value 0 (no photon noise)"
         )
+    trend = intervals["trend"]
+    # one-sided: read noise is the steepest fall with the signal any sensor noise has under a curve, so a faster
+    # fall means the curve compresses bright values more than the one assumed (a shoulder). A slower one is
+    # what photon noise is, so it says nothing against the curve
+    curve_fails = trend.low > TREND_FACTOR
+    if curve_fails:
+        reasons.append(
+            f"not identifiable: read through the {tone_curve_name(curve)} tone curve, the residual's variance "
+            f"falls with the signal {trend.estimate:.2f}x "
+            f"({100 * trend.level:.0f}% interval {trend.low:.2f}-{trend.high:.2f}; darkest vs brightest quarter, "
+            f"relative to the noise model) beyond what any sensor noise can (named within {TREND_FACTOR:g}x): the "
+            "camera's curve is not that one (a highlight shoulder compresses bright values more), and from frames "
+            "that carry nothing about the curve, photon and read noise cannot be told apart"
+        )
     if intervals["share"].estimate < SHOT_SHARE:
         reasons.append(
             f"photon noise is {intervals['share'].estimate:.0%} of the residual's modelled variance (named from "
@@ -245,7 +286,7 @@ def select_shot_noise(
         )
     return {
         "kept": not reasons,
-        "status": "identified" if not reasons else "not identified",
+        "status": "identified" if not reasons else "not identifiable" if curve_fails else "not identified",
         "reasons": reasons,
         "criterion": "Gaussian likelihood of the residuals with variance quantisation + detail D + J^2 (read^2 + "
         f"shot x) in linear light (J: tone-curve slope, D: local 3x3 variance) vs shot = 0, {folds}-fold "
@@ -256,6 +297,7 @@ def select_shot_noise(
         "validation_noise_scale_ratio": validation_ratio,
         "heldout_noise_scale_ratio": heldout_ratio,
         "shot_share": intervals["share"].as_dict(),
+        "variance_trend": intervals["trend"].as_dict(),
         "constant": {"read_noise_grey": 255.0 * math.sqrt(without["read_var"])},
         # linear-light grey levels (linear light x 255): read noise sd, shot variance per grey level of signal
         "shot_noise": {

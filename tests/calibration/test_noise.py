@@ -15,6 +15,7 @@ import torch
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.noise import (
     QUANTISATION_VARIANCE,
+    TREND_FACTOR,
     NoiseSample,
     fit_variance,
     linearise,
@@ -42,24 +43,40 @@ class IdentityProblem:
         return self.pairs[index].clean
 
 
-def capture(linear: np.ndarray, rng: np.random.Generator, *, shot: bool, read: float) -> torch.Tensor:
-    """Linear light -> noisy linear (Poisson photons + Gaussian read noise, in full-well units) -> sRGB, 8 bits."""
+def filmic(linear: np.ndarray) -> np.ndarray:
+    """A filmic tone curve with a highlight shoulder (Narkowicz's ACES fit at 3 stops, white at 1), then sRGB's
+    display encoding: bright values are compressed far more than sRGB compresses them."""
+
+    def aces(x):
+        return x * (2.51 * x + 0.03) / (x * (2.43 * x + 0.59) + 0.14)
+
+    return physics.encode(torch.from_numpy(aces(3.0 * linear) / aces(3.0)), None).numpy()
+
+
+def capture(
+    linear: np.ndarray, rng: np.random.Generator, *, shot: bool, read: float, tone: str = "srgb"
+) -> torch.Tensor:
+    """Linear light -> noisy linear (Poisson photons + Gaussian read noise, in full-well units) -> the tone curve
+    (sRGB or ``filmic``), 8 bits."""
     if shot:
         linear = rng.poisson(linear * FULL_WELL) / FULL_WELL
-    linear = linear + rng.normal(0.0, read, linear.shape)
-    encoded = physics.encode(torch.from_numpy(np.clip(linear, 0.0, 1.0)), None)
+    linear = np.clip(linear + rng.normal(0.0, read, linear.shape), 0.0, 1.0)
+    if tone == "filmic":
+        encoded = torch.from_numpy(filmic(linear))
+    else:
+        encoded = physics.encode(torch.from_numpy(linear), None)
     return torch.round(255.0 * encoded) / 255.0
 
 
-def frame_pairs(seed: int, *, shot: bool, read: float, n_pairs: int = 8) -> list[Frames]:
+def frame_pairs(seed: int, *, shot: bool, read: float, n_pairs: int = 8, tone: str = "srgb") -> list[Frames]:
     """Scenes of flat 8x8 blocks (levels 0.02-0.9 of full scale, linear), captured twice."""
     rng = np.random.default_rng(seed)
     pairs = []
     for _ in range(n_pairs):
         blocks = rng.uniform(0.02, 0.9, (3, 6, 8))
         scene = np.kron(blocks, np.ones((8, 8)))
-        clean = capture(scene, rng, shot=shot, read=read)
-        pairs.append(Frames(capture(scene, rng, shot=shot, read=read), clean))
+        clean = capture(scene, rng, shot=shot, read=read, tone=tone)
+        pairs.append(Frames(capture(scene, rng, shot=shot, read=read, tone=tone), clean))
     return pairs
 
 
@@ -111,6 +128,19 @@ def test_photon_noise_is_named_although_flat_in_output_units():
     assert noise["shot_noise"]["shot_gain_grey"] == pytest.approx(2 * 255.0 / FULL_WELL, rel=0.25)
     assert noise["intervals"]["shot_gain_grey"]["low"] > 0.0
     assert noise["shot_share"]["estimate"] >= 0.5
+    assert noise["status"] == "identified"
+    trend = noise["variance_trend"]
+    assert trend["low"] <= trend["high"] < TREND_FACTOR
+
+
+def test_photon_noise_under_an_unknown_filmic_curve_is_reported_not_identifiable():
+    """Read through sRGB, a filmic camera's noise falls with the signal faster than any sensor noise can: the
+    report says the curve is wrong rather than splitting the variance between read and photon noise."""
+    noise = select(frame_pairs(1, shot=True, read=1.5 / FULL_WELL, tone="filmic"))
+    assert not noise["kept"]
+    assert noise["status"] == "not identifiable"
+    assert noise["variance_trend"]["low"] > TREND_FACTOR
+    assert any(r.startswith("not identifiable") and "sRGB" in r for r in noise["reasons"]), noise["reasons"]
 
 
 @pytest.mark.parametrize("read", [0.0, 0.01], ids=["no sensor noise", "read noise only"])
