@@ -174,17 +174,23 @@ def test_own_params_of_a_parent_exclude_its_dependants_params():
     assert [p.name for p in own_params(problem, both, "child")] == ["threshold"]
 
 
-def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
-    problem = ParentAndChild()
+PER_ITEM = np.random.default_rng(0).uniform(1.0, 2.0, 20)
+ONE_AT_A_TIME = [
+    Step([], 2.0, {}, 4.0 * PER_ITEM),
+    Step(["parent"], 1.0, {}, PER_ITEM),
+    Step(["child", "parent"], 0.9, {}, 0.8 * PER_ITEM),
+]
+
+
+def select_parent_and_child(problem: ParentAndChild, steps: list[Step]):
+    """identify_selection over 20 items, each step's model fitted on all of them."""
     items = np.arange(20)
-    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
-    steps = [
-        Step([], 2.0, {}, 4.0 * per_item),
-        Step(["parent"], 1.0, {}, per_item),
-        Step(["child", "parent"], 0.9, {}, 0.8 * per_item),
-    ]
     chain = [problem.fit(frozenset(s.effects), items) for s in steps]
-    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    return identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+
+
+def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
+    selection = select_parent_and_child(ParentAndChild(), ONE_AT_A_TIME)
     parent, child = selection.results
     assert parent["effect"] == "parent" and parent["identified"], parent["reasons"]
     assert child["effect"] == "child" and not child["identified"]
@@ -196,16 +202,12 @@ def test_a_child_at_its_bound_is_not_identified_and_its_parent_still_is():
 def test_a_pair_taken_in_one_step_is_compared_with_the_model_before_the_pair():
     """Selection took parent and child as one step (``paired``): both are judged against the model before the
     pair, and the result says which steps its ratio compares (the report quotes those steps' errors)."""
-    problem = ChildAtItsLimit()
-    items = np.arange(20)
-    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
     steps = [
-        Step([], 2.0, {}, 4.0 * per_item),
-        Step(["parent"], 1.9, {}, 3.8 * per_item, paired=True),
-        Step(["child", "parent"], 0.9, {}, per_item),
+        Step([], 2.0, {}, 4.0 * PER_ITEM),
+        Step(["parent"], 1.9, {}, 3.8 * PER_ITEM, paired=True),
+        Step(["child", "parent"], 0.9, {}, PER_ITEM),
     ]
-    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
-    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    selection = select_parent_and_child(ChildAtItsLimit(), steps)
     for result in selection.results:
         assert result["compared_steps"] == [0, 2], result["effect"]
         assert result["validation_ratio"]["estimate"] == pytest.approx(2.0)  # sqrt(4): RMSE from squared sums
@@ -222,16 +224,7 @@ class ChildAtItsLimit(ParentAndChild):
 
 
 def test_a_child_at_its_declared_limit_is_identified_with_a_note():
-    problem = ChildAtItsLimit()
-    items = np.arange(20)
-    per_item = np.random.default_rng(0).uniform(1.0, 2.0, 20)
-    steps = [
-        Step([], 2.0, {}, 4.0 * per_item),
-        Step(["parent"], 1.0, {}, per_item),
-        Step(["child", "parent"], 0.9, {}, 0.8 * per_item),
-    ]
-    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
-    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    selection = select_parent_and_child(ChildAtItsLimit(), ONE_AT_A_TIME)
     parent, child = selection.results
     assert parent["identified"] and child["identified"], child["reasons"]
     assert child["notes"] and "no threshold at all" in child["notes"][0] and not parent["notes"]

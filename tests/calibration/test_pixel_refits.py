@@ -38,15 +38,21 @@ def problem() -> Brightened:
     return Brightened(pairs, seed=0)
 
 
-def test_extensions_also_start_from_the_defaults_refits_only_from_the_estimate(monkeypatch):
+def recorded_fits(monkeypatch, module) -> list[dict]:
+    """The keyword arguments of every ``fit_least_squares`` call made through ``module`` (the fits still run)."""
     calls = []
-    real = common.fit_least_squares
+    real = module.fit_least_squares
 
     def recorded(specs, residuals, **kwargs):
         calls.append(kwargs)
         return real(specs, residuals, **kwargs)
 
-    monkeypatch.setattr(common, "fit_least_squares", recorded)
+    monkeypatch.setattr(module, "fit_least_squares", recorded)
+    return calls
+
+
+def test_extensions_also_start_from_the_defaults_refits_only_from_the_estimate(monkeypatch):
+    calls = recorded_fits(monkeypatch, common)
     toy, items = problem(), np.arange(4)
     base = toy.fit(frozenset(), items)
     extended = toy.fit(frozenset({"offset"}), items, start=base)
@@ -68,14 +74,7 @@ def test_further_starts_rule():
 
 def test_colour_triple_refits_start_from_the_estimate_only(monkeypatch, tmp_path):
     """Fails on the code before the rule moved to core: projection refits also started from the defaults."""
-    calls = []
-    real = projection.fit_least_squares
-
-    def recorded(specs, residuals, **kwargs):
-        calls.append(kwargs)
-        return real(specs, residuals, **kwargs)
-
-    monkeypatch.setattr(projection, "fit_least_squares", recorded)
+    calls = recorded_fits(monkeypatch, projection)
     triples = projection.TripleProblem(write_example(tmp_path, rows=120))
     items = np.arange(triples.n_items)
     base = triples.fit(frozenset(), items)
