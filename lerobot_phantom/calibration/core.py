@@ -49,9 +49,9 @@ class Param:
     """A fitted parameter: start value, bounds and a typical magnitude (the optimiser works in ``value/scale``).
 
     ``low_limit``, when given, says what the model *is* at the low bound: a bound where the form converges to a
-    physical limit the frames cannot tell from it (a glare's inner scale below a pixel: a pure power law), rather
-    than an edge of the search. A value there is reported as "at its limit" (an upper bound on the quantity), not
-    as a parameter pinned at a bound (identify.py, rule 3)."""
+    physical limit the frames cannot tell from it (a glare's inner scale far inside the clipped core: a pure power
+    law), rather than an edge of the search. A value there is reported as "at its limit" (an upper bound on the
+    quantity), not as a parameter pinned at a bound (identify.py, rule 3)."""
 
     name: str
     init: float

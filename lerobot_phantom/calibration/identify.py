@@ -15,9 +15,10 @@ The rule (:func:`identify`): an extension is a named cause only if
    with those of its dependants that pass 2-5 on their own (an effect of no use alone is still not named unless
    what it makes possible is);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
-   range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare's
-   inner scale below a pixel is a pure power law outside the clipped core); a value there is reported in the
-   result's ``notes`` as at its limit, an upper bound on the quantity, and the effect is judged by the rest;
+   range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare
+   whose inner scale lies far inside the clipped core is a pure power law where the frames show it); a value there
+   is reported in the result's ``notes`` as at its limit, an upper bound on the quantity, and the effect is judged
+   by the rest;
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
    least one such parameter excludes its null value;

@@ -36,12 +36,12 @@ null value 0, and (3) photon noise is the main part of the residual: at least ``
 variance, averaged over the fit pairs' residuals, and (4) the model follows the residual's variance across the
 signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
 not above ``TREND_FACTOR``; read noise is the steepest fall any sensor noise has under a curve, so a faster one
-means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it is named as a cause of the residual only
-where it is what the residual mostly is. When (4) fails the curve the residuals were read through is not the
-camera's, and the report says "not identifiable" with why, instead of dividing the variance between two terms that
-the frames cannot tell apart. It runs after the mean
-model is selected, on that model's residuals, and changes no prediction: it is reported under ``noise`` and in the
-findings, never as an effect of the written (mean) model.
+means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
+is named as a cause of the residual only where it is what the residual mostly is. When (4) fails, the curve the
+residuals were read through is not the camera's, and the report says "not identifiable" with why, instead of
+dividing the variance between two terms that the frames cannot tell apart. It runs after the mean model is
+selected, on that model's residuals, and changes no prediction: it is reported under ``noise`` and in the findings,
+never as an effect of the written (mean) model.
 """
 
 from __future__ import annotations

@@ -14,8 +14,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   rejected};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
-  compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio includes),
-  params, intervals, nulls} (rule: ``calibration/identify.py``);
+  compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
+  includes), params, intervals, nulls} (rule: ``calibration/identify.py``);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}]} (``calibration/structure.py``);
