@@ -1,0 +1,35 @@
+"""The camera each camsim case draws on given master seeds, exactly as the test draws it (nothing is rendered).
+
+Usage: ``PYTHONPATH=. python docs/bench/camsim_case_cameras.py CASE[,CASE...] SEED...``
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
+
+
+def main() -> None:
+    cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
+    for master in seeds:
+        os.environ["CAMSIM_SEED"] = str(master)
+        sim = importlib.reload(importlib.import_module("test_independent_sim"))
+        for name in cases:
+            case = sim.CASE_BY_NAME[name]
+            rng = np.random.default_rng(sim.case_seed(case))
+            overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
+            if name == "projection_sensor_gamma":
+                overrides.update(sim._gamma_camera(rng))
+            camera = sim.random_camera(rng, **overrides)
+            gamma = f" {camera.tone_gamma:.2f}" if camera.tone == "power" else ""
+            print(f"master {master} {name}: tone {camera.tone}{gamma}, full well {camera.full_well_e:.0f} e")
+
+
+if __name__ == "__main__":
+    main()
