@@ -10,8 +10,6 @@ import os
 import sys
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
 
 
@@ -21,12 +19,7 @@ def main() -> None:
         os.environ["CAMSIM_SEED"] = str(master)
         sim = importlib.reload(importlib.import_module("test_independent_sim"))
         for name in cases:
-            case = sim.CASE_BY_NAME[name]
-            rng = np.random.default_rng(sim.case_seed(case))
-            overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
-            if name == "projection_sensor_gamma":
-                overrides.update(sim._gamma_camera(rng))
-            camera = sim.random_camera(rng, **overrides)
+            _, _, camera = sim.case_camera(sim.CASE_BY_NAME[name])
             gamma = f" {camera.tone_gamma:.2f}" if camera.tone == "power" else ""
             print(f"master {master} {name}: tone {camera.tone}{gamma}, full well {camera.full_well_e:.0f} e")
 

@@ -11,12 +11,13 @@ overrides the drawn tone curve) and calibrates it; prints the seed, the camera's
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import importlib
 import os
 import sys
 import tempfile
 
-import numpy as np
+NAME = "truncation_shot_noise"
 
 
 def main() -> None:
@@ -29,27 +30,20 @@ def main() -> None:
     for master in args.seeds:
         os.environ["CAMSIM_SEED"] = str(master)
         sim = importlib.reload(importlib.import_module("test_independent_sim"))
-        case = sim.CASE_BY_NAME["truncation_shot_noise"]
-        seed = sim.case_seed(case)
-        rng = np.random.default_rng(seed)
-        overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
         if args.tone:
-            overrides["tone"] = args.tone
-        camera = sim.random_camera(rng, **overrides)
+            # a fixed tone replaces the drawn one (a drawn tone then no longer takes its draw from the case's rng)
+            case = sim.CASE_BY_NAME[NAME]
+            sim.CASE_BY_NAME[NAME] = dataclasses.replace(case, camera={**case.camera, "tone": args.tone})
         with tempfile.TemporaryDirectory() as scratch:
-            sim.cs.write_pairs(f"{scratch}/pairs", case.render(rng, camera))
-            report = sim.calibrate(
-                sim.CalibrateConfig(
-                    attack=case.attack, measured=f"{scratch}/pairs", out=f"{scratch}/out", seed=seed % 2**31
-                )
-            )
-        noise = report["noise"]
+            result = sim.run_case(NAME, scratch)  # renders and calibrates exactly as the test does
+        noise, camera = result["report"]["noise"], result["camera"]
         trend = noise["variance_trend"]
         tone = camera.tone + (f" {camera.tone_gamma:.2f}" if camera.tone == "power" else "")
         print(
-            f"master {master} case seed {seed}: {tone}, shot_noise {'named' if noise['kept'] else 'not named'} "
-            f"({noise['status']}), photon share {noise['shot_share']['estimate']:.2f}, variance trend "
-            f"{trend['estimate']:.2f} [{trend['low']:.2f}, {trend['high']:.2f}]",
+            f"master {master} case seed {result['seed']}: {tone}, shot_noise "
+            f"{'named' if noise['kept'] else 'not named'} ({noise['status']}), photon share "
+            f"{noise['shot_share']['estimate']:.2f}, variance trend {trend['estimate']:.2f} "
+            f"[{trend['low']:.2f}, {trend['high']:.2f}]",
             flush=True,
         )
 

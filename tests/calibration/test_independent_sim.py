@@ -357,15 +357,20 @@ def unexplained_structure(report: dict) -> str | None:
     return structure.get("summary") or "structure remains"
 
 
-@cache
-def run_case(name: str, root: str) -> dict:
-    case = CASE_BY_NAME[name]
+def case_camera(case: Case) -> tuple[int, np.random.Generator, cs.Camera]:
+    """The case's seed, its generator (after the camera's draws; the render draws next) and its camera."""
     seed = case_seed(case)
     rng = np.random.default_rng(seed)
     overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
     if case.name == "projection_sensor_gamma":
         overrides.update(_gamma_camera(rng))
-    camera = random_camera(rng, **overrides)
+    return seed, rng, random_camera(rng, **overrides)
+
+
+@cache
+def run_case(name: str, root: str) -> dict:
+    case = CASE_BY_NAME[name]
+    seed, rng, camera = case_camera(case)
     folder = Path(root) / name
     cs.write_pairs(folder / "pairs", case.render(rng, camera))
     report = calibrate(
