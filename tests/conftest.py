@@ -4,16 +4,29 @@ A group runs on one worker. Each test file is a group (its module fixtures and c
 independent simulator's case reports, which the >= 90% naming test reads back), except the directories whose
 ``conftest.py`` builds session artefacts (a trained clean policy, image datasets): all their files share one group,
 so the artefact is built once rather than once per worker.
+
+Tests that draw fresh seeds each run (``CAMSIM_SEED``, ``STRIPES_SEED``; their failures report the seed to replay)
+draw them once per run, in the controlling process, before the workers start: the workers inherit the
+environment, so they collect the same cases and test the same draw.
 """
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 TESTS = Path(__file__).parent
 SESSION_ARTEFACT_DIRS = ("train", "datasets")
+FRESH_SEEDS = ("CAMSIM_SEED", "STRIPES_SEED")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    if not hasattr(config, "workerinput"):  # the controller (or a run without workers): workers inherit these
+        for name in FRESH_SEEDS:
+            os.environ.setdefault(name, str(np.random.SeedSequence().entropy % 2**32))
 
 
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
