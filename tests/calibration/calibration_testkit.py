@@ -98,6 +98,18 @@ def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np
     return srgb_encode(irradiance[..., None] * colour), (cx, cy), colour
 
 
+def metered_exposure(blinded: np.ndarray, clean: np.ndarray) -> float:
+    """The library's auto-exposure meter (``frame_models/laser_blinding.py``): the exposure ``k`` at which the
+    blinded frame's clipped mean level (channel means, clipped at white) equals the clean frame's (bisection; the
+    reading grows monotonically with ``k``)."""
+    level, target = blinded.mean(-1), np.minimum(clean.mean(-1), 1.0).mean()
+    low, high = 1e-4, 10.0
+    for _ in range(60):
+        k = 0.5 * (low + high)
+        low, high = (k, high) if np.minimum(k * level, 1.0).mean() < target else (low, k)
+    return 0.5 * (low + high)
+
+
 def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
     rng = np.random.default_rng(seed)
     truth = {
@@ -106,7 +118,7 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
         "halo_amplitude": rng.uniform(0.3, 0.6),
         "halo_exponent": rng.uniform(1.5, 2.5),
         "halo_scale": rng.uniform(10.0, 25.0),
-        "auto_exposure": rng.uniform(2.0, 5.0),
+        "auto_exposure": rng.uniform(0.7, 1.5),  # power of the meter's exposure (1: a uniform meter)
     }
     rows = []
     for i, (height, width) in enumerate(sizes(rng, n_pairs)):
@@ -128,7 +140,7 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
             light = light + s * halo[..., None] * colour
         total = weight * x + light
         if "auto_exposure" in effects:
-            total = total / (1 + truth["auto_exposure"] * s * srgb_decode(pattern).mean())
+            total = total * metered_exposure(total, x) ** truth["auto_exposure"]
         attacked = encode(np.clip(total, 0, 1))
         for name, image in (("clean", clean), ("attacked", attacked), ("pattern", pattern)):
             save(folder / f"{name}_{i}.png", image, rng, noise=0.0 if name == "pattern" else READ_NOISE)
