@@ -29,6 +29,7 @@ def pytest_configure(config: pytest.Config) -> None:
             os.environ.setdefault(name, str(np.random.SeedSequence().entropy % 2**32))
 
 
+@pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the marks into the test ids
 def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
     for item in items:
         relative = Path(item.path).relative_to(TESTS)
