@@ -7,7 +7,7 @@ so the artefact is built once rather than once per worker.
 
 Tests that draw fresh seeds each run (``CAMSIM_SEED``, ``STRIPES_SEED``; their failures report the seed to replay)
 draw them once per run, in the controlling process, before the workers start: the workers inherit the
-environment, so they collect the same cases and test the same draw.
+environment, so they collect the same cases and test the same draw. The run's last line names them.
 """
 
 from __future__ import annotations
@@ -27,6 +27,11 @@ def pytest_configure(config: pytest.Config) -> None:
     if not hasattr(config, "workerinput"):  # the controller (or a run without workers): workers inherit these
         for name in FRESH_SEEDS:
             os.environ.setdefault(name, str(np.random.SeedSequence().entropy % 2**32))
+
+
+def pytest_terminal_summary(terminalreporter) -> None:
+    seeds = " ".join(f"{name}={os.environ[name]}" for name in FRESH_SEEDS if name in os.environ)
+    terminalreporter.write_line(f"fresh seeds of this run (set them to replay it): {seeds}")
 
 
 @pytest.hookimpl(tryfirst=True)  # before xdist's own hook, which reads the marks into the test ids
