@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 from PIL import Image
-from scipy import ndimage
+from scipy import ndimage, optimize
 
 
 def srgb_decode(v: np.ndarray) -> np.ndarray:
@@ -100,14 +100,9 @@ def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np
 
 def metered_exposure(blinded: np.ndarray, clean: np.ndarray) -> float:
     """The library's auto-exposure meter (``frame_models/laser_blinding.py``): the exposure ``k`` at which the
-    blinded frame's clipped mean level (channel means, clipped at white) equals the clean frame's (bisection; the
-    reading grows monotonically with ``k``)."""
+    blinded frame's clipped mean level (channel means, clipped at white) equals the clean frame's."""
     level, target = blinded.mean(-1), np.minimum(clean.mean(-1), 1.0).mean()
-    low, high = 1e-4, 10.0
-    for _ in range(60):
-        k = 0.5 * (low + high)
-        low, high = (k, high) if np.minimum(k * level, 1.0).mean() < target else (low, k)
-    return 0.5 * (low + high)
+    return optimize.brentq(lambda k: np.minimum(k * level, 1.0).mean() - target, 1e-4, 10.0)
 
 
 def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
