@@ -25,7 +25,7 @@ import pytest
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 
-MASTER_SEED = int(os.environ.get("CAMSIM_SEED") or np.random.SeedSequence().entropy)
+MASTER_SEED = int(os.environ["CAMSIM_SEED"])  # drawn fresh per run by tests/conftest.py
 N_PAIRS = 8
 NAMED_SHARE = 0.9
 # effects any physical render contains to some degree: photon noise; and, where light adds in linear irradiance
