@@ -259,9 +259,25 @@ def scene(rng: np.random.Generator, cam: Camera) -> tuple[np.ndarray, np.ndarray
     return scene_reflectance(rng, cam.height, cam.width), ambient_light(rng, cam.height, cam.width)
 
 
-def clean_capture(irradiance: np.ndarray, cam: Camera, rng: np.random.Generator) -> tuple[np.ndarray, float]:
-    """The clean frame; without auto-exposure the fixed exposure is set once from this scene (a manual setting)."""
-    return capture(irradiance, cam, rng, exposure=meter(optics(irradiance, cam), cam))
+class Session:
+    """One capture session's exposure: a camera with auto-exposure meters every scene; one without keeps the
+    exposure metered on the session's first scene (a manual setting). Re-metering every scene on a manual camera
+    scales each clean frame by a factor nothing in the pair records: against a laser pattern recorded once, or
+    against the surface's reflectance, which sets how much projected light it returns (until session 15 the
+    projection renderer did this, and the reflectance and sensor-gamma effects it planted were then unobservable
+    on some draws)."""
+
+    def __init__(self, cam: Camera) -> None:
+        self.cam = cam
+        self.first_exposure: float | None = None
+
+    def clean(self, irradiance: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, float]:
+        """The clean frame of a scene and the exposure it was taken at."""
+        if self.first_exposure is None or self.cam.auto_exposure:
+            metered = meter(optics(irradiance, self.cam), self.cam)
+            self.first_exposure = metered if self.first_exposure is None else self.first_exposure
+            return capture(irradiance, self.cam, rng, exposure=metered)
+        return capture(irradiance, self.cam, rng, exposure=self.first_exposure)
 
 
 def intensities(rng: np.random.Generator, n: int, low: float = 0.2, high: float = 1.0) -> np.ndarray:
@@ -334,19 +350,14 @@ def laser_blinding_pairs(
     core_fill = rng.uniform(0.5, 0.9) if halo else None
     pairs = []
     dark = 0.01 * ambient_light(rng, cam.height, cam.width)
-    pattern_exposure = None
+    session = Session(cam)
+    pattern_u8 = None
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
-        # a camera without auto-exposure keeps the exposure set on the first scene for the whole session (the
-        # pattern is recorded at it too); re-metering every scene would scale the laser's light relative to the
-        # pattern by a factor nothing in the pair records
-        fixed = None if cam.auto_exposure else pattern_exposure
-        if fixed is None:
-            clean, exposure = clean_capture(refl * light, cam, rng)
-        else:
-            clean, exposure = capture(refl * light, cam, rng, exposure=fixed)
-        if pattern_exposure is None:
-            pattern_exposure = exposure
+        clean, exposure = session.clean(refl * light, rng)
+        if pattern_u8 is None:
+            # recorded at the session's first exposure, kept for the session
+            pattern_exposure = session.first_exposure
             at_core = float(optics(spot, cam).max()) * pattern_exposure
             reference = peak_power if core_fill is None else core_fill / at_core
             pattern, _ = capture(dark + reference * spot, cam, rng, exposure=pattern_exposure)
@@ -409,10 +420,11 @@ def light_projection_pairs(
     board was captured with a different lens-to-board geometry): an effect the library has no name for."""
     mix = np.eye(3) + crosstalk * rng.uniform(0.5, 1.5, (3, 3)) * (1 - np.eye(3))
     board = 0.85
+    session = Session(cam)
     pairs = []
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        clean, exposure = session.clean(refl * light, rng)
         frame = projected_image(rng, cam.height, cam.width)
         projector = (frame**2.2) @ mix.T
         pattern, _ = capture(board * power * projector, cam, rng, exposure=exposure)
@@ -480,10 +492,11 @@ def laser_strip_pairs(
         period_rows = 10.0 * h
         on_rows = rng.uniform(0.08, 0.2) * h
     power = rng.uniform(0.06, 0.12)  # full wells per row time of overlap, at intensity 1
+    session = Session(cam)
     pairs = []
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        clean, exposure = session.clean(refl * light, rng)
         if paper_band is not None:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             attacked_u8 = encode(quantised(attacked) + paper_band * intensity * profile * colour, cam)
@@ -545,10 +558,11 @@ def em_strip_pairs(
         raise ValueError(f"lost_lines {lost_lines!r}; valid: banded, single")
     h = cam.height
     period = float(rng.integers(h // 5, h // 2)) // 2 * 2
+    session = Session(cam)
     pairs = []
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        clean, exposure = session.clean(refl * light, rng)
         if lost_lines == "single":
             band = np.arange(h) >= rng.integers(0, h)
         else:
@@ -588,10 +602,11 @@ def em_truncation_pairs(
     h = cam.height
     ratio_per_intensity = rng.uniform(0.2, 0.3)
     ripple_period, ripple_phase = rng.uniform(0.3, 0.6) * h, rng.uniform(0, 2 * np.pi)
+    session = Session(cam)
     pairs = []
     for intensity in intensities(rng, n_pairs, 0.3, 1.0):
         refl, light = scene(rng, cam)
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        clean, exposure = session.clean(refl * light, rng)
         attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
         n = int(h * ratio_per_intensity * intensity)
         start = int(rng.integers(0, h - n + 1)) if free_position else n
@@ -652,6 +667,7 @@ def ultrasound_blur_pairs(
     amplitude = amplitude_px if amplitude_px is not None else rng.uniform(8, 14)
     unit = np.array([np.sin(direction), np.cos(direction)])
     cycles = rng.uniform(5.2, 8.8)
+    session = Session(cam)
     pairs = []
     for intensity in intensities(rng, n_pairs, 0.3, 1.0):
         refl, light = scene(rng, cam)
@@ -659,7 +675,7 @@ def ultrasound_blur_pairs(
         block = rng.uniform(4, 7)
         yy, xx = np.mgrid[0 : cam.height, 0 : cam.width]
         refl = refl * np.where((yy // block + xx // block) % 2 == 0, 1.0, 0.4)[..., None]
-        clean, exposure = clean_capture(refl * light, cam, rng)
+        clean, exposure = session.clean(refl * light, rng)
         d = intensity * amplitude
         if path == "sinusoidal":
             t = (np.arange(64) + 0.5) / 64
