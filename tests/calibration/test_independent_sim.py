@@ -430,7 +430,7 @@ def test_case(name, root):
 @pytest.mark.xfail(
     reason="issue 12 open: the share of effect cases named swings between draws. Session 15 (camsim's manual "
     "camera keeps one exposure), core selection on six master seeds: 48 of 62 (7/10, 9/11, 8/10, 8/10, 8/10, 8/11; "
-    "before the change 44 of 62). The misses left: blinding_halo and blinding_auto_exposure on filmic cameras (the "
+    "before the change 44 of 62). The misses left: blinding_halo (filmic cameras) and blinding_auto_exposure (the "
     "display gamma fitted over the tone shoulder sends the laser's gain to its bound; with the frames re-encoded to "
     "sRGB all five missed cases tried are named), projection_crosstalk on filmic cameras (albedo), "
     "projection_clipping (the clip gains under the margin). History and measurements: the README, 'Tested against "
