@@ -1,30 +1,39 @@
-"""Condense ``camsim_core_batch.sh``'s summary.txt: per master seed, the share of effect cases named and each miss.
+"""Count, per master seed of a ``camsim_core_batch.sh`` run, the effect cases whose planted effects were named.
 
-Usage: ``python docs/bench/camsim_batch_misses.py OUTDIR/summary.txt``. A seed whose >= 90% naming test passed has
-no assertion line; it is printed with the test counts instead.
+Usage: ``PYTHONPATH=. python docs/bench/camsim_batch_misses.py OUTDIR`` from the repository root. Reads every case's
+``report.json`` that the batch kept under ``OUTDIR/bt_SEED`` and applies the naming test's own rule
+(``test_independent_sim.named_causes``) to the cases that master seed selected, so seeds whose >= 90% test passed
+are counted too.
 """
 
 from __future__ import annotations
 
-import re
+import importlib
+import json
+import os
 import sys
 from pathlib import Path
 
-LINE = re.compile(r"seed (\d+): .*named in (\d+)% of (\d+) cases.*misses: \[(.*)\]; replay")
-MISS = re.compile(r'"(\w+): planted (\[[^\]]*\]), named (\[[^\]]*\])')
+sys.path.insert(0, "tests/calibration")
 
 
 def main() -> None:
-    for line in Path(sys.argv[1]).read_text().splitlines():
-        match = LINE.match(line)
-        if not match:
-            seed = line.split(":")[0]
-            counts = re.findall(r"\d+ (?:passed|failed|xfailed|xpassed)", line)
-            print(f"{seed}: no miss assertion ({', '.join(counts)})")
-            continue
-        seed, share, cases, misses = match.groups()
-        listed = "; ".join(f"{case} named {named}" for case, _, named in MISS.findall(misses))
-        print(f"seed {seed}: {share}% of {cases} effect cases named; misses: {listed}")
+    out = Path(sys.argv[1])
+    for folder in sorted(out.glob("bt_*")):
+        seed = folder.name.removeprefix("bt_")
+        os.environ["CAMSIM_SEED"] = seed
+        sim = importlib.reload(importlib.import_module("test_independent_sim"))
+        effect_cases = [sim.CASE_BY_NAME[n] for n in sim.SELECTED if sim.CASE_BY_NAME[n].kind == "effect"]
+        misses = []
+        for case in effect_cases:
+            report = json.loads((folder / "camsim0" / case.name / "out" / "report.json").read_text())
+            named = sim.named_causes(report)
+            if not case.planted <= named:
+                misses.append(f"{case.name} named {sorted(named)}")
+        named_cases = len(effect_cases) - len(misses)
+        print(
+            f"seed {seed}: {named_cases} of {len(effect_cases)} effect cases named; misses: {'; '.join(misses)}"
+        )
 
 
 if __name__ == "__main__":

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lerobot_phantom.calibration.cli import CalibrateConfig
 from lerobot_phantom.calibration.core import kfold, seeded_split
 from lerobot_phantom.calibration.frame_models.common import load_pairs
 from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
@@ -27,7 +28,8 @@ def describe(problem: BlindingFrames, fit) -> str:
 
 def main() -> None:
     folder, seed = Path(sys.argv[1]), int(sys.argv[2]) % 2**31
-    problem = BlindingFrames(load_pairs(folder, max_side=128), seed)
+    defaults = CalibrateConfig()
+    problem = BlindingFrames(load_pairs(folder, max_side=defaults.max_side), seed)
     every = np.arange(problem.n_items)
     print("intensities", [round(p.intensity, 2) for p in problem.pairs])
     for effects in MODELS:
@@ -35,8 +37,9 @@ def main() -> None:
         print(
             f"all pairs {'+'.join(sorted(effects)) or 'base'}: {problem.rmse(fit, every):.2f}; {describe(problem, fit)}"
         )
-    fit_items, _ = seeded_split(problem.n_items, 0.2, seed)
-    for train, val in kfold(fit_items, 4, seed + 1, 2500):
+    fit_items, _ = seeded_split(problem.n_items, defaults.heldout, seed)
+    # forward_select's folds: seed + 1 and its default cap on training items
+    for train, val in kfold(fit_items, defaults.folds, seed + 1, 2500):
         for effects in MODELS:
             fit = problem.fit(effects, train)
             print(

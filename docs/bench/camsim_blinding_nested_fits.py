@@ -1,35 +1,46 @@
 """Nested laser blinding models fitted to one camsim case's fit pairs (the CLI's split), each warm-started from the
-previous one: the parameters behind a selection path. Usage: ``PYTHONPATH=. python
-docs/bench/camsim_blinding_nested_fits.py PAIRS_DIR CASE_SEED`` (a case's ``pairs`` folder under a camsim run's
-basetemp, and the case seed its report was calibrated with)."""
+previous nested one: the parameters behind a selection path.
+
+Usage: ``PYTHONPATH=. python docs/bench/camsim_blinding_nested_fits.py PAIRS_DIR CASE_SEED`` (a case's ``pairs``
+folder under a camsim run's basetemp, and the case seed its report was calibrated with).
+"""
+
+from __future__ import annotations
 
 import sys
 from pathlib import Path
 
+from lerobot_phantom.calibration.cli import CalibrateConfig
 from lerobot_phantom.calibration.core import seeded_split
 from lerobot_phantom.calibration.frame_models.common import load_pairs
 from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
 
-folder = Path(sys.argv[1])
-seed = int(sys.argv[2]) % 2**31
-prob = BlindingFrames(load_pairs(folder, max_side=128), seed)
-fit_items, held = seeded_split(prob.n_items, 0.2, seed)
-prev = None
-for eff in [
-    ["linear_light_saturation"],
-    ["linear_light_saturation", "tone_shoulder"],
-    ["linear_light_saturation", "tone_shoulder", "halo_power_law"],
-    ["linear_light_saturation", "tone_shoulder", "halo_power_law", "sensor_gamma"],
-    ["linear_light_saturation", "halo_power_law"],
-    ["linear_light_saturation", "halo_power_law", "sensor_gamma"],
-]:
-    f = prob.fit(frozenset(eff), fit_items, prev if prev and prev.effects <= frozenset(eff) else None)
-    prev = f
-    print(
-        "+".join(eff),
-        "fit",
-        round(prob.rmse(f, fit_items), 3),
-        "held",
-        round(prob.rmse(f, held), 3),
-        {k: round(v, 3) for k, v in f.params.items()},
-    )
+LINEAR = "linear_light_saturation"
+PATHS = (
+    (LINEAR,),
+    (LINEAR, "tone_shoulder"),
+    (LINEAR, "tone_shoulder", "halo_power_law"),
+    (LINEAR, "tone_shoulder", "halo_power_law", "sensor_gamma"),
+    (LINEAR, "halo_power_law"),
+    (LINEAR, "halo_power_law", "sensor_gamma"),
+)
+
+
+def main() -> None:
+    folder, seed = Path(sys.argv[1]), int(sys.argv[2]) % 2**31
+    defaults = CalibrateConfig()
+    problem = BlindingFrames(load_pairs(folder, max_side=defaults.max_side), seed)
+    fit_items, heldout = seeded_split(problem.n_items, defaults.heldout, seed)
+    previous = None
+    for effects in map(frozenset, PATHS):
+        start = previous if previous is not None and previous.effects <= effects else None
+        previous = problem.fit(effects, fit_items, start)
+        params = {k: round(v, 3) for k, v in previous.params.items()}
+        print(
+            f"{'+'.join(sorted(effects))} fit {problem.rmse(previous, fit_items):.3f} "
+            f"held {problem.rmse(previous, heldout):.3f} {params}"
+        )
+
+
+if __name__ == "__main__":
+    main()

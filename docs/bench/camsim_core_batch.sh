@@ -2,7 +2,7 @@
 # The camsim core selection (tests/calibration/test_independent_sim.py) on several master seeds, one after another.
 # usage: docs/bench/camsim_core_batch.sh TREE OUTDIR SEED...   (TREE: a checkout; its package is what is tested)
 # Per seed: OUTDIR/log_SEED.txt (pytest -rA output, --runxfail), OUTDIR/bt_SEED (pytest's basetemp, with every
-# case's pairs and report.json) and one line in OUTDIR/summary.txt; docs/bench/camsim_batch_misses.py condenses it.
+# case's pairs and report.json) and one line in OUTDIR/summary.txt; docs/bench/camsim_batch_misses.py OUTDIR counts it.
 tree=$1; out=$2; shift 2
 mkdir -p "$out"
 for s in "$@"; do

@@ -21,9 +21,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
 import camsim as cs
 
-os.environ.setdefault(
-    "CAMSIM_SEED", "0"
-)  # the test module reads its master seed on import; only its camera draw is used
+# the test module reads its master seed on import; only its camera draw is used
+os.environ.setdefault("CAMSIM_SEED", "0")
 import test_independent_sim as tis
 
 

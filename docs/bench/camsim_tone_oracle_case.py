@@ -17,15 +17,13 @@ import tempfile
 from pathlib import Path
 
 import numpy as np
+import torch
 from PIL import Image
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.transforms.physics import linear_to_srgb
 
 sys.path.insert(0, "tests/calibration")
-
-
-def srgb(linear: np.ndarray) -> np.ndarray:
-    return np.where(linear <= 0.0031308, 12.92 * linear, 1.055 * np.power(linear, 1 / 2.4) - 0.055)
 
 
 def main() -> None:
@@ -41,7 +39,7 @@ def main() -> None:
             camsim.write_pairs(root / "pairs", case.render(rng, camera))
             grid = np.linspace(0.0, 1.0, 20001)
             table = np.interp(np.arange(256) / 255, camsim.tone_curve(grid, camera), grid)
-            table = np.round(255 * srgb(table)).astype(np.uint8)
+            table = np.round(255 * linear_to_srgb(torch.from_numpy(table)).numpy()).astype(np.uint8)
             (root / "oracle").mkdir()
             for path in (root / "pairs").iterdir():
                 target = root / "oracle" / path.name
