@@ -1,12 +1,13 @@
 #!/bin/bash
 # The camsim core selection (tests/calibration/test_independent_sim.py) on several master seeds, one after another.
-# usage: docs/bench/camsim_core_batch.sh TREE OUTDIR SEED...   (TREE: a checkout; its package is what is tested)
+# usage: [CAMSIM_CASES=a,b] docs/bench/camsim_core_batch.sh TREE OUTDIR SEED...   (TREE: a checkout; its package is
+# what is tested; CAMSIM_CASES: the cases, default the core selection)
 # Per seed: OUTDIR/log_SEED.txt (pytest -rA output, --runxfail), OUTDIR/bt_SEED (pytest's basetemp, with every
 # case's pairs and report.json) and one line in OUTDIR/summary.txt; docs/bench/camsim_batch_misses.py OUTDIR counts it.
 tree=$1; out=$2; shift 2
 mkdir -p "$out"
 for s in "$@"; do
-  (cd "$tree" && CAMSIM_SEED=$s CAMSIM_CASES=core HF_HUB_OFFLINE=1 OMP_NUM_THREADS=1 PYTHONPATH=$tree timeout 1800 \
+  (cd "$tree" && CAMSIM_SEED=$s CAMSIM_CASES=${CAMSIM_CASES:-core} HF_HUB_OFFLINE=1 OMP_NUM_THREADS=1 PYTHONPATH=$tree timeout 1800 \
     python3 -m pytest -q -p no:cacheprovider --runxfail -rA --basetemp="$out/bt_$s" \
     tests/calibration/test_independent_sim.py > "$out/log_$s.txt" 2>&1)
   echo "seed $s: $(grep -E 'AssertionError: planted|passed|failed' "$out/log_$s.txt" | tail -2 | tr '\n' ' ')" >> "$out/summary.txt"

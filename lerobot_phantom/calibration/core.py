@@ -37,11 +37,18 @@ def single_threaded() -> Iterator[None]:
 
 @dataclass(frozen=True)
 class Effect:
-    """A named physical extension: its cause in plain words and the effects it builds on."""
+    """A named physical extension: its cause in plain words, the effects it builds on and the effects it is an
+    alternative to (``excludes``: two forms of one physical term, never in one model; the relation is symmetric)."""
 
     name: str
     cause: str
     requires: tuple[str, ...] = ()
+    excludes: tuple[str, ...] = ()
+
+
+def exclusive(candidates: tuple[Effect, ...], effects: frozenset[str] | set[str]) -> bool:
+    """Whether ``effects`` holds two effects one of which ``excludes`` the other."""
+    return any(set(e.excludes) & set(effects) for e in candidates if e.name in effects)
 
 
 @dataclass(frozen=True)
@@ -323,7 +330,11 @@ def forward_select(
     while True:
         scored: dict[str, tuple[float, list[Fit], dict[int, float]]] = {}
         for effect in problem.candidates:
-            if effect.name in chosen or not set(effect.requires) <= chosen:
+            if (
+                effect.name in chosen
+                or not set(effect.requires) <= chosen
+                or exclusive(problem.candidates, chosen | {effect.name})
+            ):
                 continue
             scored[effect.name] = cross_validated(problem, chosen | {effect.name}, splits, parents)
         if not scored:
@@ -342,7 +353,9 @@ def forward_select(
                 second = effect.name
                 if second == first or second in chosen or (second in tried and second < first):
                     continue  # each unordered pair once
-                if not set(effect.requires) <= chosen | {first}:
+                if not set(effect.requires) <= chosen | {first} or exclusive(
+                    problem.candidates, chosen | {first, second}
+                ):
                     continue
                 pairs[(first, second)] = cross_validated(
                     problem, chosen | {first, second}, splits, scored[first][1]

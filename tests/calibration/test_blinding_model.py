@@ -31,6 +31,10 @@ def test_glare_and_tone_shoulder_build_on_linear_light():
     assert requires["halo_power_law"] == ("linear_light_saturation",)
     assert requires["tone_shoulder"] == ("linear_light_saturation",)
     assert requires["linear_light_saturation"] == ()
+    # two tone curves, not a curve and its refinement: never in one model
+    excludes = {e.name: e.excludes for e in BlindingFrames.candidates}
+    assert excludes["tone_shoulder"] == ("sensor_gamma",)
+    assert not any(excludes[name] for name in excludes if name != "tone_shoulder")
 
 
 @pytest.mark.parametrize(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import typing
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,7 @@ from lerobot_phantom.calibration.core import (
     Effect,
     Fit,
     Problem,
+    exclusive,
     forward_select,
     item_scores,
     selection_value,
@@ -71,3 +74,49 @@ def test_the_two_scores_from_their_item_terms():
         item_scores("median", squared, counts)
     with pytest.raises(ValueError, match="valid: rmse, mean_item_error"):
         error_ratio(squared, squared, draws=2, rng=np.random.default_rng(0), score="median")
+
+
+class TwoToneCurves(Problem):
+    """Two alternative forms of one term (``power`` and ``shoulder``, as sensor_gamma and tone_shoulder) and an
+    independent ``glare``. Each helps alone, and the two forms together would fit best of all: the error of a
+    model is fixed by its effects and the same on every item."""
+
+    candidates = (
+        Effect("power", "a power-law tone curve"),
+        Effect("shoulder", "a tone curve with a shoulder", excludes=("power",)),
+        Effect("glare", "light around the spot"),
+    )
+    errors: typing.ClassVar[dict[frozenset[str], float]] = {
+        frozenset(): 10.0,
+        frozenset({"power"}): 5.0,
+        frozenset({"shoulder"}): 4.0,
+        frozenset({"glare"}): 9.0,
+        frozenset({"power", "shoulder"}): 1.0,
+        frozenset({"power", "glare"}): 4.5,
+        frozenset({"shoulder", "glare"}): 3.5,
+        frozenset({"power", "shoulder", "glare"}): 0.5,
+    }
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def fit(self, effects, items, start=None) -> Fit:
+        return Fit(effects, {})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        return self.errors[fit.effects] ** 2 * len(items), len(items)
+
+
+def test_exclusive_effects_are_never_tried_together():
+    problem = TwoToneCurves()
+    assert exclusive(problem.candidates, {"power", "shoulder"})
+    assert exclusive(
+        problem.candidates, {"shoulder", "power", "glare"}
+    )  # symmetric: declared on one side only
+    assert not exclusive(problem.candidates, {"power", "glare"})
+    chosen, steps = forward_select(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"shoulder", "glare"}, [s.tried for s in steps]
+    tried = {name for step in steps for name in step.tried}
+    assert not any({"power", "shoulder"} <= set(name.split("+")) for name in tried), tried
+    assert all("power" not in step.effects for step in steps)

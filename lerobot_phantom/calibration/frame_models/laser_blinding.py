@@ -23,7 +23,9 @@ as laser irradiance instead, which needs three corrections any capture of a lase
 at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it), its exponent and its scale. ``tone_shoulder``
 (also on linear light) composes in the log-logistic tone curve of ``calibration/tone.py`` instead of sRGB: a filmic
 camera stores the laser's light on a curve no power law follows (on the independent simulator, a power law fitted
-to one ran to its bound and a halo took over the laser's whole spot).
+to one ran to its bound and a halo took over the laser's whole spot). It is an alternative to ``sensor_gamma``, not
+a refinement of it: the shoulder alone follows a filmic curve to half a grey level, and under a power law of its own
+the curve can stretch the light's scale freely, so the laser's gain is no longer pinned by the frames.
 
 ``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
@@ -80,6 +82,9 @@ BLINDING_EFFECTS = (
         "the laser's light and the scene's are stored on a curve far steeper in the shadows and flatter in the "
         "highlights than sRGB, so light added in linear irradiance brightens dark pixels far more than sRGB predicts",
         requires=("linear_light_saturation",),
+        # a tone curve, as sensor_gamma is: under a power law of its own the shoulder stops pinning the light's
+        # scale and the laser's gain runs to its bound (camsim halo case, docs/bench/camsim_session16.md)
+        excludes=("sensor_gamma",),
     ),
 )
 
@@ -335,7 +340,7 @@ class BlindingFrames(PixelProblem):
     @staticmethod
     def tone(effects, params):
         """Power-law tone curve the light is composed in: fitted, sRGB (linear light), or the encoded values (the
-        paper); under a fitted shoulder (which builds on linear light), its display gamma (None: 1)."""
+        paper); under a fitted shoulder (which excludes ``sensor_gamma``), None: the shoulder has no display gamma."""
         if "sensor_gamma" in effects:
             return params["gamma"]
         return None if "linear_light_saturation" in effects else 1.0
@@ -428,7 +433,7 @@ class BlindingFrames(PixelProblem):
             "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); the
             # transform knows power laws only, so a fitted shoulder gives it the closest one
-            "gamma": equivalent_power_gamma(p, p.get("gamma"))
+            "gamma": equivalent_power_gamma(p)
             if "tone_shoulder" in effects
             else p["gamma"]
             if "sensor_gamma" in effects
