@@ -11,6 +11,7 @@ no fit can predict would otherwise decide every comparison.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
@@ -157,6 +158,8 @@ class Problem:
     heldout_definition: str = (
         "RMSE of the model fitted on the fit items, predicting the held-out items from their inputs alone"
     )
+    # the largest group of new effects one selection step scores together (``forward_select``)
+    joint_effects: int = 2
     # what inner cross-validation compares models by (``SELECTION_SCORES``); held-out figures are RMSE either way
     selection_score: str = "rmse"
     selection_score_reason: str = ""  # why, when it is not the RMSE (the report says it)
@@ -285,7 +288,8 @@ class Step:
     tried: dict[str, float]
     # per fit item: this model's term of the selection score (``item_scores``), the item scored in its validation fold
     item_errors: np.ndarray | None = None
-    # the first of an interacting pair kept together: its effect is judged with the pair (the next step)
+    # a step inside a group of interacting effects kept together (forward_select): its effect is judged with the
+    # whole group, from the step before the group to the step that completes it
     paired: bool = False
 
 
@@ -317,7 +321,14 @@ def forward_select(
     """Forward selection of extensions by the inner k-fold validation score, each step needing a ``margin`` gain.
 
     Only ``fit_items`` are used. Every step keeps each fit item's term of the score, so the effect size of a step
-    can be bootstrapped over items (``identify.error_ratio``)."""
+    can be bootstrapped over items (``identify.error_ratio``).
+
+    Interacting effects can each be weak alone and strong together (a halo is invisible while the model cannot
+    saturate; a reflectance term only pays in linear light): every step also scores each group of up to
+    ``problem.joint_effects`` new effects. A group is taken over everything smaller only when it beats the best
+    smaller one by the margin (its last effect earns its place given the others) and brings the margin over the
+    current model once per effect in it that stands on its own - an effect that builds on another of the group
+    (``requires``) only exists to carry it and adds no margin."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
     requires = {e.name: set(e.requires) for e in problem.candidates}
 
@@ -328,67 +339,74 @@ def forward_select(
     current, parents, per_item = cross_validated(problem, chosen, splits, None)
     steps = [Step([], current, {}, aligned(per_item))]
     while True:
-        scored: dict[str, tuple[float, list[Fit], dict[int, float]]] = {}
-        for effect in problem.candidates:
-            if (
-                effect.name in chosen
-                or not set(effect.requires) <= chosen
-                or exclusive(problem.candidates, chosen | {effect.name})
-            ):
-                continue
-            scored[effect.name] = cross_validated(problem, chosen | {effect.name}, splits, parents)
+        open_names = [e.name for e in problem.candidates if e.name not in chosen]
+        # group -> (score, fold fits, per-item terms); a group's members in label order (_group_label)
+        scored: dict[tuple[str, ...], tuple[float, list[Fit], dict[int, float]]] = {}
+        for size in range(1, problem.joint_effects + 1):
+            for members in itertools.combinations(open_names, size):
+                model = chosen | set(members)
+                if any(not requires[e] <= model for e in members) or exclusive(problem.candidates, model):
+                    continue
+                group = _group_label(members, chosen, requires)
+                # warm start: the fold fits of the group without its last member (a pair: its first effect's)
+                start = scored[group[:-1]][1] if group[:-1] in scored else parents
+                scored[group] = cross_validated(problem, model, splits, start)
         if not scored:
             break
-        tried = {k: v[0] for k, v in scored.items()}
-        best = min(tried, key=tried.__getitem__)
-        steps[-1].tried = tried
-        # Interacting effects can each be weak alone and strong together (a halo is invisible while the model
-        # cannot saturate; a reflectance term only pays in linear light): every step also scores each pair. A
-        # pair is taken over the best single effect only when it beats it by the margin (its second effect earns
-        # its place given the first) and brings twice the margin over the current model - or once the margin
-        # when one of the two only exists to carry the other (``requires``: the pair is one extension).
-        pairs: dict[tuple[str, str], tuple[float, list[Fit], dict[int, float]]] = {}
-        for first in tried:
-            for effect in problem.candidates:
-                second = effect.name
-                if second == first or second in chosen or (second in tried and second < first):
-                    continue  # each unordered pair once
-                if not set(effect.requires) <= chosen | {first} or exclusive(
-                    problem.candidates, chosen | {first, second}
-                ):
-                    continue
-                pairs[(first, second)] = cross_validated(
-                    problem, chosen | {first, second}, splits, scored[first][1]
+        steps[-1].tried = {"+".join(g): v[0] for g, v in scored.items()}
+        best_single = min((g for g in scored if len(g) == 1), key=lambda g: scored[g][0], default=None)
+        needed = {}
+        for group in scored:
+            if len(group) < 2:
+                continue
+            smaller = min((v[0] for g, v in scored.items() if len(g) < len(group)), default=math.inf)
+            standing = max(1, sum(1 for e in group if not requires[e] & set(group)))
+            needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
+        joint = min(needed, key=lambda g: scored[g][0] / needed[g], default=None)
+        if joint is not None and scored[joint][0] <= needed[joint]:
+            # the intermediate steps: each prefix of the best-scoring order whose prefixes were all scored
+            for prefix in _build_order(joint, scored)[:-1]:
+                steps.append(
+                    Step(
+                        sorted(chosen | set(prefix)),
+                        scored[prefix][0],
+                        {},
+                        aligned(scored[prefix][2]),
+                        paired=True,
+                    )
                 )
-        steps[-1].tried.update({"+".join(k): v[0] for k, v in pairs.items()})
-        needed = {
-            (a, b): min(
-                (1.0 - margin) * tried[best],
-                (1.0 - (1.0 if a in requires[b] or b in requires[a] else 2.0) * margin) * current,
-            )
-            for a, b in pairs
-        }
-        pair = min(pairs, key=lambda k: pairs[k][0] / needed[k]) if pairs else None
-        if pair is not None and pairs[pair][0] <= needed[pair]:
-            first, second = pair
-            if (
-                second in tried and tried[second] < tried[first]
-            ):  # the better one alone is the intermediate step
-                first, second = second, first
-            steps.append(
-                Step(sorted(chosen | {first}), tried[first], {}, aligned(scored[first][2]), paired=True)
-            )
-            chosen = chosen | {first, second}
-            current, parents, per_item = pairs[pair]
+            chosen = chosen | set(joint)
+            current, parents, per_item = scored[joint]
             steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
             continue
-        if tried[best] <= (1.0 - margin) * current:
-            chosen = chosen | {best}
-            current, parents, per_item = scored[best]
+        if best_single is not None and scored[best_single][0] <= (1.0 - margin) * current:
+            chosen = chosen | set(best_single)
+            current, parents, per_item = scored[best_single]
             steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
             continue
         break
     return chosen, steps
+
+
+def _group_label(members, chosen: frozenset[str], requires: dict[str, set[str]]) -> tuple[str, ...]:
+    """A group's members in a fixed order: those valid alone on the current model first, each part by name."""
+    alone = sorted(e for e in members if requires[e] <= chosen)
+    return tuple(alone + sorted(e for e in members if e not in alone))
+
+
+def _build_order(group: tuple[str, ...], scored: dict) -> list[tuple[str, ...]]:
+    """The group's prefixes, as labelled groups, along the order whose every prefix was scored, best first: for a
+    pair, the better of its two effects alone, then the pair."""
+    orders = []
+    for order in itertools.permutations(group):
+        prefixes = [_find(order[: k + 1], scored) for k in range(len(order))]
+        if all(p is not None for p in prefixes):
+            orders.append(prefixes)
+    return min(orders, key=lambda prefixes: [scored[p][0] for p in prefixes[:-1]])
+
+
+def _find(members: tuple[str, ...], scored: dict) -> tuple[str, ...] | None:
+    return next((g for g in scored if len(g) == len(members) and set(g) == set(members)), None)
 
 
 def fit_chain(problem: Problem, steps: list[Step], items: np.ndarray) -> list[Fit]:

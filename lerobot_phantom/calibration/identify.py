@@ -282,8 +282,13 @@ def identify_selection(
     entries = []
     for k, (before, after) in enumerate(itertools.pairwise(steps)):
         (effect,) = set(after.effects) - set(before.effects)
-        # an interacting pair (each useless alone) is judged by what the two bring together
-        entries.append((effect, k - 1 if before.paired else k, k + 2 if after.paired else k + 1))
+        # a group of interacting effects (each useless alone) is judged by what they bring together
+        first, last = k, k + 1
+        while steps[first].paired:
+            first -= 1
+        while steps[last].paired:
+            last += 1
+        entries.append((effect, first, last))
     own: dict[str, dict] = {}
     # leaves first: an effect that hosts others (the form their parameters live in) is judged with those of them
     # that pass on their own, because the model without it cannot have them either

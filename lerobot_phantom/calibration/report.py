@@ -157,8 +157,10 @@ def build_report(
             "criterion": f"forward selection on the fit items by {folds}-fold cross-validated {score_name}"
             + (f" ({problem.selection_score_reason})" if problem.selection_score != "rmse" else "")
             + "; each kept "
-            f"extension must lower it by >= {100 * margin:.0f}% (a pair of interacting extensions by "
-            f">= {200 * margin:.0f}%); then each kept extension must pass the identification rule "
+            f"extension must lower it by >= {100 * margin:.0f}% (a group of up to {problem.joint_effects} "
+            f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
+            f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group); then each kept "
+            "extension must pass the identification rule "
             "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
             "bound, an interval excluding its null value",
             "selected": selection.selected,

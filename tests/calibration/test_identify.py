@@ -213,6 +213,36 @@ def test_a_pair_taken_in_one_step_is_compared_with_the_model_before_the_pair():
         assert result["validation_ratio"]["estimate"] == pytest.approx(2.0)  # sqrt(4): RMSE from squared sums
 
 
+def test_a_group_of_three_taken_in_one_step_is_compared_with_the_model_before_the_group():
+    """Three effects taken in one step (two ``paired`` steps inside the group): each is judged from the step before
+    the group to the step that completes it."""
+    steps = [
+        Step([], 2.0, {}, 4.0 * PER_ITEM),
+        Step(["a"], 1.95, {}, 3.9 * PER_ITEM, paired=True),
+        Step(["a", "b"], 1.9, {}, 3.8 * PER_ITEM, paired=True),
+        Step(["a", "b", "c"], 0.9, {}, PER_ITEM),
+    ]
+
+    class ThreeTogether(Problem):
+        candidates = tuple(Effect(name, "one of three") for name in "abc")
+
+        def param_specs(self, effects):
+            return [Param(f"p_{name}", 0.0, -10.0, 10.0) for name in sorted(effects)]
+
+        def fit(self, effects, items, start=None) -> Fit:
+            return Fit(effects, {f"p_{name}": 1.0 + 0.01 * float(np.mean(items)) for name in sorted(effects)})
+
+    items = np.arange(20)
+    chain = [ThreeTogether().fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(
+        ThreeTogether(), steps, chain, items, draws=20, rng=np.random.default_rng(1)
+    )
+    assert [r["effect"] for r in selection.results] == ["a", "b", "c"]
+    for result in selection.results:
+        assert result["compared_steps"] == [0, 3], result["effect"]
+        assert result["validation_ratio"]["estimate"] == pytest.approx(2.0)
+
+
 class ChildAtItsLimit(ParentAndChild):
     """The same, with the child's low bound declared the form's physical limit."""
 

@@ -120,3 +120,42 @@ def test_exclusive_effects_are_never_tried_together():
     tried = {name for step in steps for name in step.tried}
     assert not any({"power", "shoulder"} <= set(name.split("+")) for name in tried), tried
     assert all("power" not in step.effects for step in steps)
+
+
+class MeterToneAndLight(Problem):
+    """Three effects each useless alone and in pairs, strong together (as the auto-exposure meter, the tone curve
+    and linear light on a filmic camera with auto-exposure); ``tone`` builds on ``light``. A model's error is fixed
+    by its effects and the same on every item."""
+
+    candidates = (
+        Effect("light", "light adds in linear irradiance"),
+        Effect("meter", "auto-exposure"),
+        Effect("tone", "a tone curve", requires=("light",)),
+    )
+
+    def __init__(self, joint_effects: int) -> None:
+        self.joint_effects = joint_effects
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def fit(self, effects, items, start=None) -> Fit:
+        return Fit(effects, {})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        error = {3: 5.0, 2: 9.6}.get(len(fit.effects), 10.0)
+        return error**2 * len(items), len(items)
+
+
+def test_a_group_of_three_is_taken_only_when_the_problem_scores_groups_of_three():
+    chosen, steps = forward_select(MeterToneAndLight(2), np.arange(20), seed=0, margin=0.05)
+    assert chosen == frozenset(), steps[0].tried  # every pair gains 4%, under the margin
+    assert not any(name.count("+") == 2 for name in steps[0].tried)
+    chosen, steps = forward_select(MeterToneAndLight(3), np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"light", "meter", "tone"}, steps[0].tried
+    assert steps[0].tried["light+meter+tone"] == pytest.approx(5.0)
+    # the two steps inside the group are marked, each a valid model (tone never without light)
+    assert [s.paired for s in steps] == [False, True, True, False]
+    assert [len(s.effects) for s in steps] == [0, 1, 2, 3]
+    assert all("tone" not in s.effects or "light" in s.effects for s in steps)
