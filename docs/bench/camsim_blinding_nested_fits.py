@@ -1,8 +1,10 @@
 """Nested laser blinding models fitted to one camsim case's fit pairs (the CLI's split), each warm-started from the
 previous nested one: the parameters behind a selection path.
 
-Usage: ``PYTHONPATH=. python docs/bench/camsim_blinding_nested_fits.py PAIRS_DIR CASE_SEED`` (a case's ``pairs``
-folder under a camsim run's basetemp, and the case seed its report was calibrated with).
+Usage: ``PYTHONPATH=. python docs/bench/camsim_blinding_nested_fits.py PAIRS_DIR CASE_SEED [halo|auto_exposure]``
+(a case's ``pairs`` folder under a camsim run's basetemp, the case seed its report was calibrated with, and the
+paths to fit: the halo case's, the default, or the auto-exposure case's). A model not nested in the one before it
+starts from the defaults.
 """
 
 from __future__ import annotations
@@ -16,23 +18,35 @@ from lerobot_phantom.calibration.frame_models.common import load_pairs
 from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
 
 LINEAR = "linear_light_saturation"
-PATHS = (
-    (LINEAR,),
-    (LINEAR, "tone_shoulder"),
-    (LINEAR, "tone_shoulder", "halo_power_law"),
-    (LINEAR, "tone_shoulder", "halo_power_law", "sensor_gamma"),
-    (LINEAR, "halo_power_law"),
-    (LINEAR, "halo_power_law", "sensor_gamma"),
-)
+METER = "auto_exposure"
+PATHS = {
+    "halo": (
+        (LINEAR,),
+        (LINEAR, "tone_shoulder"),
+        (LINEAR, "tone_shoulder", "halo_power_law"),
+        (LINEAR, "tone_shoulder", "halo_power_law", "sensor_gamma"),
+        (LINEAR, "halo_power_law"),
+        (LINEAR, "halo_power_law", "sensor_gamma"),
+    ),
+    "auto_exposure": (
+        (METER,),
+        (METER, LINEAR),
+        (METER, LINEAR, "tone_shoulder"),
+        (METER, LINEAR, "halo_power_law"),
+        (METER, LINEAR, "halo_power_law", "sensor_gamma"),
+        (METER, LINEAR, "sensor_gamma"),
+    ),
+}
 
 
 def main() -> None:
     folder, seed = Path(sys.argv[1]), int(sys.argv[2]) % 2**31
+    paths = PATHS[sys.argv[3] if len(sys.argv) > 3 else "halo"]
     defaults = CalibrateConfig()
     problem = BlindingFrames(load_pairs(folder, max_side=defaults.max_side), seed)
     fit_items, heldout = seeded_split(problem.n_items, defaults.heldout, seed)
     previous = None
-    for effects in map(frozenset, PATHS):
+    for effects in map(frozenset, paths):
         start = previous if previous is not None and previous.effects <= effects else None
         previous = problem.fit(effects, fit_items, start)
         params = {k: round(v, 3) for k, v in previous.params.items()}
