@@ -349,8 +349,50 @@ def identify_selection(
     kept = frozenset(identified)
     if kept == selected_fit.effects:
         return Selection(sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals)
-    # the largest model of the chain inside the kept set starts the refit
-    start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
-    final = start if start.effects == kept else problem.fit(kept, fit_items, start)
-    final_intervals = parameter_intervals(problem, final, fit_items, draws=draws, rng=rng)
-    return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)
+    by_effect = {r["effect"]: r for r in results}
+    while True:
+        # the largest model of the chain inside the kept set starts the refit
+        start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
+        final = start if start.effects == kept else problem.fit(kept, fit_items, start)
+        final_intervals = parameter_intervals(problem, final, fit_items, draws=draws, rng=rng)
+        # the written model's own parameters are held to rules 3 and 4 too: without a dropped effect, one that
+        # passed may fall to its null (a meter that only balanced a glare, refitted without the glare)
+        failing = {
+            effect: reasons
+            for effect in sorted(kept)
+            if (
+                reasons := refit_reasons(problem, final, final_intervals, effect, selected_fit.effects - kept)
+            )
+        }
+        if not failing:
+            return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)
+        for effect, reasons in failing.items():
+            by_effect[effect].update(identified=False, status="not identified")
+            by_effect[effect]["reasons"].extend(reasons)
+        dropped = set(failing).union(*(dependants(problem, kept, e) for e in failing))
+        for effect in dropped - set(failing):
+            by_effect[effect].update(identified=False, status="not identified")
+            by_effect[effect]["reasons"].append(
+                f"builds on {', '.join(sorted(failing))}, which is not identified"
+            )
+        kept = kept - dropped
+
+
+def refit_reasons(
+    problem: Problem, fit: Fit, intervals: Mapping[str, Interval], effect: str, dropped: frozenset[str]
+) -> list[str]:
+    """Why ``effect``'s own parameters in ``fit`` (the refit without ``dropped``) fail rules 3 or 4, if they do."""
+    specs = own_params(problem, fit.effects, effect)
+    without = ", ".join(sorted(dropped))
+    reasons = [
+        f"refitted without {without}, {p.name} = {fit.params[p.name]:.4g} sits at its {side} bound "
+        f"{p.low if side == 'low' else p.high:.4g}"
+        for p in specs
+        if (side := at_bound(fit.params[p.name], p.low, p.high)) and not (side == "low" and p.low_limit)
+    ]
+    nulls = {k: v for k, v in problem.null_values(effect).items() if k in fit.params}
+    if nulls and not any(intervals[k].excludes(v) for k, v in nulls.items()):
+        reasons.append(
+            f"refitted without {without}, the intervals of {', '.join(nulls)} include the null value"
+        )
+    return reasons

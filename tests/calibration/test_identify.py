@@ -347,3 +347,40 @@ def test_a_host_of_no_use_alone_is_judged_with_the_dependants_that_pass(child_at
         assert any("does not exclude 1" in r for r in parent["reasons"])
     else:
         assert parent["validation_ratio"]["low"] > 5  # an RMSE ratio: sqrt(1 / 0.01)
+
+
+class MeterBalancingAGlare(Problem):
+    """A meter that passes every condition in the model with a glare, but only balanced it: refitted without the
+    glare (whose level sits at its bound), the meter falls to its null value 0, the low bound of its range."""
+
+    candidates = (Effect("glare", "scattered light"), Effect("meter", "auto-exposure"))
+
+    def param_specs(self, effects):
+        return [Param(name, 1.0, 0.0, 10.0) for name in ("level", "meter") if _owner(name) in effects]
+
+    def null_values(self, effect):
+        return {"meter": {"meter": 0.0}}.get(effect, {})
+
+    def fit(self, effects, items, start=None) -> Fit:
+        values = {"level": 10.0, "meter": 0.5 + 0.01 * float(np.mean(items)) if "glare" in effects else 0.0}
+        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+
+
+def _owner(param: str) -> str:
+    return {"level": "glare", "meter": "meter"}[param]
+
+
+def test_an_effect_that_falls_to_its_null_in_the_refit_is_not_identified():
+    steps = [
+        Step([], 2.0, {}, 4.0 * PER_ITEM),
+        Step(["glare"], 1.0, {}, PER_ITEM),
+        Step(["glare", "meter"], 0.5, {}, 0.25 * PER_ITEM),
+    ]
+    problem, items = MeterBalancingAGlare(), np.arange(20)
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    glare, meter = selection.results
+    assert not glare["identified"] and "level = 10 sits at its high bound" in glare["reasons"][0]
+    assert not meter["identified"]
+    assert any("refitted without glare, meter = 0 sits at its low bound 0" in r for r in meter["reasons"])
+    assert selection.identified == [] and selection.fit.effects == frozenset()
