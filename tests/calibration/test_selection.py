@@ -76,10 +76,27 @@ def test_the_two_scores_from_their_item_terms():
         error_ratio(squared, squared, draws=2, rng=np.random.default_rng(0), score="median")
 
 
-class TwoToneCurves(Problem):
+class FixedErrors(Problem):
+    """A problem whose models have no parameters: a model's error is fixed by its effects (``error``) and the same
+    on every one of 20 items."""
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def error(self, effects: frozenset[str]) -> float:
+        raise NotImplementedError
+
+    def fit(self, effects, items, start=None) -> Fit:
+        return Fit(effects, {})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        return self.error(fit.effects) ** 2 * len(items), len(items)
+
+
+class TwoToneCurves(FixedErrors):
     """Two alternative forms of one term (``power`` and ``shoulder``, as sensor_gamma and tone_shoulder) and an
-    independent ``glare``. Each helps alone, and the two forms together would fit best of all: the error of a
-    model is fixed by its effects and the same on every item."""
+    independent ``glare``. Each helps alone, and the two forms together would fit best of all."""
 
     candidates = (
         Effect("power", "a power-law tone curve"),
@@ -97,15 +114,8 @@ class TwoToneCurves(Problem):
         frozenset({"power", "shoulder", "glare"}): 0.5,
     }
 
-    @property
-    def n_items(self) -> int:
-        return 20
-
-    def fit(self, effects, items, start=None) -> Fit:
-        return Fit(effects, {})
-
-    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
-        return self.errors[fit.effects] ** 2 * len(items), len(items)
+    def error(self, effects: frozenset[str]) -> float:
+        return self.errors[effects]
 
 
 def test_exclusive_effects_are_never_tried_together():
@@ -122,10 +132,9 @@ def test_exclusive_effects_are_never_tried_together():
     assert all("power" not in step.effects for step in steps)
 
 
-class MeterToneAndLight(Problem):
+class MeterToneAndLight(FixedErrors):
     """Three effects each useless alone and in pairs, strong together (as the auto-exposure meter, the tone curve
-    and linear light on a filmic camera with auto-exposure); ``tone`` builds on ``light``. A model's error is fixed
-    by its effects and the same on every item."""
+    and linear light on a filmic camera with auto-exposure); ``tone`` builds on ``light``."""
 
     candidates = (
         Effect("light", "light adds in linear irradiance"),
@@ -136,16 +145,8 @@ class MeterToneAndLight(Problem):
     def __init__(self, joint_effects: int) -> None:
         self.joint_effects = joint_effects
 
-    @property
-    def n_items(self) -> int:
-        return 20
-
-    def fit(self, effects, items, start=None) -> Fit:
-        return Fit(effects, {})
-
-    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
-        error = {3: 5.0, 2: 9.6}.get(len(fit.effects), 10.0)
-        return error**2 * len(items), len(items)
+    def error(self, effects: frozenset[str]) -> float:
+        return {3: 5.0, 2: 9.6}.get(len(effects), 10.0)
 
 
 def test_a_group_of_three_is_taken_only_when_the_problem_scores_groups_of_three():
