@@ -340,47 +340,58 @@ def forward_select(
     steps = [Step([], current, {}, aligned(per_item))]
     while True:
         open_names = [e.name for e in problem.candidates if e.name not in chosen]
-        # group -> (score, fold fits, per-item terms); a group's members in label order (_group_label)
-        scored: dict[tuple[str, ...], tuple[float, list[Fit], dict[int, float]]] = {}
+        # new effects -> (score, fold fits, per-item terms), and the name each is reported by (_group_label)
+        scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
+        labels: dict[frozenset[str], str] = {}
         for size in range(1, problem.joint_effects + 1):
             for members in itertools.combinations(open_names, size):
                 model = chosen | set(members)
                 if any(not requires[e] <= model for e in members) or exclusive(problem.candidates, model):
                     continue
-                group = _group_label(members, chosen, requires)
+                label = _group_label(members, chosen, requires)
+                group = frozenset(members)
                 # warm start: the fold fits of the group without its last member (a pair: its first effect's)
-                start = scored[group[:-1]][1] if group[:-1] in scored else parents
+                start = scored.get(frozenset(label[:-1]), (None, parents))[1]
                 scored[group] = cross_validated(problem, model, splits, start)
+                labels[group] = "+".join(label)
         if not scored:
             break
-        steps[-1].tried = {"+".join(g): v[0] for g, v in scored.items()}
+        steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
         best_single = min((g for g in scored if len(g) == 1), key=lambda g: scored[g][0], default=None)
         needed = {}
         for group in scored:
             if len(group) < 2:
                 continue
             smaller = min((v[0] for g, v in scored.items() if len(g) < len(group)), default=math.inf)
-            standing = max(1, sum(1 for e in group if not requires[e] & set(group)))
+            standing = max(1, sum(1 for e in group if not requires[e] & group))
             needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
         joint = min(needed, key=lambda g: scored[g][0] / needed[g], default=None)
         if joint is not None and scored[joint][0] <= needed[joint]:
-            # the intermediate steps: each prefix of the best-scoring order whose prefixes were all scored
-            for prefix in _build_order(joint, scored)[:-1]:
+            # the steps inside the group: the order whose every prefix was scored, the best-scoring prefixes first
+            # (a pair: the better of its two effects alone)
+            orders = [
+                [frozenset(order[: k + 1]) for k in range(len(order) - 1)]
+                for order in itertools.permutations(joint)
+            ]
+            inside = min(
+                (o for o in orders if all(p in scored for p in o)), key=lambda o: [scored[p][0] for p in o]
+            )
+            for prefix in inside:
                 steps.append(
                     Step(
-                        sorted(chosen | set(prefix)),
+                        sorted(chosen | prefix),
                         scored[prefix][0],
                         {},
                         aligned(scored[prefix][2]),
                         paired=True,
                     )
                 )
-            chosen = chosen | set(joint)
+            chosen = chosen | joint
             current, parents, per_item = scored[joint]
             steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
             continue
         if best_single is not None and scored[best_single][0] <= (1.0 - margin) * current:
-            chosen = chosen | set(best_single)
+            chosen = chosen | best_single
             current, parents, per_item = scored[best_single]
             steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
             continue
@@ -392,21 +403,6 @@ def _group_label(members, chosen: frozenset[str], requires: dict[str, set[str]])
     """A group's members in a fixed order: those valid alone on the current model first, each part by name."""
     alone = sorted(e for e in members if requires[e] <= chosen)
     return tuple(alone + sorted(e for e in members if e not in alone))
-
-
-def _build_order(group: tuple[str, ...], scored: dict) -> list[tuple[str, ...]]:
-    """The group's prefixes, as labelled groups, along the order whose every prefix was scored, best first: for a
-    pair, the better of its two effects alone, then the pair."""
-    orders = []
-    for order in itertools.permutations(group):
-        prefixes = [_find(order[: k + 1], scored) for k in range(len(order))]
-        if all(p is not None for p in prefixes):
-            orders.append(prefixes)
-    return min(orders, key=lambda prefixes: [scored[p][0] for p in prefixes[:-1]])
-
-
-def _find(members: tuple[str, ...], scored: dict) -> tuple[str, ...] | None:
-    return next((g for g in scored if len(g) == len(members) and set(g) == set(members)), None)
 
 
 def fit_chain(problem: Problem, steps: list[Step], items: np.ndarray) -> list[Fit]:

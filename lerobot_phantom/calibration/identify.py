@@ -177,7 +177,7 @@ def identify(
     ``limits``: parameter -> what the model is at its low bound, for bounds that are the form's physical limit
     (``Param.low_limit``)."""
     limits = limits or {}
-    reasons, notes = [], []
+    reasons = []
     if not selected:
         reasons.append("not selected by the inner cross-validation on the fit items")
     if validation_ratio is None:
@@ -188,6 +188,20 @@ def identify(
             f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
             "does not exclude 1 (no gain)"
         )
+    parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits)
+    reasons += parameter_reasons
+    return Identification(effect, not reasons, tuple(reasons), tuple(notes))
+
+
+def parameter_checks(
+    params: Mapping[str, float],
+    bounds: Mapping[str, tuple[float, float]],
+    intervals: Mapping[str, Interval],
+    nulls: Mapping[str, float],
+    limits: Mapping[str, str],
+) -> tuple[list[str], list[str]]:
+    """Rules 3 and 4 on an extension's own parameters: (reasons it fails them, notes of values at their limit)."""
+    reasons, notes = [], []
     for name, value in params.items():
         side = at_bound(value, *bounds[name])
         if side == "low" and limits.get(name):
@@ -211,7 +225,7 @@ def identify(
                 + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
                 + " at which the extension reduces to the model without it"
             )
-    return Identification(effect, not reasons, tuple(reasons), tuple(notes))
+    return reasons, notes
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -383,16 +397,11 @@ def refit_reasons(
 ) -> list[str]:
     """Why ``effect``'s own parameters in ``fit`` (the refit without ``dropped``) fail rules 3 or 4, if they do."""
     specs = own_params(problem, fit.effects, effect)
-    without = ", ".join(sorted(dropped))
-    reasons = [
-        f"refitted without {without}, {p.name} = {fit.params[p.name]:.4g} sits at its {side} bound "
-        f"{p.low if side == 'low' else p.high:.4g}"
-        for p in specs
-        if (side := at_bound(fit.params[p.name], p.low, p.high)) and not (side == "low" and p.low_limit)
-    ]
-    nulls = {k: v for k, v in problem.null_values(effect).items() if k in fit.params}
-    if nulls and not any(intervals[k].excludes(v) for k, v in nulls.items()):
-        reasons.append(
-            f"refitted without {without}, the intervals of {', '.join(nulls)} include the null value"
-        )
-    return reasons
+    reasons, _ = parameter_checks(
+        {p.name: fit.params[p.name] for p in specs},
+        {p.name: (p.low, p.high) for p in specs},
+        intervals,
+        {k: v for k, v in problem.null_values(effect).items() if k in fit.params},
+        {p.name: p.low_limit for p in specs if p.low_limit},
+    )
+    return [f"refitted without {', '.join(sorted(dropped))}, {reason}" for reason in reasons]

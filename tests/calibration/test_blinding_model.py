@@ -3,6 +3,8 @@ tone curves the laser's light is composed in (``calibration/frame_models/laser_b
 
 from __future__ import annotations
 
+import math
+
 import pytest
 import torch
 
@@ -10,7 +12,9 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     GLARE_REFERENCE_PX,
     BlindingFrames,
     halo_amplitude,
+    laser_gain,
 )
+from lerobot_phantom.calibration.identify import at_bound
 from lerobot_phantom.transforms import physics
 
 
@@ -65,3 +69,18 @@ def test_a_shoulder_lifts_the_shadows_above_srgb():
     faint = torch.tensor([0.01], dtype=torch.float64)
     assert float(shoulder_encode(faint)) > 1.8 * float(physics.encode(faint, None))
     assert float(srgb_decode(physics.encode(faint, None))) == pytest.approx(0.01, rel=1e-9)
+
+
+@pytest.mark.parametrize("gain", [0.18, 1.0, 30.0, 150.0])
+def test_laser_gains_of_a_fraction_to_a_hundred_are_inside_the_search_range(gain):
+    """The gain spans decades (about 1 for a pattern captured at the attack's power, tens for a capture exposed for
+    the beam's profile): searched on its logarithm, none of these reads as pinned at a bound (on a linear 0-200
+    range, 0.18 did)."""
+    (spec,) = [
+        p
+        for p in BlindingFrames.param_specs(None, frozenset({"linear_light_saturation"}))
+        if "gain" in p.name
+    ]
+    value = math.log10(gain)
+    assert at_bound(value, spec.low, spec.high) is None
+    assert float(laser_gain({spec.name: value})) == pytest.approx(gain)
