@@ -7,8 +7,12 @@ noise floor must not be lost (at tens of times the capture's power it lights the
 
 from __future__ import annotations
 
+import io
+
 import numpy as np
+import pytest
 import torch
+from PIL import Image
 
 from lerobot_phantom.calibration.frame_models.laser_blinding import beam_profile, dark_level, pattern_centre
 from lerobot_phantom.transforms import physics
@@ -79,3 +83,46 @@ def test_a_channel_without_a_measurable_edge_is_named_not_skipped_silently(caplo
     assert not any("channel 1" in message for message in warned), warned
     # the dark channel reads as no laser light at all
     assert torch.allclose(profile[2], pattern[2], atol=1e-6)
+
+
+def jpeg(pattern: torch.Tensor, quality: int = 90) -> torch.Tensor:
+    """The capture stored as a camera stores it: JPEG, its colour subsampled (4:2:0)."""
+    buffer = io.BytesIO()
+    Image.fromarray((pattern.permute(1, 2, 0).numpy() * 255).round().astype(np.uint8)).save(
+        buffer, format="JPEG", quality=quality
+    )
+    decoded = np.asarray(Image.open(io.BytesIO(buffer.getvalue())), dtype=np.float64) / 255
+    return torch.from_numpy(decoded).permute(2, 0, 1).contiguous()
+
+
+def test_every_channel_carries_the_laser_colour():
+    # a red laser with a glare tail: the green and blue channels hold 0.1 and 0.04 of its light everywhere, and
+    # sink below their noise floors far nearer the spot than red does
+    colour = np.array([1.0, 0.1, 0.04])
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH].astype(float)
+    radius = np.hypot(xs - CENTRE[0], ys - CENTRE[1])
+    true = beam(radius) + 0.01 / (1 + radius**2 / 4.0**2)
+    light = true[None] * colour[:, None, None] + DARK
+    noisy = np.clip(light + np.random.default_rng(4).normal(0.0, 6e-4, light.shape), 0.0, 1.0)
+    pattern = jpeg(physics.linear_to_srgb(torch.from_numpy(noisy)))
+    centre = pattern_centre(pattern)
+    dark = dark_level(pattern, centre)
+    read = (
+        physics.srgb_to_linear(beam_profile(pattern, dark, centre))
+        - physics.srgb_to_linear(dark).reshape(3, 1, 1)
+    ).numpy()
+    # where only red is measured (0.5-3 noise deviations of light in it, the others far below their floors), the
+    # continued green and blue hold the laser's colour, not their own faint edges' fall-off
+    far = (true > 0.5 * 6e-4) & (true < 3 * 6e-4)
+    assert far.sum() > 100
+    for c in (1, 2):
+        ratio = read[c][far].mean() / read[0][far].mean()
+        assert ratio == pytest.approx(colour[c], rel=0.2), (c, ratio)
+    # nearer the spot, where compression bleeds red's steep edge into the faint channels, they still follow it
+    for low, high in [(3, 6), (6, 10), (10, 15), (15, 20), (20, 30)]:
+        ring = (radius >= low) & (radius < high)
+        for c in (1, 2):
+            assert read[c][ring].mean() / (colour[c] * true[ring].mean()) == pytest.approx(1.0, abs=0.25), (
+                c,
+                low,
+            )

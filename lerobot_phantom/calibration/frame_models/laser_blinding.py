@@ -14,8 +14,8 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   blinded frame is exposed less than the capture (auto-exposure, a weaker beam): the saturated disc then
   shrinks, and a model holding the core at the full well would paint it grey instead;
 * the capture's noise is not laser light either, and the beam goes on below the capture's noise floor: the
-  capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge
-  (:func:`beam_profile`). A capture exposed for the beam's profile is tens of times weaker than the attack, and
+  capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge, and
+  its fainter channels are read as the laser's channel times the laser's colour (:func:`beam_profile`). A capture exposed for the beam's profile is tens of times weaker than the attack, and
   that ratio would otherwise multiply its noise into the frames and drop the beam's faint outskirts, which the
   ``halo_power_law`` then stood in for with its exponent at the bound (measured on the independent simulator).
 
@@ -140,9 +140,21 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     (the robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read
     as measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
     the frames far around the spot. There it is continued with the fall-off of its measured edge (light
-    ``EDGE_FLOORS`` floors above the dark level): a Gaussian in the distance from the spot, ``exp(a - r^2 /
-    (2 s^2))``, fitted in linear light (sRGB) per channel and capped at the floor. A power-law glare beyond that
-    is the halo's to model."""
+    ``EDGE_FLOORS`` floors above the dark level): in the laser's own channel (the one holding the most light), a
+    Gaussian in the distance from the spot, ``exp(a - r^2 / (2 s^2))``, fitted in linear light (sRGB) and capped
+    at the floor.
+
+    A laser is narrowband, so every part of its light (beam, bloom, glare) reaches the other two channels in one
+    fixed ratio, the laser's colour. Wherever the laser's channel is unsaturated, they are its beam times that
+    ratio (the slope of one on the other through the origin, where both measure the beam unsaturated: the
+    brightest, most precisely measured light leads it). Their own readings hold more
+    than the laser's light there: demosaicing and colour compression bleed the laser channel's steep edge into
+    them, which the frames, where that channel clips, do not repeat at the power ratio; and they sink below their
+    floors far nearer the spot. Read on their own (session 16 and before), a red laser's blue channel stood at 5
+    times its colour ratio 15-20 px from the spot, and its faint edge, continued on its own, held the floor over
+    the whole frame: tens of grey levels of light of the wrong colour at the power ratio, which the fit answered
+    with a low gain and a glare for the spot (camsim halo case, docs/bench/camsim_session17.md). A power-law glare
+    beyond the continued beam is the halo's to model."""
     _, height, width = pattern.shape
     smooth = torch.from_numpy(
         ndimage.gaussian_filter(
@@ -164,30 +176,44 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise).reshape(3, 1, 1) - dark_linear
     measured = light > floor
     beam = torch.where(measured, light, torch.zeros_like(light))
+    laser = int(light.clamp(min=0.0).sum(dim=(1, 2)).argmax())
+    unsaturated = smooth < SATURATED
+    low, high = EDGE_FLOORS[0] * floor[laser], EDGE_FLOORS[1] * floor[laser]
+    edge = (light[laser] > low) & (light[laser] < high) & unsaturated[laser]
+    slope, offset = 0.0, 0.0
+    if int(edge.sum()) >= MIN_EDGE_PIXELS:
+        slope, offset = np.polyfit((radius[edge] ** 2).numpy(), torch.log(light[laser][edge]).numpy(), 1)
+    if slope < 0.0:
+        tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[laser]))
+        beam[laser] = torch.where(measured[laser], beam[laser], tail)
+    else:
+        logger.warning(
+            "laser capture channel %d (the laser's): %d pixels on the beam's edge (at least %d needed), falling off "
+            "with distance from the spot at a slope of %.3g (negative needed), so the beam is not continued below "
+            "the noise floor; the frames see no laser light there",
+            laser,
+            int(edge.sum()),
+            MIN_EDGE_PIXELS,
+            slope,
+        )
     for c in range(3):
-        low, high = EDGE_FLOORS[0] * floor[c], EDGE_FLOORS[1] * floor[c]
-        edge = (light[c] > low) & (light[c] < high) & (smooth[c] < SATURATED)
-        if int(edge.sum()) < MIN_EDGE_PIXELS:
+        if c == laser:
+            continue
+        # the colour ratio, read where both channels measure the beam unsaturated
+        both = measured[c] & measured[laser] & unsaturated[c] & unsaturated[laser]
+        if int(both.sum()) < MIN_EDGE_PIXELS:
             logger.warning(
-                "laser capture channel %d: %d pixels on the beam's edge (fewer than %d), so the beam is not continued "
-                "below the noise floor; the frames see no laser light there",
+                "laser capture channel %d: %d pixels measure the beam unsaturated where the laser's own channel "
+                "(%d) does too (fewer than %d), so it is not read in the laser's colour: its light below the noise "
+                "floor is not continued, and the frames see none there",
                 c,
-                int(edge.sum()),
+                int(both.sum()),
+                laser,
                 MIN_EDGE_PIXELS,
             )
             continue
-        r2 = radius[edge] ** 2
-        slope, offset = np.polyfit(r2.numpy(), torch.log(light[c][edge]).numpy(), 1)
-        if slope >= 0.0:
-            logger.warning(
-                "laser capture channel %d: its edge does not fall off with distance from the spot (slope %.3g), so "
-                "the beam is not continued below the noise floor",
-                c,
-                slope,
-            )
-            continue
-        tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[c]))
-        beam[c] = torch.where(measured[c], beam[c], tail)
+        ratio = (light[c][both] * light[laser][both]).sum() / (light[laser][both] ** 2).sum()
+        beam[c] = torch.where(unsaturated[laser], ratio * beam[laser], beam[c])
     return physics.linear_to_srgb(beam + dark_linear)
 
 
