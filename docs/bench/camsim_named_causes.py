@@ -1,0 +1,42 @@
+"""Per case of ``camsim_core_batch.sh`` runs: the camera's tone curve, whether the case passed its rule (effect
+cases: planted effects named; null cases: base model kept), the causes named, the unplanted ones (the test's own
+``named_causes`` and ``tolerated``), and the held-out RMSE of the written model and of the base.
+
+Usage: ``CAMSIM_CASES=... python docs/bench/camsim_named_causes.py OUTDIR...`` from the repository root (the same
+``CAMSIM_CASES`` as the batch). Cases whose ``report.json`` is missing (a run still going) are skipped.
+"""
+
+from __future__ import annotations
+
+import importlib
+import json
+import os
+import sys
+from pathlib import Path
+
+sys.path.insert(0, "tests/calibration")
+
+
+def main() -> None:
+    for out in sys.argv[1:]:
+        for folder in sorted(Path(out).glob("bt_*")):
+            os.environ["CAMSIM_SEED"] = folder.name.removeprefix("bt_")
+            sim = importlib.reload(importlib.import_module("test_independent_sim"))
+            for name in sim.SELECTED:
+                path = folder / "camsim0" / name / "out" / "report.json"
+                if not path.exists():
+                    continue
+                report, case = json.loads(path.read_text()), sim.CASE_BY_NAME[name]
+                camera = sim.case_camera(case)[2]
+                named = sim.named_causes(report)
+                unplanted = named - case.planted - sim.tolerated(case, camera)
+                passed = case.planted <= named if case.kind == "effect" else not report["extended"]["effects"]
+                print(
+                    f"{folder.name.removeprefix('bt_'):>11} {name:24s} {camera.tone:6s} "
+                    f"{'OK  ' if passed else 'MISS'} named={sorted(named)} unplanted={sorted(unplanted)} "
+                    f"held-out {report['extended']['heldout_rmse']:.2f} base {report['base']['heldout_rmse']:.2f}"
+                )
+
+
+if __name__ == "__main__":
+    main()
