@@ -14,10 +14,11 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   blinded frame is exposed less than the capture (auto-exposure, a weaker beam): the saturated disc then
   shrinks, and a model holding the core at the full well would paint it grey instead;
 * the capture's noise is not laser light either, and the beam goes on below the capture's noise floor: the
-  capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge, and
-  its fainter channels are read as the laser's channel times the laser's colour (:func:`beam_profile`). A capture exposed for the beam's profile is tens of times weaker than the attack, and
-  that ratio would otherwise multiply its noise into the frames and drop the beam's faint outskirts, which the
-  ``halo_power_law`` then stood in for with its exponent at the bound (measured on the independent simulator).
+  capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge, and its
+  fainter channels are read as the laser's channel times the laser's colour (:func:`beam_profile`). A capture
+  exposed for the beam's profile is tens of times weaker than the attack, and that ratio would otherwise multiply
+  its noise into the frames and drop the beam's faint outskirts, which the ``halo_power_law`` then stood in for
+  with its exponent at the bound (measured on the independent simulator).
 
 ``halo_power_law`` is glare, so it adds light and builds on ``linear_light_saturation``; it is fitted by its level
 at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it), its exponent and its scale. ``tone_shoulder``
@@ -146,14 +147,14 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
 
     A laser is narrowband, so every part of its light (beam, bloom, glare) reaches the other two channels in one
     fixed ratio, the laser's colour. Wherever the laser's channel is unsaturated, they are its beam times that
-    ratio (the slope of one on the other through the origin, where both measure the beam unsaturated: the
-    brightest, most precisely measured light leads it). Their own readings hold more
-    than the laser's light there: demosaicing and colour compression bleed the laser channel's steep edge into
-    them, which the frames, where that channel clips, do not repeat at the power ratio; and they sink below their
-    floors far nearer the spot. Read on their own (session 16 and before), a red laser's blue channel stood at 5
-    times its colour ratio 15-20 px from the spot, and its faint edge, continued on its own, held the floor over
-    the whole frame: tens of grey levels of light of the wrong colour at the power ratio, which the fit answered
-    with a low gain and a glare for the spot (camsim halo case, docs/bench/camsim_session17.md). A power-law glare
+    ratio: the slope of one on the other through the origin, where both measure the beam unsaturated (the
+    brightest, most precisely measured light leads it). Their own readings hold more than the laser's light
+    there: demosaicing and colour compression bleed the laser channel's steep edge into them, which the frames,
+    where that channel clips, do not repeat at the power ratio; and they sink below their floors far nearer the
+    spot. Read on their own (session 16 and before), a red laser's blue channel held 2-11 times its colour share
+    10-25 px from the spot, and its faint edge, continued on its own, held the floor over the whole frame: tens of
+    grey levels of light of the wrong colour at the power ratio, which the fit answered with a low gain and a
+    glare for the spot (camsim halo case, docs/bench/camsim_session17.md). A power-law glare
     beyond the continued beam is the halo's to model."""
     _, height, width = pattern.shape
     smooth = torch.from_numpy(
