@@ -21,6 +21,7 @@ sys.path.insert(0, "tests/calibration")
 
 import camsim as cs
 import test_independent_sim as sim
+from camsim_blinding_nested_fits import fit_line
 
 from lerobot_phantom.calibration.cli import CalibrateConfig
 from lerobot_phantom.calibration.core import Param, seeded_split
@@ -124,10 +125,8 @@ def main() -> None:
         problem.pinned = pinned
         for effects in (("linear_light_saturation",), ("linear_light_saturation", "halo_power_law")):
             fit = problem.fit(frozenset(effects), fit_items)
-            params = {k: round(v, 3) for k, v in fit.params.items()}
             print(
-                f"gain {'free' if pinned is None else 'true'}: {'+'.join(effects)} fit "
-                f"{problem.rmse(fit, fit_items):.2f} held-out {problem.rmse(fit, heldout):.2f} {params}"
+                f"gain {'free' if pinned is None else 'true'}: {fit_line(problem, fit, fit_items, heldout)}"
             )
 
 

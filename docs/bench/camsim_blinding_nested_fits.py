@@ -39,6 +39,15 @@ PATHS = {
 }
 
 
+def fit_line(problem, fit, fit_items, heldout) -> str:
+    """A fit's effects, its RMSE on the fit and the held-out pairs and its parameters, on one line."""
+    params = {k: round(v, 3) for k, v in fit.params.items()}
+    return (
+        f"{'+'.join(sorted(fit.effects))} fit {problem.rmse(fit, fit_items):.3f} "
+        f"held {problem.rmse(fit, heldout):.3f} {params}"
+    )
+
+
 def main() -> None:
     folder, seed = Path(sys.argv[1]), int(sys.argv[2]) % 2**31
     paths = PATHS[sys.argv[3] if len(sys.argv) > 3 else "halo"]
@@ -49,11 +58,7 @@ def main() -> None:
     for effects in map(frozenset, paths):
         start = previous if previous is not None and previous.effects <= effects else None
         previous = problem.fit(effects, fit_items, start)
-        params = {k: round(v, 3) for k, v in previous.params.items()}
-        print(
-            f"{'+'.join(sorted(effects))} fit {problem.rmse(previous, fit_items):.3f} "
-            f"held {problem.rmse(previous, heldout):.3f} {params}"
-        )
+        print(fit_line(problem, previous, fit_items, heldout))
 
 
 if __name__ == "__main__":
