@@ -8,6 +8,7 @@ import math
 import pytest
 import torch
 
+from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_blinding import (
     GLARE_REFERENCE_PX,
     BlindingFrames,
@@ -71,15 +72,24 @@ def test_a_shoulder_lifts_the_shadows_above_srgb():
     assert float(srgb_decode(physics.encode(faint, None))) == pytest.approx(0.01, rel=1e-9)
 
 
+def one_pair_problem() -> BlindingFrames:
+    """A blinding frame model of one small pair: a grey scene, and a laser spot whose capture saturates its core."""
+    ys, xs = torch.meshgrid(torch.arange(24.0), torch.arange(32.0), indexing="ij")
+    spot = torch.exp(-((xs - 16) ** 2 + (ys - 12) ** 2) / (2 * 3.0**2)).double()
+    pattern = (1.5 * spot * torch.tensor([1.0, 0.1, 0.05], dtype=torch.float64).reshape(3, 1, 1)).clamp(
+        max=1.0
+    )
+    scene = torch.full((3, 24, 32), 0.4, dtype=torch.float64)
+    return BlindingFrames([Pair("spot", scene, (scene + pattern).clamp(max=1.0), pattern, 1.0)], seed=0)
+
+
 @pytest.mark.parametrize("gain", [0.18, 1.0, 30.0, 150.0])
 def test_laser_gains_of_a_fraction_to_a_hundred_are_inside_the_search_range(gain):
     """The gain spans decades (about 1 for a pattern captured at the attack's power, tens for a capture exposed for
     the beam's profile): searched on its logarithm, none of these reads as pinned at a bound (on a linear 0-200
     range, 0.18 did)."""
     (spec,) = [
-        p
-        for p in BlindingFrames.param_specs(None, frozenset({"linear_light_saturation"}))
-        if "gain" in p.name
+        p for p in one_pair_problem().param_specs(frozenset({"linear_light_saturation"})) if "gain" in p.name
     ]
     value = math.log10(gain)
     assert at_bound(value, spec.low, spec.high) is None
