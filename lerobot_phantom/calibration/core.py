@@ -52,6 +52,9 @@ def exclusive(candidates: tuple[Effect, ...], effects: frozenset[str] | set[str]
     return any(set(e.excludes) & set(effects) for e in candidates if e.name in effects)
 
 
+BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
+
+
 @dataclass(frozen=True)
 class Param:
     """A fitted parameter: start value, bounds and a typical magnitude (the optimiser works in ``value/scale``).
@@ -291,6 +294,95 @@ class Step:
     # a step inside a group of interacting effects kept together (forward_select): its effect is judged with the
     # whole group, from the step before the group to the step that completes it
     paired: bool = False
+    # scored groups set aside, with the reason: a member's own parameter at a bound in most folds (pinned_members),
+    # or the richer of two forms of one term not under the simpler one by the margin (richer_alternatives)
+    pinned: dict[str, str] = field(default_factory=dict)
+
+
+def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
+    """``"low"``/``"high"`` when ``value`` sits within ``tolerance`` x range of that bound, else None."""
+    span = max(high - low, 1e-300)
+    if value - low <= tolerance * span:
+        return "low"
+    if high - value <= tolerance * span:
+        return "high"
+    return None
+
+
+def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozenset[str]:
+    """The effects in ``effects`` that build on ``effect``, directly or through another one (``Effect.requires``)."""
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    found: set[str] = set()
+    frontier = {effect}
+    while frontier:
+        frontier = {e for e in effects if requires.get(e, set()) & frontier} - found
+        found |= frontier
+    return frozenset(found)
+
+
+def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
+    """The parameters ``effect`` itself adds to the model with ``effects``.
+
+    Removing an effect also removes what builds on it (a stripe model without the exposure overlap has no
+    detection threshold either), so the parameters the model loses with it are split: those of each dependant
+    (found the same way, leaves first) belong to that dependant, the rest to ``effect``. A child at its bound
+    therefore makes the child "not identified", never its parent."""
+    below = dependants(problem, effects, effect)
+    without = {p.name for p in problem.param_specs(effects - {effect} - below)}
+    theirs = {p.name for child in below for p in own_params(problem, effects, child)}
+    return [p for p in problem.param_specs(effects) if p.name not in without and p.name not in theirs]
+
+
+def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[Fit]) -> dict[str, str]:
+    """The members of a scored group whose own parameters sit at one bound of their search range in most fold
+    fits (more than half; a low bound declared a physical limit, ``Param.low_limit``, excepted), with the reason.
+
+    Identification's rule 3 refuses to name such an effect (identify.py): its score measures the end of the range,
+    not the camera. Selection applies the same rule before taking a group, so a pinned form cannot take the step
+    that an identifiable alternative (another tone curve, a reflectance term) would have taken, only to be dropped
+    afterwards with that alternative never tried. Most folds must agree, so one fold's stray optimum is no reason
+    either way (seen: a power law at its bound 4 in three folds and at 3.94 in the fourth)."""
+    pinned = {}
+    for effect in members:
+        for spec in own_params(problem, model, effect):
+            sides = [at_bound(f.params[spec.name], spec.low, spec.high) for f in fits]
+            for side in ("low", "high"):
+                count = sides.count(side)
+                if 2 * count > len(fits) and not (side == "low" and spec.low_limit):
+                    bound = spec.high if side == "high" else spec.low
+                    pinned[effect] = (
+                        f"{spec.name} at its {side} bound {bound:g} in {count} of {len(fits)} folds"
+                    )
+            if effect in pinned:
+                break
+    return pinned
+
+
+def richer_alternatives(
+    problem: Problem, chosen: frozenset[str], scored: dict[frozenset[str], object]
+) -> list[tuple[frozenset[str], frozenset[str]]]:
+    """(group, simpler) for every scored group holding one form of a term (``Effect.excludes``) where ``simpler``,
+    the same group with the alternative form, was scored too and the alternative has fewer own parameters.
+
+    Two forms of one term (a power-law tone curve and a shouldered one) are not nested, so the richer form's lower
+    score is no evidence by itself: on a camera the simpler form describes, the richer one still fits a hair
+    better. Selection takes the richer form only by the margin under the simpler one (forward_select)."""
+    excludes = {e.name: set(e.excludes) for e in problem.candidates}
+    for e in problem.candidates:
+        for other in e.excludes:
+            excludes.setdefault(other, set()).add(e.name)
+    pairs = []
+    for group in scored:
+        for effect in group:
+            for alternative in excludes.get(effect, ()):
+                simpler = (group - {effect}) | {alternative}
+                if simpler not in scored:
+                    continue
+                mine = len(own_params(problem, chosen | group, effect))
+                theirs = len(own_params(problem, chosen | simpler, alternative))
+                if theirs < mine:
+                    pairs.append((group, simpler))
+    return pairs
 
 
 def cross_validated(
@@ -328,7 +420,11 @@ def forward_select(
     ``problem.joint_effects`` new effects. A group is taken over everything smaller only when it beats the best
     smaller one by the margin (its last effect earns its place given the others) and brings the margin over the
     current model once per effect in it that stands on its own - an effect that builds on another of the group
-    (``requires``) only exists to carry it and adds no margin."""
+    (``requires``) only exists to carry it and adds no margin.
+
+    Before that comparison, a scored group is set aside (``Step.pinned``, with the reason) when a member's own
+    parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
+    of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
     requires = {e.name: set(e.requires) for e in problem.candidates}
 
@@ -357,15 +453,30 @@ def forward_select(
         if not scored:
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
-        best_single = min((g for g in scored if len(g) == 1), key=lambda g: scored[g][0], default=None)
+        eligible = {}
+        for group, value in scored.items():
+            pinned = pinned_members(problem, chosen | group, group, value[1])
+            if pinned:
+                steps[-1].pinned[labels[group]] = "; ".join(
+                    f"{e}: {why}" for e, why in sorted(pinned.items())
+                )
+            else:
+                eligible[group] = value
+        for group, simpler in richer_alternatives(problem, chosen, eligible):
+            if eligible[group][0] > (1.0 - margin) * eligible[simpler][0]:
+                steps[-1].pinned[labels[group]] = (
+                    f"not {100 * margin:.0f}% under {labels[simpler]}, the same model with the simpler form"
+                )
+        eligible = {g: v for g, v in eligible.items() if labels[g] not in steps[-1].pinned}
+        best_single = min((g for g in eligible if len(g) == 1), key=lambda g: eligible[g][0], default=None)
         needed = {}
-        for group in scored:
+        for group in eligible:
             if len(group) < 2:
                 continue
-            smaller = min((v[0] for g, v in scored.items() if len(g) < len(group)), default=math.inf)
+            smaller = min((v[0] for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
             standing = max(1, sum(1 for e in group if not requires[e] & group))
             needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
-        joint = min(needed, key=lambda g: scored[g][0] / needed[g], default=None)
+        joint = min(needed, key=lambda g: eligible[g][0] / needed[g], default=None)
         if joint is not None and scored[joint][0] <= needed[joint]:
             # the steps inside the group: the order whose every prefix was scored, the best-scoring prefixes first
             # (a pair: the better of its two effects alone)

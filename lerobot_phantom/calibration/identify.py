@@ -37,10 +37,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import Fit, Param, Problem, Step, selection_value
+from lerobot_phantom.calibration.core import (
+    Fit,
+    Problem,
+    Step,
+    at_bound,
+    dependants,
+    own_params,
+    selection_value,
+)
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
-BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
 
 
 @dataclass(frozen=True)
@@ -128,16 +135,6 @@ def rmse_interval(
         return {"rmse": float(np.sqrt(squared[index].sum() / max(counts[index].sum(), 1.0)))}
 
     return bootstrap(rmse, np.arange(len(squared)), draws=draws, rng=rng)["rmse"]
-
-
-def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
-    """``"low"``/``"high"`` when ``value`` sits within ``tolerance`` x range of that bound, else None."""
-    span = max(high - low, 1e-300)
-    if value - low <= tolerance * span:
-        return "low"
-    if high - value <= tolerance * span:
-        return "high"
-    return None
 
 
 @dataclass(frozen=True)
@@ -243,30 +240,6 @@ def parameter_intervals(
         for k in samples:
             samples[k].append(float(refit.params.get(k, np.nan)))
     return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
-
-
-def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozenset[str]:
-    """The effects in ``effects`` that build on ``effect``, directly or through another one (``Effect.requires``)."""
-    requires = {e.name: set(e.requires) for e in problem.candidates}
-    found: set[str] = set()
-    frontier = {effect}
-    while frontier:
-        frontier = {e for e in effects if requires.get(e, set()) & frontier} - found
-        found |= frontier
-    return frozenset(found)
-
-
-def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
-    """The parameters ``effect`` itself adds to the model with ``effects``.
-
-    Removing an effect also removes what builds on it (a stripe model without the exposure overlap has no
-    detection threshold either), so the parameters the model loses with it are split: those of each dependant
-    (found the same way, leaves first) belong to that dependant, the rest to ``effect``. A child at its bound
-    therefore makes the child "not identified", never its parent."""
-    below = dependants(problem, effects, effect)
-    without = {p.name for p in problem.param_specs(effects - {effect} - below)}
-    theirs = {p.name for child in below for p in own_params(problem, effects, child)}
-    return [p for p in problem.param_specs(effects) if p.name not in without and p.name not in theirs]
 
 
 @dataclass

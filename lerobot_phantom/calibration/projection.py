@@ -70,14 +70,16 @@ EFFECTS = (
         "tone_shoulder",
         "the camera's tone curve rolls off towards white (a filmic / log-logistic shoulder, calibration/tone.py): "
         "added light brightens already bright pixels less than a power law predicts",
+        excludes=("sensor_gamma",),
     ),
 )
 
-# tone_shoulder is modelled but not offered to selection: offered on camsim frame pairs (master seeds 1001-3003) it
-# was selected, then not identified (knee exponent at its bound), and the refit without it had lost sensor_gamma:
-# held-out RMSE 2.90 -> 3.14, 3.00 -> 4.16, 3.39 -> 3.51 on the three crosstalk cases, no planted effect gained,
-# and it was named on sRGB cameras (which have no shoulder). See /work/notes/camsim-status.md, Session 4.
-OFFERED = tuple(e for e in EFFECTS if e.name != "tone_shoulder")
+# tone_shoulder is offered (since session 18) as the alternative to sensor_gamma, never both. Offered in session 4
+# on top of sensor_gamma, it was selected, then not identified (knee exponent at its bound), and the refit without
+# it had lost sensor_gamma. What changed: the two forms exclude each other, the richer one (the shoulder) must beat
+# the power law by the selection margin, and a form pinned at a bound in most inner folds never takes a step
+# (core.forward_select). Measured in docs/bench/camsim_session18.md
+OFFERED = EFFECTS
 
 CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
 

@@ -159,13 +159,20 @@ def build_report(
             + "; each kept "
             f"extension must lower it by >= {100 * margin:.0f}% (a group of up to {problem.joint_effects} "
             f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
-            f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group); then each kept "
+            f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group; a group is set "
+            "aside when a member's own parameter sits at a bound of its range in most folds, and the richer of two "
+            f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one); then each kept "
             "extension must pass the identification rule "
             "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
             "bound, an interval excluding its null value",
             "selected": selection.selected,
             "steps": [
-                {"effects": s.effects, "validation_error": s.validation_error, "tried": s.tried}
+                {
+                    "effects": s.effects,
+                    "validation_error": s.validation_error,
+                    "tried": s.tried,
+                    "pinned": s.pinned,
+                }
                 for s in steps
             ],
             "rejected": dict(steps[-1].tried),
@@ -336,7 +343,11 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         ]
     lines += ["", "## Selection", "", report["selection"]["criterion"] + ".", ""]
     for step in report["selection"]["steps"]:
-        tried = ", ".join(f"{k}: {v:.3g}" for k, v in step["tried"].items())
+        pinned = step.get("pinned", {})
+        tried = ", ".join(
+            f"{k}: {v:.3g}" + (f" (not eligible: {pinned[k]})" if k in pinned else "")
+            for k, v in step["tried"].items()
+        )
         lines.append(
             f"- {step['effects'] or ['base']}: validation {report['selection']['score']} "
             f"{step['validation_error']:.3g}" + (f"; candidates tried next: {tried}" if tried else "")

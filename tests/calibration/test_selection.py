@@ -6,17 +6,22 @@ import typing
 
 import numpy as np
 import pytest
+import torch
 
 from lerobot_phantom.calibration.core import (
     Effect,
     Fit,
+    Param,
     Problem,
     exclusive,
     forward_select,
     item_scores,
     selection_value,
 )
+from lerobot_phantom.calibration.frame_models.common import Pair
+from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.identify import error_ratio
+from lerobot_phantom.calibration.projection import projection_predict
 
 
 class LineWithALoneItem(Problem):
@@ -160,3 +165,117 @@ def test_a_group_of_three_is_taken_only_when_the_problem_scores_groups_of_three(
     assert [s.paired for s in steps] == [False, True, True, False]
     assert [len(s.effects) for s in steps] == [0, 1, 2, 3]
     assert all("tone" not in s.effects or "light" in s.effects for s in steps)
+
+
+class ToneForms(FixedErrors):
+    """Two forms of one tone term with parameters: ``power`` (one exponent) and ``shoulder`` (two). Errors are
+    fixed per model; the fit puts ``power``'s exponent wherever ``power_at`` says for the training items."""
+
+    candidates = (
+        Effect("power", "a power-law tone curve"),
+        Effect("shoulder", "a tone curve with a shoulder", excludes=("power",)),
+    )
+
+    def __init__(self, errors: dict, power_at=lambda items: 2.0, low_limit: str = "") -> None:
+        self.errors = {frozenset(k.split("+")) if k else frozenset(): v for k, v in errors.items()}
+        self.power_at = power_at
+        self.low_limit = low_limit
+
+    def error(self, effects: frozenset[str]) -> float:
+        return self.errors[effects]
+
+    def param_specs(self, effects):
+        specs = []
+        if "power" in effects:
+            specs.append(Param("gamma", 2.0, 0.3, 4.0, low_limit=self.low_limit))
+        if "shoulder" in effects:
+            specs += [Param("knee", 1.0, 0.0, 500.0), Param("knee_exponent", 1.0, 0.25, 4.0)]
+        return specs
+
+    def fit(self, effects, items, start=None) -> Fit:
+        params = {"gamma": self.power_at(items)} if "power" in effects else {}
+        if "shoulder" in effects:
+            params.update(knee=30.0, knee_exponent=1.2)
+        return Fit(effects, params)
+
+
+def test_a_form_pinned_at_a_bound_in_every_fold_does_not_take_the_step():
+    errors = {"": 10.0, "power": 3.0, "shoulder": 4.0}
+    chosen, steps = forward_select(ToneForms(errors), np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"power"}, steps[0].pinned  # inside its range, the better form wins
+    pinned = ToneForms(errors, power_at=lambda items: 4.0)
+    chosen, steps = forward_select(pinned, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"shoulder"}, steps[0].pinned
+    assert steps[0].pinned == {"power": "power: gamma at its high bound 4 in 4 of 4 folds"}
+    assert steps[0].tried["power"] == pytest.approx(3.0)  # scored and reported, only not eligible
+    # most folds decide: pinned in three of four (the fold validating item 0 puts gamma inside its range) is
+    # pinned; in one of four (only that fold at the bound) is a stray optimum
+    mostly = ToneForms(errors, power_at=lambda items: 4.0 if 0 in items else 3.9)
+    chosen, steps = forward_select(mostly, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"shoulder"}, steps[0].pinned
+    assert steps[0].pinned == {"power": "power: gamma at its high bound 4 in 3 of 4 folds"}
+    stray = ToneForms(errors, power_at=lambda items: 3.9 if 0 in items else 4.0)
+    assert forward_select(stray, np.arange(20), seed=0, margin=0.05)[0] == {"power"}
+    # a low bound that is the form's declared physical limit is a value, not a pin
+    at_limit = ToneForms(errors, power_at=lambda items: 0.3, low_limit="a linear response")
+    assert forward_select(at_limit, np.arange(20), seed=0, margin=0.05)[0] == {"power"}
+    at_low = ToneForms(errors, power_at=lambda items: 0.3)
+    assert forward_select(at_low, np.arange(20), seed=0, margin=0.05)[0] == {"shoulder"}
+
+
+@pytest.mark.parametrize(("shoulder_error", "expected"), [(4.9, "power"), (4.8, "power"), (4.7, "shoulder")])
+def test_the_richer_of_two_forms_must_beat_the_simpler_by_the_margin(shoulder_error, expected):
+    """shoulder (two parameters) against power (one): 4.9 and 4.8 are under 5% below 5.0, 4.7 is 6% below."""
+    problem = ToneForms({"": 10.0, "power": 5.0, "shoulder": shoulder_error})
+    chosen, steps = forward_select(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {expected}, (steps[0].tried, steps[0].pinned)
+    if expected == "power":
+        assert steps[0].pinned == {"shoulder": "not 5% under power, the same model with the simpler form"}
+    else:
+        assert steps[0].pinned == {}
+
+
+def projection_pairs(tone: frozenset[str], tone_params: dict, seed: int) -> list:
+    """Six small light projection pairs rendered with the library's own additive light on reflectance under ``tone``
+    (a shouldered curve or a power law), with a grey level of noise and 8-bit quantisation."""
+    g = torch.Generator().manual_seed(seed)
+    effects = frozenset({"additive_light", "albedo_modulation"}) | tone
+    params = {"strength": 0.6, "reflectance_floor": 0.02, **tone_params}
+    pairs = []
+    for k in range(6):
+        clean = (0.15 + 0.7 * torch.rand(3, 12, 16, generator=g, dtype=torch.float64)).clamp(0, 1)
+        pattern = torch.zeros(3, 12, 16, dtype=torch.float64)
+        pattern[:, 2:10, 3:13] = torch.rand(3, 1, 1, generator=g, dtype=torch.float64).round()
+        pattern[k % 3, 2:10, 3:13] = 1.0
+        intensity = 0.2 + 0.15 * k
+        flat = projection_predict(
+            clean.reshape(3, -1).T,
+            pattern.reshape(3, -1).T,
+            torch.full((12 * 16, 1), intensity, dtype=torch.float64),
+            effects,
+            params,
+        )
+        noisy = flat.T.reshape(3, 12, 16) + torch.randn(3, 12, 16, generator=g, dtype=torch.float64) / 255
+        quantised = lambda image: (image.clamp(0, 1) * 255).round() / 255  # noqa: E731
+        pairs.append(Pair(f"p{k}", quantised(clean), quantised(noisy), pattern, intensity))
+    return pairs
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("tone", "tone_params", "named", "not_named"),
+    [
+        ({"tone_shoulder"}, {"shoulder": 40.0, "shoulder_exponent": 1.2}, "tone_shoulder", "sensor_gamma"),
+        ({"sensor_gamma"}, {"gamma": 2.2}, "sensor_gamma", "tone_shoulder"),
+    ],
+)
+def test_light_projection_selects_the_tone_form_the_frames_were_made_with(
+    tone, tone_params, named, not_named
+):
+    """Light projection offers both tone forms, never together: on frames made under a filmic-like shoulder the
+    shoulder is selected (with the reflectance term it carries), on power-law frames the power law is."""
+    problem = ProjectionFrames(projection_pairs(frozenset(tone), tone_params, seed=7), seed=0)
+    assert exclusive(problem.candidates, {"tone_shoulder", "sensor_gamma"})
+    chosen, steps = forward_select(problem, np.arange(6), seed=0, margin=0.05)
+    assert named in chosen and not_named not in chosen, [(s.effects, s.tried, s.pinned) for s in steps]
+    assert {"additive_light", "albedo_modulation"} <= chosen
