@@ -9,39 +9,34 @@ the null cases that gained an effect (what the case tests assert).
 
 from __future__ import annotations
 
-import importlib
-import json
-import os
+import itertools
 import sys
 from pathlib import Path
 
-sys.path.insert(0, "tests/calibration")
+sys.path.insert(0, str(Path(__file__).parent))
+
+from camsim_named_causes import case_results
 
 
 def main() -> None:
-    out = Path(sys.argv[1])
-    for folder in sorted(out.glob("bt_*")):
-        seed = folder.name.removeprefix("bt_")
-        os.environ["CAMSIM_SEED"] = seed
-        sim = importlib.reload(importlib.import_module("test_independent_sim"))
-        effect_cases = [sim.CASE_BY_NAME[n] for n in sim.SELECTED if sim.CASE_BY_NAME[n].kind == "effect"]
-        null_cases = [sim.CASE_BY_NAME[n] for n in sim.SELECTED if sim.CASE_BY_NAME[n].kind == "null"]
-        misses, inventing, gained = [], [], []
-        for case in effect_cases + null_cases:
-            report = json.loads((folder / "camsim0" / case.name / "out" / "report.json").read_text())
-            named = sim.named_causes(report)
+    results = case_results(Path(sys.argv[1]), skip_missing=False)
+    for seed, cases in itertools.groupby(results, key=lambda result: result[0]):
+        misses, inventing, gained, effect_cases = [], [], [], 0
+        for _seed, _sim, case, report, judged in cases:
             if case.kind == "null":
                 if report["extended"]["effects"]:
                     gained.append(f"{case.name} gained {sorted(report['extended']['effects'])}")
                 continue
-            if not case.planted <= named:
-                misses.append(f"{case.name} named {sorted(named)}")
-            unplanted = named - case.planted - sim.tolerated(case, sim.case_camera(case)[2])
-            if len(unplanted) > 1:
-                inventing.append(f"{case.name} unplanted {sorted(unplanted)}")
-        named_cases = len(effect_cases) - len(misses)
+            if case.kind != "effect":
+                continue
+            effect_cases += 1
+            if not judged["passed"]:
+                misses.append(f"{case.name} named {sorted(judged['named'])}")
+            if len(judged["unplanted"]) > 1:
+                inventing.append(f"{case.name} unplanted {sorted(judged['unplanted'])}")
         print(
-            f"seed {seed}: {named_cases} of {len(effect_cases)} effect cases named; misses: {'; '.join(misses)}"
+            f"seed {seed}: {effect_cases - len(misses)} of {effect_cases} effect cases named; misses: "
+            f"{'; '.join(misses)}"
             + (f"; more than one unplanted cause: {'; '.join(inventing)}" if inventing else "")
             + (f"; null cases that gained an effect: {'; '.join(gained)}" if gained else "")
         )

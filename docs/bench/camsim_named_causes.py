@@ -12,30 +12,45 @@ import importlib
 import json
 import os
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 
 sys.path.insert(0, "tests/calibration")
 
 
+def case_results(out: Path, skip_missing: bool = True) -> Iterator[tuple[str, object, object, dict, dict]]:
+    """(master seed, the test module for it, case, report, judged) for every case a batch under ``out`` selected;
+    ``judged`` holds the camera, the causes named, the unplanted ones and whether the case passed its rule."""
+    for folder in sorted(Path(out).glob("bt_*")):
+        seed = folder.name.removeprefix("bt_")
+        os.environ["CAMSIM_SEED"] = seed
+        sim = importlib.reload(importlib.import_module("test_independent_sim"))
+        for name in sim.SELECTED:
+            path = folder / "camsim0" / name / "out" / "report.json"
+            if skip_missing and not path.exists():
+                continue
+            report, case = json.loads(path.read_text()), sim.CASE_BY_NAME[name]
+            camera = sim.case_camera(case)[2]
+            named = sim.named_causes(report)
+            passed = case.planted <= named if case.kind == "effect" else not report["extended"]["effects"]
+            judged = {
+                "camera": camera,
+                "named": named,
+                "unplanted": named - case.planted - sim.tolerated(case, camera),
+                "passed": passed,
+            }
+            yield seed, sim, case, report, judged
+
+
 def main() -> None:
     for out in sys.argv[1:]:
-        for folder in sorted(Path(out).glob("bt_*")):
-            os.environ["CAMSIM_SEED"] = folder.name.removeprefix("bt_")
-            sim = importlib.reload(importlib.import_module("test_independent_sim"))
-            for name in sim.SELECTED:
-                path = folder / "camsim0" / name / "out" / "report.json"
-                if not path.exists():
-                    continue
-                report, case = json.loads(path.read_text()), sim.CASE_BY_NAME[name]
-                camera = sim.case_camera(case)[2]
-                named = sim.named_causes(report)
-                unplanted = named - case.planted - sim.tolerated(case, camera)
-                passed = case.planted <= named if case.kind == "effect" else not report["extended"]["effects"]
-                print(
-                    f"{folder.name.removeprefix('bt_'):>11} {name:24s} {camera.tone:6s} "
-                    f"{'OK  ' if passed else 'MISS'} named={sorted(named)} unplanted={sorted(unplanted)} "
-                    f"held-out {report['extended']['heldout_rmse']:.2f} base {report['base']['heldout_rmse']:.2f}"
-                )
+        for seed, _sim, case, report, judged in case_results(Path(out)):
+            print(
+                f"{seed:>11} {case.name:24s} {judged['camera'].tone:6s} "
+                f"{'OK  ' if judged['passed'] else 'MISS'} named={sorted(judged['named'])} "
+                f"unplanted={sorted(judged['unplanted'])} "
+                f"held-out {report['extended']['heldout_rmse']:.2f} base {report['base']['heldout_rmse']:.2f}"
+            )
 
 
 if __name__ == "__main__":

@@ -3,7 +3,7 @@
 Usage: ``python docs/bench/camsim_report_summary.py REPORT.json...`` (the reports a camsim run keeps under pytest's
 ``--basetemp``, e.g. ``CAMSIM_SEED=... CAMSIM_CASES=... pytest --runxfail --basetemp=DIR
 tests/calibration/test_independent_sim.py``). Prints the written model's effects, the findings and the noise
-decision; each selection step with its validation error and the errors of what it tried; each identification with
+decision; each selection step with its validation error, the errors of what it tried and the groups it set aside; each identification with
 its reasons and parameters; the base's parameters and both held-out RMSEs.
 """
 
@@ -24,6 +24,8 @@ def summary(path: str) -> list[str]:
     for step in report["selection"]["steps"]:
         tried = {k: round(v, 3) for k, v in step["tried"].items()}
         lines.append(f" step {step['effects']} {round(step['validation_error'], 3)} {tried}")
+        for group, reason in step.get("pinned", {}).items():  # reports since session 18
+            lines.append(f"   set aside {group}: {reason}")
     for result in report["identification"]:
         params = {k: round(v, 3) for k, v in result["params"].items()}
         lines.append(f" id {result['effect']} {result['status']} {result['reasons']} {params}")
