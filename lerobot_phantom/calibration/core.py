@@ -524,21 +524,37 @@ def fit_chain(problem: Problem, steps: list[Step], items: np.ndarray) -> list[Fi
     return fits
 
 
-def binned_rmse(x: np.ndarray, residual: np.ndarray, bins: int = 8) -> dict[str, list[float]]:
-    """RMSE of ``residual`` in quantile bins of ``x`` (or per distinct value when ``x`` has few values)."""
+# a variable with at most MAX_LEVELS distinct values, each seen MIN_PER_LEVEL times on average, is binned by level
+MAX_LEVELS = 16
+MIN_PER_LEVEL = 3
+
+
+def bin_index(x: np.ndarray, bins: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    """Each value's bin and the bins' centres: one bin per distinct value when ``x`` has few values, else ``bins``
+    quantile bins.
+
+    A variable is binned by its levels when it has at most ``bins`` of them, or at most ``MAX_LEVELS`` seen
+    ``MIN_PER_LEVEL`` times each on average (a table's settings): quantile bins would merge neighbouring levels, and
+    an effect need not be smooth across them (a beat with the frame rate changes sign between neighbouring laser
+    frequencies, and two merged levels cancel)."""
     x = np.asarray(x, dtype=np.float64).ravel()
+    levels = np.unique(x)
+    if len(levels) <= bins or (len(levels) <= MAX_LEVELS and len(x) >= MIN_PER_LEVEL * len(levels)):
+        return np.searchsorted(levels, x), levels
+    edges = np.unique(np.quantile(x, np.linspace(0, 1, bins + 1)))
+    index = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
+    return index, 0.5 * (edges[:-1] + edges[1:])
+
+
+def binned_rmse(x: np.ndarray, residual: np.ndarray, bins: int = 8) -> dict[str, list[float]]:
+    """RMSE of ``residual`` per bin of ``x`` (:func:`bin_index`)."""
+    index, centres = bin_index(x, bins)
     residual = np.asarray(residual, dtype=np.float64).ravel()
-    values = np.unique(x)
-    if len(values) <= bins:
-        groups = [(float(v), x == v) for v in values]
-    else:
-        edges = np.unique(np.quantile(x, np.linspace(0, 1, bins + 1)))
-        index = np.clip(np.searchsorted(edges, x, side="right") - 1, 0, len(edges) - 2)
-        groups = [(float(0.5 * (edges[i] + edges[i + 1])), index == i) for i in range(len(edges) - 1)]
-    centres, rmses, counts = [], [], []
-    for centre, mask in groups:
-        if mask.any():
-            centres.append(centre)
-            rmses.append(float(np.sqrt(np.mean(residual[mask] ** 2))))
-            counts.append(int(mask.sum()))
-    return {"x": centres, "rmse": rmses, "count": counts}
+    counts = np.bincount(index, minlength=len(centres))
+    squares = np.bincount(index, weights=residual**2, minlength=len(centres))
+    kept = counts > 0
+    return {
+        "x": centres[kept].tolist(),
+        "rmse": np.sqrt(squares[kept] / counts[kept]).tolist(),
+        "count": counts[kept].tolist(),
+    }

@@ -3,7 +3,8 @@
 Run on the held-out residual of the model that is written (base + identified effects). Two kinds of test:
 
 - **dependence on a variable** (position in the frame, intensity, brightness, channel, the table's settings): the
-  share of the residual's variance explained by its mean in up to 8 quantile bins of the variable (eta squared).
+  share of the residual's variance explained by its mean per bin of the variable (eta squared): up to 8 quantile
+  bins, or one bin per level for a variable of few distinct values (``core.bin_index``: a table's settings).
   Structure remains when the lower end of the 90% item-bootstrap interval of eta squared exceeds both
   ``MIN_EXPLAINED`` (2% of the residual variance) and the 99th percentile of eta squared when residuals are
   permuted against the variable (``PERMUTATIONS`` permutations; what chance alone gives with this many values);
@@ -25,6 +26,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from lerobot_phantom.calibration.core import bin_index
 from lerobot_phantom.calibration.identify import bootstrap
 
 BINS = 8
@@ -43,14 +45,6 @@ class ResidualSample:
     residual: list[np.ndarray]
     covariates: dict[str, list[np.ndarray]]
     neighbours: dict[str, list[tuple[np.ndarray, np.ndarray]]] = field(default_factory=dict)
-
-
-def _bin_index(values: np.ndarray) -> np.ndarray:
-    distinct = np.unique(values)
-    if len(distinct) <= BINS:
-        return np.searchsorted(distinct, values)
-    edges = np.unique(np.quantile(values, np.linspace(0, 1, BINS + 1)))
-    return np.clip(np.searchsorted(edges, values, side="right") - 1, 0, max(len(edges) - 2, 0))
 
 
 def explained_share(residual: np.ndarray, bins: np.ndarray) -> float:
@@ -103,7 +97,7 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
 
     for name, per_item in sample.covariates.items():
         values_all = np.concatenate(per_item)
-        bins_all = _bin_index(values_all)
+        bins_all = bin_index(values_all, BINS)[0]
         starts = np.concatenate([[0], np.cumsum([len(r) for r in sample.residual])])
 
         def statistic(chosen, bins_all=bins_all, values_all=values_all, starts=starts):

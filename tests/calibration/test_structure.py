@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from lerobot_phantom.calibration.core import binned_rmse
 from lerobot_phantom.calibration.structure import ResidualSample, residual_structure
 
 
@@ -70,3 +71,35 @@ def test_problems_without_a_residual_sample_are_not_tested():
 
     result = residual_structure(Table(), None, np.arange(3), base_mse=1.0, rng=np.random.default_rng(0))
     assert not result["structure_remains"] and result["summary"].startswith("not tested")
+
+
+class LevelTable:
+    """A table's worth of held-out rows: nine laser frequencies 15 Hz apart, seen 3-5 times each, and a residual
+    that beats with a 30 Hz frame rate - its sign alternates between neighbouring frequencies - plus noise."""
+
+    def __init__(self, beat: float, seed: int = 0) -> None:
+        rng = np.random.default_rng(seed)
+        self.frequency = np.repeat(30.0 + 15.0 * np.arange(9), [3, 4, 3, 5, 3, 4, 3, 4, 3])
+        self.residual = beat * np.cos(2 * np.pi * self.frequency / 30.0) + rng.normal(
+            0.0, 0.02, len(self.frequency)
+        )
+
+    def residual_sample(self, fit, items, rng):
+        return ResidualSample(
+            [self.residual[i : i + 1] for i in items],
+            {"frequency_hz": [self.frequency[i : i + 1] for i in items]},
+        )
+
+
+def test_a_beat_across_the_levels_of_a_setting_is_explained_level_by_level():
+    """Nine levels are more than 8 quantile bins: merged, two neighbouring levels would cancel. Each level is its
+    own bin, so the level means explain all of the residual but its noise; noise alone stays below chance."""
+    table = LevelTable(beat=1.0)
+    result = residual_structure(table, None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0))
+    (test,) = result["tests"]
+    assert result["structure_remains"] and test["value"] > 0.99, test
+    assert binned_rmse(table.frequency, table.residual)["x"] == sorted(set(table.frequency.tolist()))
+    noise = residual_structure(
+        LevelTable(beat=0.0), None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0)
+    )
+    assert not noise["structure_remains"], noise["summary"]
