@@ -453,21 +453,19 @@ def forward_select(
         if not scored:
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
-        eligible = {}
+        set_aside: dict[frozenset[str], str] = {}
         for group, value in scored.items():
             pinned = pinned_members(problem, chosen | group, group, value[1])
             if pinned:
-                steps[-1].pinned[labels[group]] = "; ".join(
-                    f"{e}: {why}" for e, why in sorted(pinned.items())
-                )
-            else:
-                eligible[group] = value
-        for group, simpler in richer_alternatives(problem, chosen, eligible):
-            if eligible[group][0] > (1.0 - margin) * eligible[simpler][0]:
-                steps[-1].pinned[labels[group]] = (
+                set_aside[group] = "; ".join(f"{e}: {why}" for e, why in sorted(pinned.items()))
+        unpinned = {g: v for g, v in scored.items() if g not in set_aside}
+        for group, simpler in richer_alternatives(problem, chosen, unpinned):
+            if unpinned[group][0] > (1.0 - margin) * unpinned[simpler][0]:
+                set_aside[group] = (
                     f"not {100 * margin:.0f}% under {labels[simpler]}, the same model with the simpler form"
                 )
-        eligible = {g: v for g, v in eligible.items() if labels[g] not in steps[-1].pinned}
+        steps[-1].pinned = {labels[g]: why for g, why in set_aside.items()}
+        eligible = {g: v for g, v in scored.items() if g not in set_aside}
         best_single = min((g for g in eligible if len(g) == 1), key=lambda g: eligible[g][0], default=None)
         needed = {}
         for group in eligible:
