@@ -1,5 +1,6 @@
 """Per case of ``camsim_core_batch.sh`` runs: the camera's tone curve, whether the case passed its rule (effect
-cases: planted effects named; null cases: base model kept), the causes named, the unplanted ones (the test's own
+cases: planted effects named; null cases: base model kept; unexplained cases: nothing invented and the
+structure reported, which is printed), the causes named, the unplanted ones (the test's own
 ``named_causes`` and ``tolerated``), and the held-out RMSE of the written model and of the base.
 
 Usage: ``CAMSIM_CASES=... python docs/bench/camsim_named_causes.py OUTDIR...`` from the repository root (the same
@@ -32,11 +33,17 @@ def case_results(out: Path, skip_missing: bool = True) -> Iterator[tuple[str, ob
             report, case = json.loads(path.read_text()), sim.CASE_BY_NAME[name]
             camera = sim.case_camera(case)[2]
             named = sim.named_causes(report)
-            passed = case.planted <= named if case.kind == "effect" else not report["extended"]["effects"]
+            allowed = sim.tolerated(case, camera)
+            if case.kind == "effect":
+                passed = case.planted <= named
+            elif case.kind == "unexplained":  # the test's rule: nothing invented, and the structure reported
+                passed = not named - allowed and bool(sim.unexplained_structure(report))
+            else:
+                passed = not report["extended"]["effects"]
             judged = {
                 "camera": camera,
                 "named": named,
-                "unplanted": named - case.planted - sim.tolerated(case, camera),
+                "unplanted": named - case.planted - allowed,
                 "passed": passed,
             }
             yield seed, sim, case, report, judged
@@ -44,12 +51,13 @@ def case_results(out: Path, skip_missing: bool = True) -> Iterator[tuple[str, ob
 
 def main() -> None:
     for out in sys.argv[1:]:
-        for seed, _sim, case, report, judged in case_results(Path(out)):
+        for seed, sim, case, report, judged in case_results(Path(out)):
             print(
                 f"{seed:>11} {case.name:24s} {judged['camera'].tone:6s} "
                 f"{'OK  ' if judged['passed'] else 'MISS'} named={sorted(judged['named'])} "
                 f"unplanted={sorted(judged['unplanted'])} "
                 f"held-out {report['extended']['heldout_rmse']:.2f} base {report['base']['heldout_rmse']:.2f}"
+                + (f" structure: {sim.unexplained_structure(report)}" if case.kind == "unexplained" else "")
             )
 
 
