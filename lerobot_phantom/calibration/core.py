@@ -97,12 +97,15 @@ def fit_least_squares(
     starts: Sequence[dict[str, float]] = (),
     autodiff: bool = True,
     warm: dict[str, float] | None = None,
+    tr_solver: str = "lsmr",
 ) -> dict[str, float]:
     """Bounded least squares (scipy's trust-region reflective) over named parameters; best of several starts.
 
     ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor; with ``autodiff`` its Jacobian
     comes from torch forward-mode differentiation, otherwise from finite differences. ``warm`` (a nested model's
-    fitted values) replaces the default start for the parameters it names.
+    fitted values) replaces the default start for the parameters it names. ``tr_solver`` is scipy's trust-region
+    step: ``"lsmr"`` (iterative, no factorisation of a tall Jacobian) or ``"exact"`` (a thin SVD); neither is faster
+    everywhere (docs/bench/solver_choice.md), and two parameters or fewer always take exact steps.
     """
     if not params:
         return {}
@@ -136,8 +139,8 @@ def fit_least_squares(
             bounds=(low, high),
             max_nfev=max_nfev,
             x_scale=1.0,
-            # lsmr avoids a full SVD of the tall Jacobian, but its 2-D subspace needs >= 2 parameters
-            tr_solver="lsmr" if len(params) > 2 else "exact",
+            # lsmr's 2-D subspace needs more than two parameters
+            tr_solver=tr_solver if len(params) > 2 else "exact",
         )
         if best is None or result.cost < best[0]:
             best = (

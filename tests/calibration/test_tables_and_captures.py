@@ -14,6 +14,8 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate, main
+from lerobot_phantom.calibration.core import fit_least_squares
+from lerobot_phantom.calibration.projection import TripleProblem, projection_specs
 from lerobot_phantom.transforms.calibrated import calibrated_kwargs
 
 
@@ -169,3 +171,33 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
     # stripe tables are compared row by row (StripeProblem.selection_score), and the report says so
     assert report["selection"]["score"] == "mean per-item error"
     assert "each table row's absolute error" in report["selection"]["criterion"]
+
+
+def test_both_trust_region_steps_reach_the_same_triple_fit(tmp_path):
+    """Colour-triple fits take exact trust-region steps for speed (docs/bench/solver_choice.md), not for another
+    answer: on a table with cross-talk under a power-law tone curve (11 parameters), lsmr's steps reach the same fit."""
+    rng = np.random.default_rng(11)
+    surface = rng.uniform(0.05, 0.9, (400, 3))
+    projected = rng.choice([0.0, 127 / 255, 254 / 255], (400, 3))
+    mix = np.array([[0.5, 0.1, 0.0], [0.05, 0.6, 0.1], [0.0, 0.15, 0.4]])
+    light = (projected**2.2) @ mix.T * (surface**2.2 + 0.05)
+    captured = np.clip((surface**2.2 + light) ** (1 / 2.2) + rng.normal(0, 1 / 255, (400, 3)), 0, 1)
+    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
+    data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
+    table = tmp_path / "triples.csv"
+    table.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
+    problem = TripleProblem(table)
+    effects = frozenset({"additive_light", "albedo_modulation", "channel_crosstalk", "sensor_gamma"})
+    items = np.arange(problem.n_items)
+    target = problem.captured
+
+    def residuals(params):
+        return (problem.predict(effects, params, items) - target).ravel()
+
+    fits = {
+        solver: fit_least_squares(projection_specs(effects), residuals, tr_solver=solver)
+        for solver in ("lsmr", "exact")
+    }
+    assert len(fits["exact"]) == 11
+    assert fits["exact"]["gamma"] == pytest.approx(2.2, abs=0.1)
+    assert fits["exact"] == pytest.approx(fits["lsmr"], abs=2e-3)
