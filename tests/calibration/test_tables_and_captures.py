@@ -30,15 +30,20 @@ def write_stripe_table(path, rng, row_time, offset, height=480, unit=1e-4, noise
     path.write_text("\n".join(lines) + "\n")
 
 
+def write_triple_table(path, surface, projected, captured):
+    """A colour-triple CSV (origin, addition and outcome colours, 8-bit) from three (N, 3) arrays in [0, 1]."""
+    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
+    data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
+    path.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
+    return path
+
+
 def test_colour_triples_find_additive_light(tmp_path):
     rng = np.random.default_rng(4)
     surface = rng.uniform(0.05, 0.9, (600, 3))
     projected = rng.choice([0.0, 127 / 255, 254 / 255], (600, 3))
     captured = np.clip(surface + 0.5 * projected * (surface + 0.2) + rng.normal(0, 1 / 255, (600, 3)), 0, 1)
-    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
-    data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
-    table = tmp_path / "triples.csv"
-    table.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
+    table = write_triple_table(tmp_path / "triples.csv", surface, projected, captured)
     report = calibrate(
         CalibrateConfig(attack="light_projection", measured=str(table), out=str(tmp_path / "out"))
     )
@@ -182,11 +187,7 @@ def test_both_trust_region_steps_reach_the_same_triple_fit(tmp_path):
     mix = np.array([[0.5, 0.1, 0.0], [0.05, 0.6, 0.1], [0.0, 0.15, 0.4]])
     light = (projected**2.2) @ mix.T * (surface**2.2 + 0.05)
     captured = np.clip((surface**2.2 + light) ** (1 / 2.2) + rng.normal(0, 1 / 255, (400, 3)), 0, 1)
-    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
-    data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
-    table = tmp_path / "triples.csv"
-    table.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
-    problem = TripleProblem(table)
+    problem = TripleProblem(write_triple_table(tmp_path / "triples.csv", surface, projected, captured))
     effects = frozenset({"additive_light", "albedo_modulation", "channel_crosstalk", "sensor_gamma"})
     items = np.arange(problem.n_items)
     target = problem.captured
