@@ -15,7 +15,7 @@ import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate, main
 from lerobot_phantom.calibration.core import fit_least_squares
-from lerobot_phantom.calibration.projection import TripleProblem, projection_specs
+from lerobot_phantom.calibration.projection import TRIPLE_COLUMNS, TripleProblem, projection_specs
 from lerobot_phantom.transforms.calibrated import calibrated_kwargs
 
 
@@ -32,9 +32,10 @@ def write_stripe_table(path, rng, row_time, offset, height=480, unit=1e-4, noise
 
 def write_triple_table(path, surface, projected, captured):
     """A colour-triple CSV (origin, addition and outcome colours, 8-bit) from three (N, 3) arrays in [0, 1]."""
-    columns = [f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb"]
     data = np.round(np.concatenate([surface, projected, captured], axis=1) * 255).astype(int)
-    path.write_text(",".join(columns) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n")
+    path.write_text(
+        ",".join(TRIPLE_COLUMNS) + "\n" + "\n".join(",".join(map(str, row)) for row in data) + "\n"
+    )
     return path
 
 
