@@ -336,9 +336,20 @@ def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[P
     return [p for p in problem.param_specs(effects) if p.name not in without and p.name not in theirs]
 
 
+def pinned_in_most_folds(spec: Param, fits: list[Fit]) -> str | None:
+    """Why ``spec`` counts as pinned in ``fits`` (at one bound in more than half of them; a low bound declared a
+    physical limit excepted), or None."""
+    sides = [at_bound(f.params[spec.name], spec.low, spec.high) for f in fits]
+    for side, bound in (("low", spec.low), ("high", spec.high)):
+        count = sides.count(side)
+        if 2 * count > len(fits) and not (side == "low" and spec.low_limit):
+            return f"{spec.name} at its {side} bound {bound:g} in {count} of {len(fits)} folds"
+    return None
+
+
 def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[Fit]) -> dict[str, str]:
-    """The members of a scored group whose own parameters sit at one bound of their search range in most fold
-    fits (more than half; a low bound declared a physical limit, ``Param.low_limit``, excepted), with the reason.
+    """The members of a scored group with an own parameter at one bound of its search range in most fold fits
+    (:func:`pinned_in_most_folds`; a low bound declared a physical limit, ``Param.low_limit``, excepted), with why.
 
     Identification's rule 3 refuses to name such an effect (identify.py): its score measures the end of the range,
     not the camera. Selection applies the same rule before taking a group, so a pinned form cannot take the step
@@ -347,17 +358,10 @@ def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[
     either way (seen: a power law at its bound 4 in three folds and at 3.94 in the fourth)."""
     pinned = {}
     for effect in members:
-        for spec in own_params(problem, model, effect):
-            sides = [at_bound(f.params[spec.name], spec.low, spec.high) for f in fits]
-            for side in ("low", "high"):
-                count = sides.count(side)
-                if 2 * count > len(fits) and not (side == "low" and spec.low_limit):
-                    bound = spec.high if side == "high" else spec.low
-                    pinned[effect] = (
-                        f"{spec.name} at its {side} bound {bound:g} in {count} of {len(fits)} folds"
-                    )
-            if effect in pinned:
-                break
+        reasons = (pinned_in_most_folds(spec, fits) for spec in own_params(problem, model, effect))
+        reason = next((r for r in reasons if r), None)
+        if reason:
+            pinned[effect] = reason
     return pinned
 
 
