@@ -392,6 +392,30 @@ def richer_alternatives(
     return pairs
 
 
+def groups_set_aside(
+    problem: Problem,
+    chosen: frozenset[str],
+    scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]],
+    labels: dict[frozenset[str], str],
+    margin: float,
+) -> dict[frozenset[str], str]:
+    """The scored groups a selection step may not take, with the reason: a member pinned at a bound in most fold
+    fits (:func:`pinned_members`), or the richer of two forms of one term not ``margin`` under the same group with
+    the simpler form (:func:`richer_alternatives`)."""
+    set_aside: dict[frozenset[str], str] = {}
+    for group, (_, fits, _) in scored.items():
+        pinned = pinned_members(problem, chosen | group, group, fits)
+        if pinned:
+            set_aside[group] = "; ".join(f"{e}: {why}" for e, why in sorted(pinned.items()))
+    unpinned = {g: v for g, v in scored.items() if g not in set_aside}
+    for group, simpler in richer_alternatives(problem, chosen, unpinned):
+        if unpinned[group][0] > (1.0 - margin) * unpinned[simpler][0]:
+            set_aside[group] = (
+                f"not {100 * margin:.0f}% under {labels[simpler]}, the same model with the simpler form"
+            )
+    return set_aside
+
+
 def cross_validated(
     problem: Problem, effects: frozenset[str], splits, parents: list[Fit] | None
 ) -> tuple[float, list[Fit], dict[int, float]]:
@@ -460,17 +484,7 @@ def forward_select(
         if not scored:
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
-        set_aside: dict[frozenset[str], str] = {}
-        for group, value in scored.items():
-            pinned = pinned_members(problem, chosen | group, group, value[1])
-            if pinned:
-                set_aside[group] = "; ".join(f"{e}: {why}" for e, why in sorted(pinned.items()))
-        unpinned = {g: v for g, v in scored.items() if g not in set_aside}
-        for group, simpler in richer_alternatives(problem, chosen, unpinned):
-            if unpinned[group][0] > (1.0 - margin) * unpinned[simpler][0]:
-                set_aside[group] = (
-                    f"not {100 * margin:.0f}% under {labels[simpler]}, the same model with the simpler form"
-                )
+        set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
         steps[-1].pinned = {labels[g]: why for g, why in set_aside.items()}
         eligible = {g: v for g, v in scored.items() if g not in set_aside}
         best_single = min((g for g in eligible if len(g) == 1), key=lambda g: eligible[g][0], default=None)
