@@ -21,7 +21,7 @@ os.environ.setdefault(
 )  # the test module reads it on import; each draw below is seeded itself
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
 
-from test_stripes import DUTIES, draw_camera
+from test_stripes import draw_camera, fixed_band_table
 
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.stripes import StripeProblem
@@ -35,13 +35,7 @@ def main(draws: int, scratch: Path) -> None:
     for draw in range(draws):
         rng = np.random.default_rng([draw, 3])
         camera = draw_camera(rng, "lit")
-        lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean"]
-        for f in camera["frequencies"]:
-            for d in DUTIES:
-                for e in camera["exposures_us"][::2]:
-                    lines.append(f"{f:g}Hz,{e:g},{d},{camera['height'] / 3 + rng.normal(0, 2.0):.3f}")
-        table = scratch / f"null_{draw}.csv"
-        table.write_text("\n".join(lines) + "\n")
+        table = fixed_band_table(scratch / f"null_{draw}.csv", rng, camera)
         problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
         order = rng.permutation(problem.n_items)
         held_out, fit_items = order[: problem.n_items // 5], order[problem.n_items // 5 :]

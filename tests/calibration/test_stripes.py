@@ -309,18 +309,24 @@ def test_an_overlap_of_no_use_alone_is_named_with_the_threshold_it_hosts(tmp_pat
     assert report["extended"]["heldout_rmse"] <= 30.0
 
 
-@pytest.mark.slow
-def test_fixed_band_keeps_the_base(tmp_path):
-    """Null case: rows follow the paper's band (H/3 whatever the settings, plus frame noise)."""
-    rng = np.random.default_rng([SEED, 3])
-    camera = draw_camera(rng, "lit")
+def fixed_band_table(path, rng: np.random.Generator, camera: dict):
+    """A null stripe table on ``camera``'s settings: the paper's band (H/3 rows whatever the settings) plus frame
+    noise of 2 rows."""
     lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean"]
     for f in camera["frequencies"]:
         for d in DUTIES:
             for e in camera["exposures_us"][::2]:
                 lines.append(f"{f:g}Hz,{e:g},{d},{camera['height'] / 3 + rng.normal(0, 2.0):.3f}")
-    table = tmp_path / "band.csv"
-    table.write_text("\n".join(lines) + "\n")
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.slow
+def test_fixed_band_keeps_the_base(tmp_path):
+    """Null case: rows follow the paper's band (H/3 whatever the settings, plus frame noise)."""
+    rng = np.random.default_rng([SEED, 3])
+    camera = draw_camera(rng, "lit")
+    table = fixed_band_table(tmp_path / "band.csv", rng, camera)
     report = calibrate(
         CalibrateConfig(
             attack="laser_color_strip",
