@@ -16,9 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-os.environ.setdefault(
-    "STRIPES_SEED", "0"
-)  # the test module reads it on import; each seed below is passed explicitly
+# the test module reads STRIPES_SEED on import; each seed below is passed explicitly
+os.environ.setdefault("STRIPES_SEED", "0")
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
 
 from test_stripes import band_table

@@ -16,9 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-os.environ.setdefault(
-    "STRIPES_SEED", "0"
-)  # the test module reads it on import; each draw below is seeded itself
+# the test module reads STRIPES_SEED on import; each draw below is seeded itself
+os.environ.setdefault("STRIPES_SEED", "0")
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
 
 from test_stripes import draw_camera, fixed_band_table
