@@ -297,9 +297,8 @@ class Step:
     # a step inside a group of interacting effects kept together (forward_select): its effect is judged with the
     # whole group, from the step before the group to the step that completes it
     paired: bool = False
-    # scored groups set aside, with the reason: a member's own parameter at a bound in most folds (pinned_members),
-    # or the richer of two forms of one term not under the simpler one by the margin (richer_alternatives)
-    pinned: dict[str, str] = field(default_factory=dict)
+    # scored groups this step could not take, with the reason (groups_set_aside)
+    set_aside: dict[str, str] = field(default_factory=dict)
 
 
 def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
@@ -453,7 +452,7 @@ def forward_select(
     current model once per effect in it that stands on its own - an effect that builds on another of the group
     (``requires``) only exists to carry it and adds no margin.
 
-    Before that comparison, a scored group is set aside (``Step.pinned``, with the reason) when a member's own
+    Before that comparison, a scored group is set aside (``Step.set_aside``, with the reason) when a member's own
     parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
     of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
@@ -485,7 +484,7 @@ def forward_select(
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
         set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
-        steps[-1].pinned = {labels[g]: why for g, why in set_aside.items()}
+        steps[-1].set_aside = {labels[g]: why for g, why in set_aside.items()}
         eligible = {g: v for g, v in scored.items() if g not in set_aside}
         best_single = min((g for g in eligible if len(g) == 1), key=lambda g: eligible[g][0], default=None)
         needed = {}

@@ -37,6 +37,11 @@ from lerobot_phantom.calibration.tone import (
 
 TRIPLE_COLUMNS = tuple(f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb")
 
+# every effect is offered to selection. tone_shoulder is the alternative to sensor_gamma, never both: offered in
+# session 4 on top of sensor_gamma, it was selected, then not identified (knee exponent at its bound), and the refit
+# without it had lost sensor_gamma. Since session 18 the two forms exclude each other, the richer one (the shoulder)
+# must beat the power law by the selection margin, and a form pinned at a bound in most inner folds never takes a
+# step (core.forward_select). Measured in docs/bench/camsim_session18.md
 EFFECTS = (
     Effect(
         "additive_light",
@@ -73,13 +78,6 @@ EFFECTS = (
         excludes=("sensor_gamma",),
     ),
 )
-
-# tone_shoulder is offered (since session 18) as the alternative to sensor_gamma, never both. Offered in session 4
-# on top of sensor_gamma, it was selected, then not identified (knee exponent at its bound), and the refit without
-# it had lost sensor_gamma. What changed: the two forms exclude each other, the richer one (the shoulder) must beat
-# the power law by the selection margin, and a form pinned at a bound in most inner folds never takes a step
-# (core.forward_select). Measured in docs/bench/camsim_session18.md
-OFFERED = EFFECTS
 
 CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
 
@@ -217,7 +215,7 @@ class TripleProblem(Problem):
     units = "grey levels (0-255)"
     base_model = "alpha blend of surface and projected colour (the paper's light projection)"
     extended_model = "additive projector light"
-    candidates = OFFERED
+    candidates = EFFECTS
     item_name = "table rows"
 
     def __init__(self, path: Path) -> None:

@@ -171,7 +171,7 @@ def build_report(
                     "effects": s.effects,
                     "validation_error": s.validation_error,
                     "tried": s.tried,
-                    "pinned": s.pinned,
+                    "set_aside": s.set_aside,
                 }
                 for s in steps
             ],
@@ -343,9 +343,9 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         ]
     lines += ["", "## Selection", "", report["selection"]["criterion"] + ".", ""]
     for step in report["selection"]["steps"]:
-        pinned = step.get("pinned", {})
+        set_aside = step["set_aside"]
         tried = ", ".join(
-            f"{k}: {v:.3g}" + (f" (not eligible: {pinned[k]})" if k in pinned else "")
+            f"{k}: {v:.3g}" + (f" (not eligible: {set_aside[k]})" if k in set_aside else "")
             for k, v in step["tried"].items()
         )
         lines.append(

@@ -31,8 +31,8 @@ def test_the_example_is_written_and_its_physics_found(tmp_path, capsys):
     assert report["extended"]["heldout_rmse"] < 3.0  # 8-bit noise of 1 grey level, quantised
     # groups selection set aside are ones it scored, and report.md gives each one's reason
     steps = report["selection"]["steps"]
-    set_aside = [(group, why) for step in steps for group, why in step["pinned"].items()]
+    set_aside = [(group, why) for step in steps for group, why in step["set_aside"].items()]
     assert set_aside, "the example's tone_shoulder runs to its bounds: its groups are set aside"
-    assert all(set(step["pinned"]) <= set(step["tried"]) for step in steps)
+    assert all(set(step["set_aside"]) <= set(step["tried"]) for step in steps)
     markdown = (tmp_path / "out" / "report.md").read_text()
     assert all(f"{group}: " in markdown and f"(not eligible: {why})" in markdown for group, why in set_aside)

@@ -202,18 +202,18 @@ class ToneForms(FixedErrors):
 def test_a_form_pinned_at_a_bound_in_every_fold_does_not_take_the_step():
     errors = {"": 10.0, "power": 3.0, "shoulder": 4.0}
     chosen, steps = forward_select(ToneForms(errors), np.arange(20), seed=0, margin=0.05)
-    assert chosen == {"power"}, steps[0].pinned  # inside its range, the better form wins
+    assert chosen == {"power"}, steps[0].set_aside  # inside its range, the better form wins
     pinned = ToneForms(errors, power_at=lambda items: 4.0)
     chosen, steps = forward_select(pinned, np.arange(20), seed=0, margin=0.05)
-    assert chosen == {"shoulder"}, steps[0].pinned
-    assert steps[0].pinned == {"power": "power: gamma at its high bound 4 in 4 of 4 folds"}
+    assert chosen == {"shoulder"}, steps[0].set_aside
+    assert steps[0].set_aside == {"power": "power: gamma at its high bound 4 in 4 of 4 folds"}
     assert steps[0].tried["power"] == pytest.approx(3.0)  # scored and reported, only not eligible
     # most folds decide: pinned in three of four (the fold validating item 0 puts gamma inside its range) is
     # pinned; in one of four (only that fold at the bound) is a stray optimum
     mostly = ToneForms(errors, power_at=lambda items: 4.0 if 0 in items else 3.9)
     chosen, steps = forward_select(mostly, np.arange(20), seed=0, margin=0.05)
-    assert chosen == {"shoulder"}, steps[0].pinned
-    assert steps[0].pinned == {"power": "power: gamma at its high bound 4 in 3 of 4 folds"}
+    assert chosen == {"shoulder"}, steps[0].set_aside
+    assert steps[0].set_aside == {"power": "power: gamma at its high bound 4 in 3 of 4 folds"}
     stray = ToneForms(errors, power_at=lambda items: 3.9 if 0 in items else 4.0)
     assert forward_select(stray, np.arange(20), seed=0, margin=0.05)[0] == {"power"}
     # a low bound that is the form's declared physical limit is a value, not a pin
@@ -228,11 +228,11 @@ def test_the_richer_of_two_forms_must_beat_the_simpler_by_the_margin(shoulder_er
     """shoulder (two parameters) against power (one): 4.9 and 4.8 are under 5% below 5.0, 4.7 is 6% below."""
     problem = ToneForms({"": 10.0, "power": 5.0, "shoulder": shoulder_error})
     chosen, steps = forward_select(problem, np.arange(20), seed=0, margin=0.05)
-    assert chosen == {expected}, (steps[0].tried, steps[0].pinned)
+    assert chosen == {expected}, (steps[0].tried, steps[0].set_aside)
     if expected == "power":
-        assert steps[0].pinned == {"shoulder": "not 5% under power, the same model with the simpler form"}
+        assert steps[0].set_aside == {"shoulder": "not 5% under power, the same model with the simpler form"}
     else:
-        assert steps[0].pinned == {}
+        assert steps[0].set_aside == {}
 
 
 def projection_pairs(tone: frozenset[str], tone_params: dict, seed: int) -> list:
@@ -277,5 +277,5 @@ def test_light_projection_selects_the_tone_form_the_frames_were_made_with(
     problem = ProjectionFrames(projection_pairs(frozenset(tone), tone_params, seed=7), seed=0)
     assert exclusive(problem.candidates, {"tone_shoulder", "sensor_gamma"})
     chosen, steps = forward_select(problem, np.arange(6), seed=0, margin=0.05)
-    assert named in chosen and not_named not in chosen, [(s.effects, s.tried, s.pinned) for s in steps]
+    assert named in chosen and not_named not in chosen, [(s.effects, s.tried, s.set_aside) for s in steps]
     assert {"additive_light", "albedo_modulation"} <= chosen

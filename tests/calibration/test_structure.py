@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from lerobot_phantom.calibration.core import binned_rmse
 from lerobot_phantom.calibration.structure import ResidualSample, residual_structure
@@ -98,7 +99,10 @@ def test_a_beat_across_the_levels_of_a_setting_is_explained_level_by_level():
     result = residual_structure(table, None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0))
     (test,) = result["tests"]
     assert result["structure_remains"] and test["value"] > 0.99, test
-    assert binned_rmse(table.frequency, table.residual)["x"] == sorted(set(table.frequency.tolist()))
+    per_level = binned_rmse(table.frequency, table.residual)
+    assert per_level["x"] == sorted(set(table.frequency.tolist()))
+    assert per_level["count"] == [3, 4, 3, 5, 3, 4, 3, 4, 3]
+    assert per_level["rmse"] == pytest.approx([1.0] * 9, abs=0.05)  # |beat| = 1 at every level, noise 0.02
     noise = residual_structure(
         LevelTable(beat=0.0), None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0)
     )

@@ -7,7 +7,7 @@ import torch
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair, PixelProblem, flat_pixels
 from lerobot_phantom.calibration.projection import (
-    OFFERED as PROJECTION_EFFECTS,
+    EFFECTS as PROJECTION_EFFECTS,
 )
 from lerobot_phantom.calibration.projection import (
     projection_kwargs,
