@@ -44,7 +44,7 @@ def main(out: Path, seeds: list[int]) -> None:
             seed,
             report["extended"]["effects"],
             structure["structure_remains"],
-            f"eta={test['value']:.3f} low={test['interval']['low']:.3f} chance={test['chance_99']:.3f} "
+            f"eta={test['value']:.3f} low={test['interval']['low']:.3f} chance={test['chance']:.3f} "
             f"p={test['p_value']:.4f}",
             flush=True,
         )

@@ -107,3 +107,34 @@ def test_a_beat_across_the_levels_of_a_setting_is_explained_level_by_level():
         LevelTable(beat=0.0), None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0)
     )
     assert not noise["structure_remains"], noise["summary"]
+
+
+class NoiseTable:
+    """Held-out rows of a table: a noise residual and ``variables`` settings of 12 levels each, unrelated to it."""
+
+    def __init__(self, variables: int, rows: int = 24, seed: int = 0) -> None:
+        rng = np.random.default_rng(seed)
+        self.residual = rng.normal(0.0, 1.0, rows)
+        self.settings = {f"setting_{k}": rng.integers(0, 12, rows).astype(float) for k in range(variables)}
+
+    def residual_sample(self, fit, items, rng):
+        return ResidualSample(
+            [self.residual[i : i + 1] for i in items],
+            {name: [values[i : i + 1] for i in items] for name, values in self.settings.items()},
+        )
+
+
+def test_chance_is_judged_over_all_the_variables_tested():
+    """With k variables the chance level is the permutation null's 1 - 0.01 / k quantile (Bonferroni), so the
+    same noisy setting must clear a higher bar when it is one of ten settings tested than when it is alone."""
+    alone = residual_structure(NoiseTable(1), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0))
+    among_ten = residual_structure(
+        NoiseTable(10), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0)
+    )
+    first_alone, first_among_ten = alone["tests"][0], among_ten["tests"][0]
+    assert first_alone["variable"] == first_among_ten["variable"] == "setting_0"
+    assert first_alone["chance_quantile"] == pytest.approx(0.99)
+    assert first_among_ten["chance_quantile"] == pytest.approx(0.999)
+    # 24 rows in up to 12 levels: chance alone explains a large share of noise, and more at a stricter quantile
+    assert 0.5 < first_alone["chance"] < first_among_ten["chance"] < 1.0
+    assert not among_ten["structure_remains"], among_ten["summary"]
