@@ -67,6 +67,10 @@ class CaptureProblem(Problem):
     candidates = CAPTURE_EFFECTS
     tile = 8
     max_fit_pixels = 3000
+    # the Jacobian by finite differences, not torch forward mode: a spot model is a few dozen elementwise ops on
+    # 0-dim parameters, each of which forward mode under vmap runs as a Python decomposition; on the shared laser
+    # captures the fits match to 1e-6 and take 30% less CPU (docs/bench/capture_jacobian.py)
+    autodiff_jacobian = False
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
         from PIL import Image
@@ -203,6 +207,7 @@ class CaptureProblem(Problem):
             warm=warm,
             starts=further_starts(start, effects),
             max_nfev=20 if refit else 60,
+            autodiff=self.autodiff_jacobian,
         )
         return Fit(effects, params)
 
