@@ -69,7 +69,7 @@ class CaptureProblem(Problem):
     max_fit_pixels = 3000
     # the Jacobian by finite differences, not torch forward mode: a spot model is a few dozen elementwise ops on
     # 0-dim parameters, each of which forward mode under vmap runs as a Python decomposition; on the shared laser
-    # captures the fits match to 1e-6 and take 30% less CPU (docs/bench/capture_jacobian.py)
+    # captures the fits match to 2e-6 and take a quarter less CPU, 62 s against 84 (docs/bench/capture_jacobian.py)
     autodiff_jacobian = False
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
