@@ -2,8 +2,9 @@
 
 Replays tests/calibration/test_stripes.py::test_an_unnamed_stripe_effect_is_reported_as_structure_not_as_a_cause
 for each seed given (the same table, the same calibration seed) and prints the named effects, whether structure
-remains, and the frequency test's eta squared, the low end of its 90% bootstrap interval, the permutation 99th
-percentile it must exceed, and its permutation p-value.
+remains, and the frequency test's eta squared, the low end of its 90% bootstrap interval, the chance level it must
+exceed (the permutation null's 99th percentile before d209789, its 1 - 0.01/k quantile since), and its permutation
+p-value.
 
     python docs/bench/stripe_beat_structure.py OUTDIR SEED [SEED ...]
 """

@@ -9,9 +9,9 @@ Run on the held-out residual of the model that is written (base + identified eff
   ``MIN_EXPLAINED`` (2% of the residual variance) and what chance alone gives with this many values: the
   ``1 - FAMILY_ALPHA / k`` quantile of eta squared when the residuals are permuted (``PERMUTATIONS`` permutations,
   each scored against all ``k`` variables tested). Dividing by ``k`` (Bonferroni) holds the chance that a residual
-  without structure is reported as structured near ``FAMILY_ALPHA`` however many variables a problem offers: at
-  the 99th percentile per variable, a stripe table's five settings reported structure on 14 of 2000 null tables
-  (``docs/bench/stripe_null_structure.py``);
+  without structure is reported as structured near ``FAMILY_ALPHA`` however many variables a problem offers. On
+  2000 null stripe tables (five settings, 18 held-out rows; ``docs/bench/stripe_null_structure.py``) structure
+  was reported on 14 at the 99th percentile per variable, on 2 at this quantile;
 - **correlation between neighbours** ``LAG`` values apart along rows and along columns of a frame (a residual
   that is a smooth image, not noise): structure remains when the interval's lower end exceeds ``MIN_LAG_CORR``.
   Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
