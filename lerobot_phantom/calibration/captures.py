@@ -67,10 +67,6 @@ class CaptureProblem(Problem):
     candidates = CAPTURE_EFFECTS
     tile = 8
     max_fit_pixels = 3000
-    # the Jacobian by finite differences, not torch forward mode: a spot model is a few dozen elementwise ops on
-    # 0-dim parameters, each of which forward mode under vmap runs as a Python decomposition; on the shared laser
-    # captures the fits match to 2e-6 and take a quarter less CPU, 62 s against 84 (docs/bench/capture_jacobian.py)
-    autodiff_jacobian = False
 
     def __init__(self, path: Path, *, max_side: int, seed: int) -> None:
         from PIL import Image
@@ -207,7 +203,6 @@ class CaptureProblem(Problem):
             warm=warm,
             starts=further_starts(start, effects),
             max_nfev=20 if refit else 60,
-            autodiff=self.autodiff_jacobian,
         )
         return Fit(effects, params)
 

@@ -89,24 +89,36 @@ def further_starts(start: Fit | None, effects: frozenset[str]) -> list[dict[str,
     return [{}] if start is not None and start.effects != effects and start.params else []
 
 
+# how fit_least_squares takes a Jacobian: scipy's forward finite differences ("2-point", one residual evaluation
+# per parameter) or torch forward mode under vmap ("forward"). Finite differences are the default: forward mode runs
+# each elementwise op on a 0-dim parameter as a Python decomposition (torch 2.10), which cost more than the n
+# evaluations on every shared input, with the same fits (docs/bench/jacobian_choice.py)
+JACOBIANS = ("2-point", "forward")
+JACOBIAN = "2-point"
+
+
 def fit_least_squares(
     params: Sequence[Param],
     residuals: Callable[[dict[str, torch.Tensor]], torch.Tensor],
     *,
     max_nfev: int = 200,
     starts: Sequence[dict[str, float]] = (),
-    autodiff: bool = True,
+    jacobian: str | None = None,
     warm: dict[str, float] | None = None,
     tr_solver: str = "lsmr",
 ) -> dict[str, float]:
     """Bounded least squares (scipy's trust-region reflective) over named parameters; best of several starts.
 
-    ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor; with ``autodiff`` its Jacobian
-    comes from torch forward-mode differentiation, otherwise from finite differences. ``warm`` (a nested model's
+    ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor. ``jacobian`` is how its
+    Jacobian is taken (``JACOBIANS``; None: the module's ``JACOBIAN``); a model that is not differentiable in torch
+    (integer indexing by a parameter, a grid search inside) passes ``"2-point"`` whatever the default. ``warm`` (a nested model's
     fitted values) replaces the default start for the parameters it names. ``tr_solver`` is scipy's trust-region
     step: ``"lsmr"`` (iterative, no factorisation of a tall Jacobian) or ``"exact"`` (a thin SVD); neither is faster
     everywhere (docs/bench/solver_choice.md), and two parameters or fewer always take exact steps.
     """
+    jacobian = JACOBIAN if jacobian is None else jacobian
+    if jacobian not in JACOBIANS:
+        raise ValueError(f"jacobian={jacobian!r}: expected one of {', '.join(JACOBIANS)}")
     if not params:
         return {}
     names = [p.name for p in params]
@@ -135,7 +147,7 @@ def fit_least_squares(
         result = least_squares(
             fun,
             z0,
-            jac=jac if autodiff else "2-point",
+            jac=jac if jacobian == "forward" else "2-point",
             bounds=(low, high),
             max_nfev=max_nfev,
             x_scale=1.0,

@@ -179,9 +179,10 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
     assert "each table row's absolute error" in report["selection"]["criterion"]
 
 
-def test_both_trust_region_steps_reach_the_same_triple_fit(tmp_path):
-    """Colour-triple fits take exact trust-region steps for speed (docs/bench/solver_choice.md), not for another
-    answer: on a table with cross-talk under a power-law tone curve (11 parameters), lsmr's steps reach the same fit."""
+def test_both_trust_region_steps_and_both_jacobians_reach_the_same_triple_fit(tmp_path):
+    """Colour-triple fits take exact trust-region steps and finite-difference Jacobians for speed
+    (docs/bench/solver_choice.md, jacobian_choice.py), not for another answer: on a table with cross-talk under a
+    power-law tone curve (11 parameters), lsmr's steps and forward-mode Jacobians reach the same fit."""
     rng = np.random.default_rng(11)
     surface = rng.uniform(0.05, 0.9, (400, 3))
     projected = rng.choice([0.0, 127 / 255, 254 / 255], (400, 3))
@@ -203,3 +204,8 @@ def test_both_trust_region_steps_reach_the_same_triple_fit(tmp_path):
     assert len(fits["exact"]) == 11
     assert fits["exact"]["gamma"] == pytest.approx(2.2, abs=0.1)
     assert fits["exact"] == pytest.approx(fits["lsmr"], abs=2e-3)
+    # the Jacobian by finite differences (the default, for speed: docs/bench/jacobian_choice.py) or by forward mode
+    forward = fit_least_squares(projection_specs(effects), residuals, tr_solver="exact", jacobian="forward")
+    assert forward == pytest.approx(fits["exact"], abs=1e-4)
+    with pytest.raises(ValueError, match="2-point, forward"):
+        fit_least_squares(projection_specs(effects), residuals, jacobian="3-point")

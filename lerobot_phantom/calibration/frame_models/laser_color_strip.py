@@ -190,7 +190,7 @@ class StripFrames(LatentFrameProblem):
                         ]
                     )
 
-                params = fit_least_squares(specs, residuals, warm=params, autodiff=False, max_nfev=25)
+                params = fit_least_squares(specs, residuals, warm=params, jacobian="2-point", max_nfev=25)
             cost = sum(
                 float(
                     (

@@ -109,7 +109,7 @@ class BlurFrames(FrameProblem):
             residuals,
             warm=best[0] if start is None else start.params,
             starts=[best[1] if start is None else best[0]],
-            autodiff=False,
+            jacobian="2-point",
             max_nfev=30,
         )
         return Fit(effects, params)
@@ -144,7 +144,7 @@ class BlurFrames(FrameProblem):
                 ]
             starts = [PATH_GRID[int(k)] for k in np.argsort(costs)[:2]]
             params = fit_least_squares(
-                specs, errors, warm=fit.params, starts=starts, autodiff=False, max_nfev=30
+                specs, errors, warm=fit.params, starts=starts, jacobian="2-point", max_nfev=30
             )
             paths.append(np.array([params["dx_ref_px"], params["dy_ref_px"]]))
         return paths
