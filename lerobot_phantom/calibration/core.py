@@ -110,11 +110,12 @@ def fit_least_squares(
     """Bounded least squares (scipy's trust-region reflective) over named parameters; best of several starts.
 
     ``residuals`` maps parameters (0-dim float64 tensors) to a 1-D residual tensor. ``jacobian`` is how its
-    Jacobian is taken (``JACOBIANS``; None: the module's ``JACOBIAN``); a model that is not differentiable in torch
-    (integer indexing by a parameter, a grid search inside) passes ``"2-point"`` whatever the default. ``warm`` (a nested model's
-    fitted values) replaces the default start for the parameters it names. ``tr_solver`` is scipy's trust-region
-    step: ``"lsmr"`` (iterative, no factorisation of a tall Jacobian) or ``"exact"`` (a thin SVD); neither is faster
-    everywhere (docs/bench/solver_choice.md), and two parameters or fewer always take exact steps.
+    Jacobian is taken (``JACOBIANS``; None: the module's ``JACOBIAN``); a model that torch cannot differentiate
+    (integer indexing by a parameter, a grid search inside) passes ``"2-point"`` whatever the default. ``warm``
+    (a nested model's fitted values) replaces the default start for the parameters it names. ``tr_solver`` is
+    scipy's trust-region step: ``"lsmr"`` (iterative, no factorisation of a tall Jacobian) or ``"exact"`` (a thin
+    SVD); neither is faster everywhere (docs/bench/solver_choice.md), and two parameters or fewer always take exact
+    steps.
     """
     jacobian = JACOBIAN if jacobian is None else jacobian
     if jacobian not in JACOBIANS:
