@@ -2,8 +2,9 @@
 
 Runs ``lerobot-phantom-calibrate`` in this process on each shared input of ``calibration_shared_data.py`` (seed 0,
 the CLI's defaults) twice: first with ``core.JACOBIAN = "2-point"`` (scipy's finite differences), then with
-``"forward"`` (torch forward mode under vmap). Fits that pass their own ``jacobian`` (models torch cannot
-differentiate) are the same in both. Prints per input each run's process CPU seconds, their ratio, the written
+``"forward"`` (torch forward mode under vmap). Fits that pass their own ``jacobian`` are the same in both: models
+torch cannot differentiate, and since 0bc1c81 the stripe fits (``stripes.STRIPE_JACOBIAN``), so the stripe table's
+comparison is ``output_0bc1c81.txt``'s. Prints per input each run's process CPU seconds, their ratio, the written
 model's held-out RMSE and named effects, and the largest relative difference between the two runs' fitted
 parameters. MEASURED_DIR is ``../shared/measured`` (third-party data, not in this repository).
 

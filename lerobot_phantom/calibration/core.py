@@ -92,7 +92,8 @@ def further_starts(start: Fit | None, effects: frozenset[str]) -> list[dict[str,
 # how fit_least_squares takes a Jacobian: scipy's forward finite differences ("2-point", one residual evaluation
 # per parameter) or torch forward mode under vmap ("forward"). Finite differences are the default: forward mode runs
 # each elementwise op on a 0-dim parameter as a Python decomposition (torch 2.10), which cost more than the n
-# evaluations on every shared input, with the same fits (docs/bench/jacobian_choice.py)
+# evaluations on every shared input, with the same fits (docs/bench/jacobian_choice.py); stripe fits keep forward
+# mode (stripes.STRIPE_JACOBIAN: a regression draw where finite differences stop in another minimum)
 JACOBIANS = ("2-point", "forward")
 JACOBIAN = "2-point"
 
