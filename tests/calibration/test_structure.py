@@ -74,48 +74,11 @@ def test_problems_without_a_residual_sample_are_not_tested():
     assert not result["structure_remains"] and result["summary"].startswith("not tested")
 
 
-class LevelTable:
-    """A table's worth of held-out rows: nine laser frequencies 15 Hz apart, seen 3-5 times each, and a residual
-    that beats with a 30 Hz frame rate - its sign alternates between neighbouring frequencies - plus noise."""
+class SettingsTable:
+    """Held-out rows of a table: one residual value per row and the row's settings (name -> value per row)."""
 
-    def __init__(self, beat: float, seed: int = 0) -> None:
-        rng = np.random.default_rng(seed)
-        self.frequency = np.repeat(30.0 + 15.0 * np.arange(9), [3, 4, 3, 5, 3, 4, 3, 4, 3])
-        self.residual = beat * np.cos(2 * np.pi * self.frequency / 30.0) + rng.normal(
-            0.0, 0.02, len(self.frequency)
-        )
-
-    def residual_sample(self, fit, items, rng):
-        return ResidualSample(
-            [self.residual[i : i + 1] for i in items],
-            {"frequency_hz": [self.frequency[i : i + 1] for i in items]},
-        )
-
-
-def test_a_beat_across_the_levels_of_a_setting_is_explained_level_by_level():
-    """Nine levels are more than 8 quantile bins: merged, two neighbouring levels would cancel. Each level is its
-    own bin, so the level means explain all of the residual but its noise; noise alone stays below chance."""
-    table = LevelTable(beat=1.0)
-    result = residual_structure(table, None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0))
-    (test,) = result["tests"]
-    assert result["structure_remains"] and test["value"] > 0.99, test
-    per_level = binned_rmse(table.frequency, table.residual)
-    assert per_level["x"] == sorted(set(table.frequency.tolist()))
-    assert per_level["count"] == [3, 4, 3, 5, 3, 4, 3, 4, 3]
-    assert per_level["rmse"] == pytest.approx([1.0] * 9, abs=0.05)  # |beat| = 1 at every level, noise 0.02
-    noise = residual_structure(
-        LevelTable(beat=0.0), None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0)
-    )
-    assert not noise["structure_remains"], noise["summary"]
-
-
-class NoiseTable:
-    """Held-out rows of a table: a noise residual and ``variables`` settings of 12 levels each, unrelated to it."""
-
-    def __init__(self, variables: int, rows: int = 24, seed: int = 0) -> None:
-        rng = np.random.default_rng(seed)
-        self.residual = rng.normal(0.0, 1.0, rows)
-        self.settings = {f"setting_{k}": rng.integers(0, 12, rows).astype(float) for k in range(variables)}
+    def __init__(self, residual: np.ndarray, settings: dict[str, np.ndarray]) -> None:
+        self.residual, self.settings = residual, settings
 
     def residual_sample(self, fit, items, rng):
         return ResidualSample(
@@ -124,12 +87,50 @@ class NoiseTable:
         )
 
 
+def beat_table(beat: float, seed: int = 0) -> SettingsTable:
+    """Nine laser frequencies 15 Hz apart, seen 3-5 times each, and a residual that beats with a 30 Hz frame rate -
+    its sign alternates between neighbouring frequencies - plus noise."""
+    rng = np.random.default_rng(seed)
+    frequency = np.repeat(30.0 + 15.0 * np.arange(9), [3, 4, 3, 5, 3, 4, 3, 4, 3])
+    residual = beat * np.cos(2 * np.pi * frequency / 30.0) + rng.normal(0.0, 0.02, len(frequency))
+    return SettingsTable(residual, {"frequency_hz": frequency})
+
+
+def test_a_beat_across_the_levels_of_a_setting_is_explained_level_by_level():
+    """Nine levels are more than 8 quantile bins: merged, two neighbouring levels would cancel. Each level is its
+    own bin, so the level means explain all of the residual but its noise; noise alone stays below chance."""
+    table = beat_table(beat=1.0)
+    frequency = table.settings["frequency_hz"]
+    result = residual_structure(table, None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0))
+    (test,) = result["tests"]
+    assert result["structure_remains"] and test["value"] > 0.99, test
+    per_level = binned_rmse(frequency, table.residual)
+    assert per_level["x"] == sorted(set(frequency.tolist()))
+    assert per_level["count"] == [3, 4, 3, 5, 3, 4, 3, 4, 3]
+    assert per_level["rmse"] == pytest.approx([1.0] * 9, abs=0.05)  # |beat| = 1 at every level, noise 0.02
+    noise = residual_structure(
+        beat_table(beat=0.0), None, np.arange(32), base_mse=1.0, rng=np.random.default_rng(0)
+    )
+    assert not noise["structure_remains"], noise["summary"]
+
+
+def noise_table(variables: int, rows: int = 24, seed: int = 0) -> SettingsTable:
+    """A noise residual and ``variables`` settings of 12 levels each, unrelated to it."""
+    rng = np.random.default_rng(seed)
+    residual = rng.normal(0.0, 1.0, rows)
+    return SettingsTable(
+        residual, {f"setting_{k}": rng.integers(0, 12, rows).astype(float) for k in range(variables)}
+    )
+
+
 def test_chance_is_judged_over_all_the_variables_tested():
     """With k variables the chance level is the permutation null's 1 - 0.01 / k quantile (Bonferroni), so the
     same noisy setting must clear a higher bar when it is one of ten settings tested than when it is alone."""
-    alone = residual_structure(NoiseTable(1), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0))
+    alone = residual_structure(
+        noise_table(1), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0)
+    )
     among_ten = residual_structure(
-        NoiseTable(10), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0)
+        noise_table(10), None, np.arange(24), base_mse=1.0, rng=np.random.default_rng(0)
     )
     first_alone, first_among_ten = alone["tests"][0], among_ten["tests"][0]
     assert first_alone["variable"] == first_among_ten["variable"] == "setting_0"
