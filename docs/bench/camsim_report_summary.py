@@ -24,9 +24,8 @@ def summary(path: str) -> list[str]:
     for step in report["selection"]["steps"]:
         tried = {k: round(v, 3) for k, v in step["tried"].items()}
         lines.append(f" step {step['effects']} {round(step['validation_error'], 3)} {tried}")
-        for group, reason in step.get(
-            "set_aside", {}
-        ).items():  # reports since session 19 (session 18: "pinned")
+        # reports since session 19 (session 18's called it "pinned"; earlier ones had neither)
+        for group, reason in step.get("set_aside", {}).items():
             lines.append(f"   set aside {group}: {reason}")
     for result in report["identification"]:
         params = {k: round(v, 3) for k, v in result["params"].items()}
