@@ -95,6 +95,7 @@ class PerAttackLossLog:
         self._window_count = torch.zeros(_NUM_SLOTS, dtype=torch.float64)
         self._seen = torch.zeros(_NUM_SLOTS, dtype=torch.float64)
         self._seen_total = torch.zeros((), dtype=torch.float64)
+        self._last_reduced: torch.Tensor | None = None
         logging.info("lerobot-phantom: per-attack loss logging in %r mode", self.mode)
 
     # -- per-sample forward ---------------------------------------------------------------------------------
@@ -113,6 +114,8 @@ class PerAttackLossLog:
         self.policy.forward = forward
 
     def close(self) -> None:
+        # Called after LeRobot's loop returned: its process group and gloo's threads are gone.
+        self._last_reduced = None
         if self._original_forward is not None:
             del self.policy.forward
             self._original_forward = None
@@ -162,7 +165,14 @@ class PerAttackLossLog:
         # Every process reaches its log steps together (same step counter), so the reduction is collective.
         stacked = torch.stack([self._window_sum, self._window_count, self._seen])
         stacked = torch.cat([stacked.reshape(-1), self._seen_total.reshape(1)]).to(self.accelerator.device)
-        stacked = self.accelerator.reduce(stacked, reduction="sum").to("cpu", torch.float64)
+        stacked = self.accelerator.reduce(stacked, reduction="sum")
+        # For a sum, accelerate returns the very tensor gloo reduced. Gloo's worker thread can drop its last reference
+        # to it after the call returned (a barrier queued right after still holds the finished work). Were that the
+        # last reference, freeing the Python tensor would need the GIL, and at the end of training the main thread
+        # holds the GIL while it joins that worker (destroying DDP's process group): a deadlock after "End of
+        # training" (torch 2.10; docs/bench/ddp_teardown.md). Holding the tensor here keeps the last reference ours.
+        self._last_reduced = stacked
+        stacked = stacked.to("cpu", torch.float64)
         window_sum, window_count, seen = stacked[:-1].reshape(3, _NUM_SLOTS)
         seen_total = float(stacked[-1])
         self._window_sum.zero_()

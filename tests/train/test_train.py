@@ -206,7 +206,12 @@ def test_two_processes_share_one_epoch_plan(tmp_path, tiny_dataset_root, tiny_vl
         "lerobot_phantom.train.train",
     ]
     env = {**os.environ, "HF_HUB_OFFLINE": "1", "OMP_NUM_THREADS": "1"}
-    result = subprocess.run([*command, *args], env=env, capture_output=True, text=True, timeout=600)
+    try:
+        result = subprocess.run([*command, *args], env=env, capture_output=True, text=True, timeout=300)
+    except subprocess.TimeoutExpired as timeout:
+        log = timeout.stderr or b""  # bytes even with text=True (Python 3.11)
+        log = log.decode(errors="replace") if isinstance(log, bytes) else log
+        pytest.fail(f"torchrun still running after {timeout.timeout} s; the end of its log:\n{log[-3000:]}")
     assert result.returncode == 0, result.stderr[-3000:]
     (record,) = loss_log(out)
     assert record["seen"]["total"] == FRAMES  # 6 steps x batch 2 x 2 processes
