@@ -4,7 +4,10 @@ structure reported, which is printed), the causes named, the unplanted ones (the
 ``named_causes`` and ``tolerated``), and the held-out RMSE of the written model and of the base.
 
 Usage: ``CAMSIM_CASES=... python docs/bench/camsim_named_causes.py OUTDIR...`` from the repository root (the same
-``CAMSIM_CASES`` as the batch). Cases whose ``report.json`` is missing (a run still going) are skipped.
+``CAMSIM_CASES`` as the batch). Cases whose ``report.json`` is missing (a run still going) are skipped. With
+``CAMSIM_WITHOUT_IMPLIED=1`` the causes that an identified form implies (``Effect.implies``, since session 22) are
+taken out of each report first: how the same fits were named before (the implication adds findings and changes
+no fit).
 """
 
 from __future__ import annotations
@@ -19,6 +22,16 @@ from pathlib import Path
 sys.path.insert(0, "tests/calibration")
 
 
+def without_implied(report: dict) -> dict:
+    """The report without the causes implied by an identified form (their identification entries and findings)."""
+    implied = {r["effect"] for r in report["identification"] if r.get("implied_by")}
+    return {
+        **report,
+        "identification": [r for r in report["identification"] if not r.get("implied_by")],
+        "findings": [f for f in report["findings"] if f["effect"] not in implied],
+    }
+
+
 def case_results(out: Path, skip_missing: bool = True) -> Iterator[tuple[str, object, object, dict, dict]]:
     """(master seed, the test module for it, case, report, judged) for every case a batch under ``out`` selected;
     ``judged`` holds the camera, the causes named, the unplanted ones and whether the case passed its rule."""
@@ -31,6 +44,8 @@ def case_results(out: Path, skip_missing: bool = True) -> Iterator[tuple[str, ob
             if skip_missing and not path.exists():
                 continue
             report, case = json.loads(path.read_text()), sim.CASE_BY_NAME[name]
+            if os.environ.get("CAMSIM_WITHOUT_IMPLIED"):
+                report = without_implied(report)
             camera = sim.case_camera(case)[2]
             named = sim.named_causes(report)
             allowed = sim.tolerated(case, camera)

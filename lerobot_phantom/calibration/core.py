@@ -39,12 +39,17 @@ def single_threaded() -> Iterator[None]:
 @dataclass(frozen=True)
 class Effect:
     """A named physical extension: its cause in plain words, the effects it builds on and the effects it is an
-    alternative to (``excludes``: two forms of one physical term, never in one model; the relation is symmetric)."""
+    alternative to (``excludes``: two forms of one physical term, never in one model; the relation is symmetric).
+
+    ``implies``: causes this effect's form asserts too, without their own term in the model (a shouldered tone
+    curve is also a gamma encoding of linear light). Each is judged on the written model by its own statistic
+    (``Problem.implied_statistic``), with the same interval rule as a parameter's null value (identify.py)."""
 
     name: str
     cause: str
     requires: tuple[str, ...] = ()
     excludes: tuple[str, ...] = ()
+    implies: tuple[str, ...] = ()
 
 
 def exclusive(candidates: tuple[Effect, ...], effects: frozenset[str] | set[str]) -> bool:
@@ -226,6 +231,15 @@ class Problem:
     def null_values(self, effect: str) -> dict[str, float]:
         """Parameter values at which ``effect`` reduces to the model without it ({} for a change of form)."""
         return {}
+
+    def implied_statistic(
+        self, effect: str, implied: str, params: dict[str, float]
+    ) -> tuple[str, float, float]:
+        """(name, value, null value) of the statistic by which the fitted ``params`` of a model holding ``effect``
+        show the cause ``implied`` (``Effect.implies``)."""
+        raise NotImplementedError(
+            f"{type(self).__name__} declares no statistic for {implied} implied by {effect}"
+        )
 
     def analyse(self, fit: Fit, items: np.ndarray) -> dict[str, dict[str, list[float]]]:
         """Residual RMSE binned by the variables that could explain it: ``{variable: {"x": [...], "rmse": [...]}}``."""

@@ -27,6 +27,10 @@ The rule (:func:`identify`): an extension is a named cause only if
    path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
 
 Otherwise it is reported as "not identified" with the reasons, and it is not part of the model that is written.
+
+A cause that an identified effect's form asserts without a term of its own (``Effect.implies``: a shouldered tone
+curve is a gamma encoding too) is judged on the written model by rule 4 alone, on its own statistic
+(:func:`implied_results`); its effect size is the implying effect's.
 """
 
 from __future__ import annotations
@@ -229,17 +233,76 @@ def parameter_checks(
 # applying the rule to a forward selection
 
 
+def parameter_draws(
+    problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
+) -> list[dict[str, float]]:
+    """The parameters of ``fit``'s model refitted on ``draws`` resamples of the fit ``items``, each refit
+    warm-started from ``fit`` (the estimate)."""
+    return [problem.fit(fit.effects, resample(items, rng), start=fit).params for _ in range(draws)]
+
+
+def draw_intervals(fit: Fit, samples: Sequence[Mapping[str, float]]) -> dict[str, Interval]:
+    """Percentile intervals of every fitted parameter of ``fit`` over bootstrap refits (``parameter_draws``)."""
+    return {
+        k: percentile_interval(fit.params[k], [float(s.get(k, np.nan)) for s in samples]) for k in fit.params
+    }
+
+
 def parameter_intervals(
     problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
 ) -> dict[str, Interval]:
-    """Percentile intervals of every fitted parameter: the model is refitted on ``draws`` resamples of the fit
-    ``items``, each refit warm-started from ``fit`` (the estimate)."""
-    samples: dict[str, list[float]] = {k: [] for k in fit.params}
-    for _ in range(draws):
-        refit = problem.fit(fit.effects, resample(items, rng), start=fit)
-        for k in samples:
-            samples[k].append(float(refit.params.get(k, np.nan)))
-    return {k: percentile_interval(fit.params[k], samples[k]) for k in fit.params}
+    """Percentile intervals of every fitted parameter over ``draws`` bootstrap refits (``parameter_draws``)."""
+    return draw_intervals(fit, parameter_draws(problem, fit, items, draws=draws, rng=rng))
+
+
+def implied_results(
+    problem: Problem, results: Sequence[dict], fit: Fit, samples: Sequence[Mapping[str, float]]
+) -> list[dict]:
+    """The causes that the written model's identified effects imply (``Effect.implies``) without a term of their
+    own. Each is judged by its statistic on ``fit`` (``Problem.implied_statistic``), whose interval over the same
+    bootstrap refits as the parameters' (``samples``) must exclude its null value (rule 4); its effect size is the
+    implying effect's, which passed rule 2."""
+    implies = {e.name: e.implies for e in problem.candidates}
+    judged = {r["effect"] for r in results}
+    out = []
+    for result in results:
+        effect = result["effect"]
+        if not result["identified"] or effect not in fit.effects:
+            continue
+        for implied in implies.get(effect, ()):
+            if implied in fit.effects or implied in judged:
+                continue
+            judged.add(implied)
+            name, value, null = problem.implied_statistic(effect, implied, fit.params)
+            interval = percentile_interval(
+                value, [problem.implied_statistic(effect, implied, dict(s))[1] for s in samples]
+            )
+            reasons = []
+            if not interval.excludes(null):
+                reasons.append(
+                    f"the interval of {name} ({interval.low:.4g}-{interval.high:.4g}) includes the null value "
+                    f"{name} = {null:g}, at which {effect}'s fitted form shows no {implied}"
+                )
+            out.append(
+                {
+                    **Identification(
+                        implied,
+                        not reasons,
+                        tuple(reasons),
+                        (
+                            f"implied by {effect}: the written model holds that form, which asserts this cause too",
+                        ),
+                    ).as_dict(),
+                    "implied_by": effect,
+                    "validation_ratio": result["validation_ratio"],
+                    "compared_steps": result["compared_steps"],
+                    "judged_with": result["judged_with"],
+                    "params": {name: value},
+                    "intervals": {name: interval.as_dict()},
+                    "nulls": {name: null},
+                }
+            )
+    return out
 
 
 @dataclass
@@ -264,7 +327,8 @@ def identify_selection(
 ) -> Selection:
     """Judge every extension forward selection kept by the module's rule; refit without those that fail."""
     selected_fit = chain[-1]
-    intervals = parameter_intervals(problem, selected_fit, fit_items, draws=draws, rng=rng)
+    samples = parameter_draws(problem, selected_fit, fit_items, draws=draws, rng=rng)
+    intervals = draw_intervals(selected_fit, samples)
     # (effect, index of the step before it, index of the step with it) in the order selection added them
     entries = []
     for k, (before, after) in enumerate(itertools.pairwise(steps)):
@@ -335,13 +399,15 @@ def identify_selection(
             identified.append(effect)
     kept = frozenset(identified)
     if kept == selected_fit.effects:
+        results += implied_results(problem, results, selected_fit, samples)
         return Selection(sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals)
     by_effect = {r["effect"]: r for r in results}
     while True:
         # the largest model of the chain inside the kept set starts the refit
         start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
         final = start if start.effects == kept else problem.fit(kept, fit_items, start)
-        final_intervals = parameter_intervals(problem, final, fit_items, draws=draws, rng=rng)
+        final_samples = parameter_draws(problem, final, fit_items, draws=draws, rng=rng)
+        final_intervals = draw_intervals(final, final_samples)
         # the written model's own parameters are held to rules 3 and 4 too: without a dropped effect, one that
         # passed may fall to its null (a meter that only balanced a glare, refitted without the glare)
         failing = {
@@ -352,6 +418,7 @@ def identify_selection(
             )
         }
         if not failing:
+            results += implied_results(problem, results, final, final_samples)
             return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)
         for effect, reasons in failing.items():
             by_effect[effect].update(identified=False, status="not identified")

@@ -15,7 +15,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
-  includes), params, intervals, nulls} (rule: ``calibration/identify.py``);
+  includes), params, intervals, nulls} (rule: ``calibration/identify.py``); a cause implied by an identified
+  effect's form (``Effect.implies``) has ``implied_by`` and its statistic as ``params`` (identify.implied_results);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}]} (``calibration/structure.py``);
@@ -103,8 +104,10 @@ def build_report(
         # ratio too: the evidence names them
         together = sorted(set(step.effects) - set(before.effects) - {effect} - set(hosted))
         interval = result["validation_ratio"]
+        implying = result.get("implied_by")
         evidence = (
-            f"inner validation {score_name} {before.validation_error:.3g} -> {step.validation_error:.3g} "
+            (f"the fitted form of {implying}, identified with " if implying else "")
+            + f"inner validation {score_name} {before.validation_error:.3g} -> {step.validation_error:.3g} "
             f"{problem.units} "
             + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
             + (f"together with {', '.join(together)}, in the same comparison " if together else "")
@@ -118,7 +121,8 @@ def build_report(
             )
         if result.get("notes"):
             evidence += "; " + "; ".join(result["notes"])
-        detail = problem.evidence(effect, base, extended, fit_items)  # the base's residual on the fit items
+        # the base's residual on the fit items; an implied cause has no term of its own to add to the base
+        detail = None if implying else problem.evidence(effect, base, extended, fit_items)
         if detail:
             evidence += "; " + detail
         findings.append({"effect": effect, "cause": causes[effect], "evidence": evidence})

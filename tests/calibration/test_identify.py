@@ -384,3 +384,57 @@ def test_an_effect_that_falls_to_its_null_in_the_refit_is_not_identified():
     assert not meter["identified"]
     assert any("refitted without glare, meter = 0 sits at its low bound 0" in r for r in meter["reasons"])
     assert selection.identified == [] and selection.fit.effects == frozenset()
+
+
+class ShoulderedCurve(Problem):
+    """One effect, a tone curve whose form also asserts an encoding it has no term for (``implies``); its fitted
+    parameter follows the items, so the bootstrap over items sets the spread of the implied statistic."""
+
+    candidates = (Effect("curve", "a shouldered tone curve", implies=("encoding",)),)
+
+    def __init__(self, centre: float, slope: float) -> None:
+        self.centre, self.slope = centre, slope
+
+    def param_specs(self, effects):
+        return [Param("s", 1.0, -10.0, 10.0)] if "curve" in effects else []
+
+    def fit(self, effects, items, start=None) -> Fit:
+        value = self.centre + self.slope * (float(np.mean(items)) - 9.5)
+        return Fit(effects, {"s": value} if "curve" in effects else {})
+
+    def implied_statistic(self, effect, implied, params):
+        return "equivalent", 1.0 + params["s"], 1.0
+
+
+def select_curve(problem: ShoulderedCurve):
+    steps = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["curve"], 1.0, {}, PER_ITEM)]
+    items = np.arange(20)
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    return identify_selection(problem, steps, chain, items, draws=50, rng=np.random.default_rng(2))
+
+
+def test_a_cause_implied_by_an_identified_form_is_named_when_its_statistic_excludes_the_null():
+    selection = select_curve(ShoulderedCurve(centre=1.0, slope=0.01))
+    curve, encoding = selection.results
+    assert curve["effect"] == "curve" and curve["identified"]
+    assert encoding["effect"] == "encoding" and encoding["identified"], encoding["reasons"]
+    assert encoding["implied_by"] == "curve" and encoding["nulls"] == {"equivalent": 1.0}
+    assert encoding["params"]["equivalent"] == pytest.approx(2.0)
+    assert encoding["intervals"]["equivalent"]["low"] > 1.0
+    assert encoding["validation_ratio"] == curve["validation_ratio"]
+    # a cause, not a term: the written model holds the form that implies it
+    assert selection.identified == ["curve"] and selection.fit.effects == {"curve"}
+
+
+def test_an_implied_cause_whose_statistic_reaches_the_null_is_not_identified():
+    selection = select_curve(ShoulderedCurve(centre=0.0, slope=0.05))
+    curve, encoding = selection.results
+    assert curve["identified"], curve["reasons"]  # a change of form: no null of its own
+    assert not encoding["identified"]
+    assert "includes the null value equivalent = 1" in encoding["reasons"][0]
+
+
+def test_a_form_that_is_not_identified_implies_nothing():
+    selection = select_curve(ShoulderedCurve(centre=10.0, slope=0.0))  # pinned at its high bound
+    assert [r["effect"] for r in selection.results] == ["curve"]
+    assert not selection.results[0]["identified"] and selection.identified == []

@@ -10,7 +10,12 @@ from scipy.optimize import least_squares
 
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.noise import linearise, tone_curve, tone_curve_name
-from lerobot_phantom.calibration.projection import projection_kwargs, projection_nulls, projection_predict
+from lerobot_phantom.calibration.projection import (
+    projection_implied_statistic,
+    projection_kwargs,
+    projection_nulls,
+    projection_predict,
+)
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     equivalent_power_gamma,
@@ -102,6 +107,25 @@ def test_projection_with_a_shoulder_of_zero_is_the_model_without_it():
     null, shouldered = with_shoulder(0.0, 2.0), with_shoulder(20.0, 1.2)
     assert torch.allclose(null, without, atol=1e-9)
     assert (shouldered - without).abs().max() > 0.02
+
+
+@pytest.mark.parametrize("shoulder", [0.8, 1.2, 1.6])
+def test_a_vanishing_knee_exponent_is_the_power_law_of_gamma_one_plus_shoulder(shoulder):
+    """Why a shouldered curve implies a gamma encoding: as its knee exponent goes to 0 the log-logistic curve is
+    the power law of gamma 1 + shoulder, which a fit on a power-law camera approaches."""
+    linear = torch.linspace(0.0, 1.0, 1001, dtype=torch.float64)
+    curve = shoulder_encode(linear, {"shoulder": shoulder, "shoulder_exponent": 1e-4}, None)
+    assert torch.allclose(curve, linear.clamp(min=1e-12) ** (1 / (1 + shoulder)), atol=1e-4)
+    name, value, null = projection_implied_statistic(
+        "tone_shoulder", "sensor_gamma", {"shoulder": shoulder, "shoulder_exponent": 1e-4}
+    )
+    assert (name, null) == ("equivalent_gamma", 1.0)
+    assert value == pytest.approx(1 + shoulder, abs=0.01)
+
+
+def test_only_the_declared_implication_has_a_statistic():
+    with pytest.raises(ValueError, match="valid: sensor_gamma by tone_shoulder"):
+        projection_implied_statistic("albedo_modulation", "sensor_gamma", {})
 
 
 def test_the_transform_gets_the_closest_power_law():

@@ -10,6 +10,7 @@ from lerobot_phantom.calibration.projection import (
     EFFECTS as PROJECTION_EFFECTS,
 )
 from lerobot_phantom.calibration.projection import (
+    projection_implied_statistic,
     projection_kwargs,
     projection_nulls,
     projection_predict,
@@ -53,6 +54,11 @@ class ProjectionFrames(PixelProblem):
 
     def null_values(self, effect: str) -> dict[str, float]:
         return projection_nulls(effect)
+
+    def implied_statistic(
+        self, effect: str, implied: str, params: dict[str, float]
+    ) -> tuple[str, float, float]:
+        return projection_implied_statistic(effect, implied, params)
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
