@@ -327,6 +327,9 @@ class Step:
     paired: bool = False
     # scored groups this step could not take, with the reason (groups_set_aside)
     set_aside: dict[str, str] = field(default_factory=dict)
+    # per scored group (by its label in ``tried``): its per-item terms, like ``item_errors``; what a simpler form
+    # that lost this step to a richer one is judged by if the richer one is not identified (identify.py)
+    tried_item_errors: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
@@ -390,6 +393,18 @@ def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[
         if reason:
             pinned[effect] = reason
     return pinned
+
+
+def simpler_form(problem: Problem, effects: frozenset[str], effect: str) -> str | None:
+    """The alternative form of ``effect``'s term (``Effect.excludes``, either direction) with fewer own parameters
+    in ``effects`` with it in ``effect``'s place, or None."""
+    alternatives = {o for e in problem.candidates if e.name == effect for o in e.excludes}
+    alternatives |= {e.name for e in problem.candidates if effect in e.excludes}
+    mine = len(own_params(problem, effects, effect))
+    simpler = [
+        a for a in sorted(alternatives) if len(own_params(problem, (effects - {effect}) | {a}, a)) < mine
+    ]
+    return simpler[0] if simpler else None
 
 
 def richer_alternatives(
@@ -494,7 +509,7 @@ def forward_select(
     steps = [Step([], current, {}, aligned(per_item))]
     while True:
         open_names = [e.name for e in problem.candidates if e.name not in chosen]
-        # new effects -> (score, fold fits, per-item terms), and the name each is reported by (_group_label)
+        # new effects -> (score, fold fits, per-item terms), and the name each is reported by (group_label)
         scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
         labels: dict[frozenset[str], str] = {}
         for size in range(1, problem.joint_effects + 1):
@@ -502,7 +517,7 @@ def forward_select(
                 model = chosen | set(members)
                 if any(not requires[e] <= model for e in members) or exclusive(problem.candidates, model):
                     continue
-                label = _group_label(members, chosen, requires)
+                label = group_label(members, chosen, requires)
                 group = frozenset(members)
                 # warm start: the fold fits of the group without its last member (a pair: its first effect's)
                 start = scored.get(frozenset(label[:-1]), (None, parents))[1]
@@ -511,6 +526,7 @@ def forward_select(
         if not scored:
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
+        steps[-1].tried_item_errors = {labels[g]: aligned(v[2]) for g, v in scored.items()}
         set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
         steps[-1].set_aside = {labels[g]: why for g, why in set_aside.items()}
         eligible = {g: v for g, v in scored.items() if g not in set_aside}
@@ -556,7 +572,7 @@ def forward_select(
     return chosen, steps
 
 
-def _group_label(members, chosen: frozenset[str], requires: dict[str, set[str]]) -> tuple[str, ...]:
+def group_label(members, chosen: frozenset[str], requires: dict[str, set[str]]) -> tuple[str, ...]:
     """A group's members in a fixed order: those valid alone on the current model first, each part by name."""
     alone = sorted(e for e in members if requires[e] <= chosen)
     return tuple(alone + sorted(e for e in members if e not in alone))

@@ -47,8 +47,10 @@ from lerobot_phantom.calibration.core import (
     Step,
     at_bound,
     dependants,
+    group_label,
     own_params,
     selection_value,
+    simpler_form,
 )
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
@@ -397,6 +399,15 @@ def identify_selection(
         results.append(result)
         if result["identified"]:
             identified.append(effect)
+    for effect, before, after in entries:
+        if not own[effect]["identified"]:
+            fallback = simpler_form_result(
+                problem, steps, effect, before, after, identified, draws=draws, rng=rng
+            )
+            if fallback is not None:
+                results.append(fallback)
+                if fallback["identified"]:
+                    identified.append(fallback["effect"])
     kept = frozenset(identified)
     if kept == selected_fit.effects:
         results += implied_results(problem, results, selected_fit, samples)
@@ -418,6 +429,11 @@ def identify_selection(
             )
         }
         if not failing:
+            for result in results:
+                if result.get("in_place_of") and result["identified"]:
+                    specs = own_params(problem, final.effects, result["effect"])
+                    result["params"] = {p.name: final.params[p.name] for p in specs}
+                    result["intervals"] = {p.name: final_intervals[p.name].as_dict() for p in specs}
             results += implied_results(problem, results, final, final_samples)
             return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)
         for effect, reasons in failing.items():
@@ -430,6 +446,60 @@ def identify_selection(
                 f"builds on {', '.join(sorted(failing))}, which is not identified"
             )
         kept = kept - dropped
+
+
+def simpler_form_result(
+    problem: Problem,
+    steps: list[Step],
+    effect: str,
+    before: int,
+    after: int,
+    identified: Sequence[str],
+    *,
+    draws: int,
+    rng: np.random.Generator,
+) -> dict | None:
+    """The simpler form of a term whose richer form ``effect`` is not identified, judged in its place, or None.
+
+    Selection scored both forms of the term in the same step and took the richer one by the margin
+    (``core.forward_select``); when the richer one then fails the rule (a knee exponent pinned at its bound, on a
+    camera whose curve is a power law), the model it leaves has no form of the term at all. The simpler form
+    takes its place if that step scored it as eligible with the same other effects, all of them identified, and
+    its gain over the model before the step passes rule 2; the refit that follows holds it to rules 3 and 4. The
+    result says whose place it took (``in_place_of``) and the score it was selected by (``scored``)."""
+    chosen = frozenset(steps[before].effects)
+    group = frozenset(steps[after].effects) - chosen
+    alternative = simpler_form(problem, chosen | group, effect)
+    if alternative is None or not (group - {effect}) <= set(identified):
+        return None
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    label = "+".join(group_label((group - {effect}) | {alternative}, chosen, requires))
+    terms = steps[before].tried_item_errors.get(label)
+    if terms is None or label in steps[before].set_aside or steps[before].item_errors is None:
+        return None
+    ratio = error_ratio(
+        steps[before].item_errors, terms, draws=max(draws, 200), rng=rng, score=problem.selection_score
+    )
+    outcome = identify(
+        alternative,
+        selected=True,
+        validation_ratio=ratio,
+        params={},
+        bounds={},
+        intervals={},
+        nulls={},
+    )
+    return {
+        **outcome.as_dict(),
+        "in_place_of": effect,
+        "scored": {"group": label, "validation_error": steps[before].tried[label]},
+        "validation_ratio": ratio.as_dict(),
+        "compared_steps": [before, after],
+        "judged_with": [],
+        "params": {},
+        "intervals": {},
+        "nulls": {k: v for k, v in problem.null_values(alternative).items()},
+    }
 
 
 def refit_reasons(

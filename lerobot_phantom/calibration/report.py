@@ -17,6 +17,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
   includes), params, intervals, nulls} (rule: ``calibration/identify.py``); a cause implied by an identified
   effect's form (``Effect.implies``) has ``implied_by`` and its statistic as ``params`` (identify.implied_results);
+  the simpler form of a term judged in place of a richer one that is not identified has ``in_place_of`` and
+  ``scored`` {group, validation_error} (identify.simpler_form_result);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}]} (``calibration/structure.py``);
@@ -100,14 +102,17 @@ def build_report(
         effect = result["effect"]
         before, step = (steps[k] for k in result["compared_steps"])
         hosted = result.get("judged_with", [])
+        implying, replaced = result.get("implied_by"), result.get("in_place_of")
         # a pair taken in one selection step (or effects selected between it and those it hosts) are in the
         # ratio too: the evidence names them
-        together = sorted(set(step.effects) - set(before.effects) - {effect} - set(hosted))
+        together = sorted(set(step.effects) - set(before.effects) - {effect, replaced} - set(hosted))
         interval = result["validation_ratio"]
-        implying = result.get("implied_by")
+        # a simpler form in place of a richer one that is not identified: the score its own group had in that step
+        after = result["scored"]["validation_error"] if replaced else step.validation_error
         evidence = (
             (f"the fitted form of {implying}, identified with " if implying else "")
-            + f"inner validation {score_name} {before.validation_error:.3g} -> {step.validation_error:.3g} "
+            + (f"in place of {replaced} (not identified), the same term's simpler form, " if replaced else "")
+            + f"inner validation {score_name} {before.validation_error:.3g} -> {after:.3g} "
             f"{problem.units} "
             + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
             + (f"together with {', '.join(together)}, in the same comparison " if together else "")

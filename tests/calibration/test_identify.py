@@ -438,3 +438,67 @@ def test_a_form_that_is_not_identified_implies_nothing():
     selection = select_curve(ShoulderedCurve(centre=10.0, slope=0.0))  # pinned at its high bound
     assert [r["effect"] for r in selection.results] == ["curve"]
     assert not selection.results[0]["identified"] and selection.identified == []
+
+
+class TwoForms(Problem):
+    """One term in two forms: a power law (one parameter) and a shouldered curve (two) whose knee exponent sits at
+    its bound on every fit, as a shoulder fitted to a power-law camera does."""
+
+    candidates = (
+        Effect("power", "a power-law curve"),
+        Effect("knee", "a shouldered curve", excludes=("power",)),
+    )
+
+    def param_specs(self, effects):
+        specs = [Param("gamma", 2.0, 0.3, 4.0)] if "power" in effects else []
+        if "knee" in effects:
+            specs += [Param("s", 1.0, 0.0, 10.0), Param("n", 1.0, 0.25, 4.0)]
+        return specs
+
+    def null_values(self, effect):
+        return {"power": {"gamma": 1.0}, "knee": {"s": 0.0}}.get(effect, {})
+
+    def fit(self, effects, items, start=None) -> Fit:
+        shift = 0.01 * (float(np.mean(items)) - 9.5)
+        values = {"gamma": 2.1 + shift, "s": 1.5 + shift, "n": 0.25}
+        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+
+
+def select_two_forms(power_terms: np.ndarray, set_aside: dict | None = None):
+    """Selection took the knee over the power law, both scored from the model without either."""
+    steps = [
+        Step(
+            [],
+            2.0,
+            {"knee": 1.0, "power": 1.1},
+            4.0 * PER_ITEM,
+            set_aside=set_aside or {},
+            tried_item_errors={"knee": PER_ITEM, "power": power_terms},
+        ),
+        Step(["knee"], 1.0, {}, PER_ITEM),
+    ]
+    items = np.arange(20)
+    chain = [TwoForms().fit(frozenset(s.effects), items) for s in steps]
+    return identify_selection(TwoForms(), steps, chain, items, draws=20, rng=np.random.default_rng(3))
+
+
+def test_a_richer_form_that_is_not_identified_gives_way_to_the_simpler_form():
+    selection = select_two_forms(1.2 * PER_ITEM)
+    knee, power = selection.results
+    assert not knee["identified"] and any("n = 0.25 sits at its low bound" in r for r in knee["reasons"])
+    assert power["effect"] == "power" and power["identified"], power["reasons"]
+    assert power["in_place_of"] == "knee" and power["scored"] == {"group": "power", "validation_error": 1.1}
+    assert power["validation_ratio"]["estimate"] == pytest.approx(np.sqrt(4.0 / 1.2))
+    assert selection.identified == ["power"] and selection.fit.effects == {"power"}
+    assert power["params"]["gamma"] == pytest.approx(2.1) and power["intervals"]["gamma"]["low"] > 1.0
+
+
+def test_a_simpler_form_set_aside_by_selection_or_without_a_gain_takes_no_place():
+    set_aside = select_two_forms(
+        1.2 * PER_ITEM, set_aside={"power": "gamma at its high bound 4 in 4 of 4 folds"}
+    )
+    assert [r["effect"] for r in set_aside.results] == ["knee"] and set_aside.identified == []
+    no_gain = select_two_forms(4.0 * PER_ITEM)
+    _knee, power = no_gain.results
+    assert not power["identified"] and "does not exclude 1" in power["reasons"][0]
+    assert no_gain.identified == [] and no_gain.fit.effects == frozenset()
