@@ -17,13 +17,13 @@ has all but vanished) and the spread of the per-pair levels.
 from __future__ import annotations
 
 import importlib
-import os
 import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
 import torch
+from camsim_case_cameras import case_draws
 
 from lerobot_phantom.calibration.core import Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import load_pairs
@@ -84,11 +84,7 @@ def main() -> None:
     tests_dir, seeds = sys.argv[1], [int(s) for s in sys.argv[2:]]
     sys.path.insert(0, tests_dir)
     camsim = importlib.import_module("camsim")
-    for master in seeds:
-        os.environ["CAMSIM_SEED"] = str(master)
-        sim = importlib.reload(importlib.import_module("test_independent_sim"))
-        case = sim.CASE_BY_NAME[NAME]
-        seed, rng, camera = sim.case_camera(case)
+    for master, _sim, case, seed, rng, camera in case_draws(NAME, seeds):
         with tempfile.TemporaryDirectory() as scratch:
             camsim.write_pairs(Path(scratch) / "pairs", case.render(rng, camera))
             pairs = load_pairs(Path(scratch) / "pairs", max_side=256)  # the CLI's default working size

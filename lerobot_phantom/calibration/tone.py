@@ -11,12 +11,16 @@ that the sensor's saturation (linear light ``x = 1``) stays the file's white and
 
 ``s = E_50 ** -n`` >= 0 is the shoulder strength (``s = 0``: no shoulder, the curve is the power law of
 ``sensor_gamma``, or the identity without it), ``n`` > 0 the sharpness of the knee (large ``n``: almost a hard
-clip at the knee), ``gamma`` the display exponent (1 when the model has no ``sensor_gamma``). Its inverse is closed
-form, ``u = pixel ** (gamma n)``, ``x = (u / (1 + s - s u)) ** (1 / n)``, so every model that composes light in
-linear irradiance (light projection: projector light adds to the ambient light) can decode and re-encode
-through it. A pure power law cannot bend back below the straight line in log-log at the bright end: fitted to a
-filmic camera it runs its exponent to the edge of its range and leaves the reflectance and cross-talk effects
-that ride on the bright pixels unexplained (measured on the independent camera simulator, camsim-status.md).
+clip at the knee; ``n`` -> 0: no knee at all, the power law ``x ** (1 / (1 + s))``, since ``x**n ~ 1 + n log x``),
+``gamma`` the display exponent (1 when the model has no ``sensor_gamma``). So the curve is a gamma encoding too,
+judged by its closest power law (``equivalent_power_gamma``), and on a power-law camera a fit drives ``n`` down
+towards that limit (calibration/identify.py: causes a form implies; a simpler form in place of a richer one).
+Its inverse is closed form, ``u = pixel ** (gamma n)``, ``x = (u / (1 + s - s u)) ** (1 / n)``, so every model
+that composes light in linear irradiance (light projection: projector light adds to the ambient light) can decode
+and re-encode through it. A pure power law cannot bend back below the straight line in log-log at the bright
+end: fitted to a filmic camera it runs its exponent to the edge of its range and leaves the reflectance and
+cross-talk effects that ride on the bright pixels unexplained (measured on the independent camera simulator:
+docs/bench/camsim_session12.md, camsim_session18.md).
 """
 
 from __future__ import annotations
