@@ -30,7 +30,9 @@ Otherwise it is reported as "not identified" with the reasons, and it is not par
 
 A cause that an identified effect's form asserts without a term of its own (``Effect.implies``: a shouldered tone
 curve is a gamma encoding too) is judged on the written model by rule 4 alone, on its own statistic
-(:func:`implied_results`); its effect size is the implying effect's.
+(:func:`implied_results`); its effect size is the implying effect's. When the richer of two forms of one term
+(``Effect.excludes``) is not identified, the simpler form that selection scored beside it in the same step is
+judged in its place (:func:`simpler_form_result`): rule 2 on its own scores, rules 3-4 on the refit.
 """
 
 from __future__ import annotations
@@ -470,9 +472,9 @@ def simpler_form_result(
     chosen = frozenset(steps[before].effects)
     group = frozenset(steps[after].effects) - chosen
     alternative = simpler_form(problem, chosen | group, effect)
-    if alternative is None or not (group - {effect}) <= set(identified):
-        return None
     requires = {e.name: set(e.requires) for e in problem.candidates}
+    if alternative is None or not (group - {effect}) | requires[alternative] <= set(identified):
+        return None
     label = "+".join(group_label((group - {effect}) | {alternative}, chosen, requires))
     terms = steps[before].tried_item_errors.get(label)
     if terms is None or label in steps[before].set_aside or steps[before].item_errors is None:
@@ -498,7 +500,7 @@ def simpler_form_result(
         "judged_with": [],
         "params": {},
         "intervals": {},
-        "nulls": {k: v for k, v in problem.null_values(alternative).items()},
+        "nulls": dict(problem.null_values(alternative)),
     }
 
 
