@@ -435,7 +435,9 @@ def test_case(name, root):
     "glare's exponent at its bound 8 on sRGB cameras), blinding_auto_exposure on 2860931351 (one inner fold), "
     "projection_crosstalk on filmic cameras (albedo; 4 of 5 on eight fresh seeds in session 18, after the shoulder "
     "was offered to light projection: projection effect cases 20 -> 23 of 32), projection_clipping (the clip "
-    "gains under the margin). "
+    "gains under the margin), strip_period on some draws (its gain interval over 6 fit pairs spans 1; session 22, "
+    "master seed 3042280278). Session 22: projection_sensor_gamma 22 -> 24 of 24 on fresh seeds (a shouldered "
+    "curve implies the gamma encoding; a richer form that fails gives way to the simpler one). "
     "History and measurements: the README, 'Tested against an independent camera simulator', and "
     "docs/bench/camsim_session*.md",
     strict=False,
