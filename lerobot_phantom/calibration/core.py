@@ -395,41 +395,31 @@ def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[
     return pinned
 
 
-def simpler_form(problem: Problem, effects: frozenset[str], effect: str) -> str | None:
-    """The alternative form of ``effect``'s term (``Effect.excludes``, either direction) with fewer own parameters
-    in ``effects`` with it in ``effect``'s place, or None."""
+def simpler_forms(problem: Problem, effects: frozenset[str], effect: str) -> list[str]:
+    """The alternative forms of ``effect``'s term (``Effect.excludes``, either direction) with fewer own parameters
+    in ``effects`` with the alternative in ``effect``'s place, by name."""
     alternatives = {o for e in problem.candidates if e.name == effect for o in e.excludes}
     alternatives |= {e.name for e in problem.candidates if effect in e.excludes}
     mine = len(own_params(problem, effects, effect))
-    simpler = [
-        a for a in sorted(alternatives) if len(own_params(problem, (effects - {effect}) | {a}, a)) < mine
-    ]
-    return simpler[0] if simpler else None
+    return [a for a in sorted(alternatives) if len(own_params(problem, (effects - {effect}) | {a}, a)) < mine]
 
 
 def richer_alternatives(
     problem: Problem, chosen: frozenset[str], scored: dict[frozenset[str], object]
 ) -> list[tuple[frozenset[str], frozenset[str]]]:
     """(group, simpler) for every scored group holding one form of a term (``Effect.excludes``) where ``simpler``,
-    the same group with the alternative form, was scored too and the alternative has fewer own parameters.
+    the same group with an alternative form that has fewer own parameters, was scored too.
 
-    Two forms of one term (a power-law tone curve and a shouldered one) are not nested, so the richer form's lower
-    score is no evidence by itself: on a camera the simpler form describes, the richer one still fits a hair
-    better. Selection takes the richer form only by the margin under the simpler one (forward_select)."""
-    excludes = {e.name: set(e.excludes) for e in problem.candidates}
-    for e in problem.candidates:
-        for other in e.excludes:
-            excludes.setdefault(other, set()).add(e.name)
+    Within their search ranges two forms of one term (a power-law tone curve and a shouldered one, which reaches the
+    power law only in a limit outside its range) are not nested, so the richer form's lower score is no evidence by
+    itself: on a camera the simpler form describes, the richer one still fits a hair better. Selection takes the
+    richer form only by the margin under the simpler one (forward_select)."""
     pairs = []
     for group in scored:
         for effect in group:
-            for alternative in excludes.get(effect, ()):
+            for alternative in simpler_forms(problem, chosen | group, effect):
                 simpler = (group - {effect}) | {alternative}
-                if simpler not in scored:
-                    continue
-                mine = len(own_params(problem, chosen | group, effect))
-                theirs = len(own_params(problem, chosen | simpler, alternative))
-                if theirs < mine:
+                if simpler in scored:
                     pairs.append((group, simpler))
     return pairs
 

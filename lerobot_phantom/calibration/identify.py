@@ -52,7 +52,7 @@ from lerobot_phantom.calibration.core import (
     group_label,
     own_params,
     selection_value,
-    simpler_form,
+    simpler_forms,
 )
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
@@ -267,6 +267,11 @@ def implied_results(
     bootstrap refits as the parameters' (``samples``) must exclude its null value (rule 4); its effect size is the
     implying effect's, which passed rule 2."""
     implies = {e.name: e.implies for e in problem.candidates}
+    for effect, implied in ((e, i) for e, names in implies.items() for i in names):
+        if implied not in implies:  # a named cause needs its cause text, which candidates carry
+            raise ValueError(
+                f"{effect} implies {implied}, not a candidate of {type(problem).__name__}; valid: {', '.join(implies)}"
+            )
     judged = {r["effect"] for r in results}
     out = []
     for result in results:
@@ -279,7 +284,7 @@ def implied_results(
             judged.add(implied)
             name, value, null = problem.implied_statistic(effect, implied, fit.params)
             interval = percentile_interval(
-                value, [problem.implied_statistic(effect, implied, dict(s))[1] for s in samples]
+                value, [problem.implied_statistic(effect, implied, s)[1] for s in samples]
             )
             reasons = []
             if not interval.excludes(null):
@@ -471,14 +476,17 @@ def simpler_form_result(
     result says whose place it took (``in_place_of``) and the score it was selected by (``scored``)."""
     chosen = frozenset(steps[before].effects)
     group = frozenset(steps[after].effects) - chosen
-    alternative = simpler_form(problem, chosen | group, effect)
     requires = {e.name: set(e.requires) for e in problem.candidates}
-    if alternative is None or not (group - {effect}) | requires[alternative] <= set(identified):
+    if steps[before].item_errors is None:
         return None
-    label = "+".join(group_label((group - {effect}) | {alternative}, chosen, requires))
-    terms = steps[before].tried_item_errors.get(label)
-    if terms is None or label in steps[before].set_aside or steps[before].item_errors is None:
+    for alternative in simpler_forms(problem, chosen | group, effect):
+        label = "+".join(group_label((group - {effect}) | {alternative}, chosen, requires))
+        eligible = label in steps[before].tried_item_errors and label not in steps[before].set_aside
+        if eligible and (group - {effect}) | requires[alternative] <= set(identified):
+            break
+    else:
         return None
+    terms = steps[before].tried_item_errors[label]
     ratio = error_ratio(
         steps[before].item_errors, terms, draws=max(draws, 200), rng=rng, score=problem.selection_score
     )

@@ -173,7 +173,9 @@ def build_report(
             f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one); then each kept "
             "extension must pass the identification rule "
             "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
-            "bound, an interval excluding its null value",
+            "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
+            "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
+            "when the interval of its statistic excludes the null value",
             "selected": selection.selected,
             "steps": [
                 {

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,6 +25,7 @@ from lerobot_phantom.calibration.identify import (
     resample,
     rmse_interval,
 )
+from lerobot_phantom.calibration.report import build_report
 from lerobot_phantom.transforms import physics
 
 CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
@@ -390,7 +392,10 @@ class ShoulderedCurve(Problem):
     """One effect, a tone curve whose form also asserts an encoding it has no term for (``implies``); its fitted
     parameter follows the items, so the bootstrap over items sets the spread of the implied statistic."""
 
-    candidates = (Effect("curve", "a shouldered tone curve", implies=("encoding",)),)
+    candidates = (
+        Effect("curve", "a shouldered tone curve", implies=("encoding",)),
+        Effect("encoding", "a gamma encoding", excludes=("curve",)),
+    )
 
     def __init__(self, centre: float, slope: float) -> None:
         self.centre, self.slope = centre, slope
@@ -405,12 +410,17 @@ class ShoulderedCurve(Problem):
     def implied_statistic(self, effect, implied, params):
         return "equivalent", 1.0 + params["s"], 1.0
 
+    def squared_errors(self, fit, items):
+        return (1.0 if fit.effects else 4.0) * len(items), len(items)
+
+
+CURVE_STEPS = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["curve"], 1.0, {}, PER_ITEM)]
+
 
 def select_curve(problem: ShoulderedCurve):
-    steps = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["curve"], 1.0, {}, PER_ITEM)]
     items = np.arange(20)
-    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
-    return identify_selection(problem, steps, chain, items, draws=50, rng=np.random.default_rng(2))
+    chain = [problem.fit(frozenset(s.effects), items) for s in CURVE_STEPS]
+    return identify_selection(problem, CURVE_STEPS, chain, items, draws=50, rng=np.random.default_rng(2))
 
 
 def test_a_cause_implied_by_an_identified_form_is_named_when_its_statistic_excludes_the_null():
@@ -463,10 +473,13 @@ class TwoForms(Problem):
         values = {"gamma": 2.1 + shift, "s": 1.5 + shift, "n": 0.25}
         return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
 
+    def squared_errors(self, fit, items):
+        return (1.0 if fit.effects else 4.0) * len(items), len(items)
 
-def select_two_forms(power_terms: np.ndarray, set_aside: dict | None = None):
+
+def two_forms_steps(power_terms: np.ndarray, set_aside: dict | None = None) -> list[Step]:
     """Selection took the knee over the power law, both scored from the model without either."""
-    steps = [
+    return [
         Step(
             [],
             2.0,
@@ -477,6 +490,10 @@ def select_two_forms(power_terms: np.ndarray, set_aside: dict | None = None):
         ),
         Step(["knee"], 1.0, {}, PER_ITEM),
     ]
+
+
+def select_two_forms(power_terms: np.ndarray, set_aside: dict | None = None):
+    steps = two_forms_steps(power_terms, set_aside)
     items = np.arange(20)
     chain = [TwoForms().fit(frozenset(s.effects), items) for s in steps]
     return identify_selection(TwoForms(), steps, chain, items, draws=20, rng=np.random.default_rng(3))
@@ -502,3 +519,47 @@ def test_a_simpler_form_set_aside_by_selection_or_without_a_gain_takes_no_place(
     _knee, power = no_gain.results
     assert not power["identified"] and "does not exclude 1" in power["reasons"][0]
     assert no_gain.identified == [] and no_gain.fit.effects == frozenset()
+
+
+@pytest.mark.parametrize("kind", ["implied", "in place"])
+def test_the_report_names_an_implied_or_replacing_cause_with_its_own_evidence(kind):
+    if kind == "implied":
+        problem, steps, selection = (
+            ShoulderedCurve(1.0, 0.01),
+            CURVE_STEPS,
+            select_curve(ShoulderedCurve(1.0, 0.01)),
+        )
+        effect, says = "encoding", "the fitted form of curve, identified with inner validation RMSE 2 -> 1 "
+    else:
+        problem, steps = TwoForms(), two_forms_steps(1.2 * PER_ITEM)
+        selection = select_two_forms(1.2 * PER_ITEM)
+        effect, says = (
+            "power",
+            "in place of knee (not identified), the same term's simpler form, inner validation RMSE 2 -> 1.1 ",
+        )
+    report = build_report(
+        problem,
+        input_path=Path("measured"),
+        fit_items=np.arange(20),
+        heldout_items=np.arange(20, 24),
+        base=Fit(frozenset(), {}),
+        base_intervals={},
+        selection=selection,
+        steps=steps,
+        seed=0,
+        margin=0.05,
+        folds=4,
+        draws=20,
+    )
+    (finding,) = [f for f in report["findings"] if f["effect"] == effect]
+    assert finding["evidence"].startswith(says), finding["evidence"]
+    # an implied cause is named, not written; a simpler form in another's place is the written term
+    assert (effect in report["extended"]["effects"]) == (kind == "in place")
+
+
+def test_an_implied_cause_must_be_a_candidate_of_the_problem():
+    class Undeclared(ShoulderedCurve):
+        candidates = (Effect("curve", "a shouldered tone curve", implies=("encoding",)),)
+
+    with pytest.raises(ValueError, match="valid: curve"):
+        select_curve(Undeclared(1.0, 0.01))
