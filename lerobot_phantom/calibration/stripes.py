@@ -36,8 +36,9 @@ FRAME_RULE_CHOICES = ("auto", *STRIPE_FRAME_RULES)
 # 3-point alike) stop in another offset/threshold minimum, 7.42 rows against the 1.50 forward mode reaches
 STRIPE_JACOBIAN = "forward"
 
-# The kernel's blooming term (spread_rows) is not a candidate: for one stripe per frame it adds the same rows as
-# integration_offset, so the two cannot be told apart from stripe tables.
+# The kernel's blooming term (spread_rows) is not a candidate: for one stripe per frame at least a row wide it adds
+# the same rows as integration_offset, so the two cannot be told apart from stripe tables; they differ only for
+# stripes narrower than a row time, which bloom in the share of frames that light a row.
 EFFECTS = (
     Effect(
         "exposure_overlap",

@@ -341,7 +341,9 @@ def rolling_shutter_rows_lit(
       stripe covers ``on + window - 2 threshold`` of start time while the threshold is below the shorter of the
       two; rows at the stripe's edges, lit only in part, drop out first. Read noise (``noise_s``, seconds of
       laser light) makes that detection probabilistic near the threshold (a soft threshold).
-    - edge spread: blooming and the optics' glare widen every stripe by ``spread_rows`` at each edge.
+    - edge spread: blooming and the optics' glare widen every stripe that lights a row by ``spread_rows`` at each
+      edge; a stripe narrower than a row time (``lit < row_time``) lights a row only for ``lit / row_time`` of
+      pulse phases, so it adds ``2 spread_rows min(lit, row_time)`` of start time, and it never lights a frame.
     - phase and aliasing: the pulse phase relative to the frame is unknowable per frame (it drifts when the laser
       and frame rates beat), so the prediction is the expectation over a uniform phase. Which frames the
       measurement averaged over matters at low frequency, where many frames catch no pulse:
@@ -358,14 +360,16 @@ def rolling_shutter_rows_lit(
     window = (torch.as_tensor(exposure_s, dtype=torch.float64) + integration_offset_s).clamp(min=0.0)
     row_time = torch.as_tensor(row_time_s, dtype=torch.float64)
     height = torch.as_tensor(image_rows, dtype=torch.float64)
-    lit_time = pulse_overlap_lit_time(period, on, window, threshold_s, noise_s)
-    # blooming widens stripes that exist; it lights nothing where no row reaches the threshold
-    spread = torch.where(lit_time > 0, 2.0 * spread_rows * row_time, torch.zeros_like(lit_time))
-    lit_time = (lit_time + spread).clamp(max=period)
+    reached = pulse_overlap_lit_time(period, on, window, threshold_s, noise_s)
+    # blooming widens stripes that light a row; it lights nothing where no row reaches the threshold, and a
+    # stripe narrower than a row time lights a row only for that share of pulse phases
+    spread = 2.0 * spread_rows * torch.minimum(reached, row_time)
+    lit_time = (reached + spread).clamp(max=period)
     share = lit_time / period
     if frames == "all":
         return height * share
-    catch = ((height - 1.0) * torch.minimum(lit_time, row_time) + lit_time) / period
+    # blooming cannot light a frame no row of which reaches the threshold
+    catch = ((height - 1.0) * torch.minimum(reached, row_time) + reached) / period
     lit_frames = height * share / catch.clamp(min=1e-12, max=1.0)
     lit_frames = torch.where(lit_time > 0, lit_frames, torch.zeros_like(lit_frames))
     if frames == "lit":
