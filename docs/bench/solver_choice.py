@@ -3,11 +3,13 @@
 Calibrates each shared input once per solver, in this one process, one after another; every least-squares call
 in ``calibration/core.py`` is made with the solver under test (two parameters or fewer: always exact, as in
 ``fit_least_squares``). Prints, per input and solver, the total user CPU, the model written and its held-out
-RMSE, and per number of fitted parameters the fits made, their mean evaluations and their CPU.
+RMSE, and per number of fitted parameters the fits made, their mean evaluations and their CPU; then the largest
+relative difference between the two solvers' fitted parameters.
 
-    OMP_NUM_THREADS=1 python docs/bench/solver_choice.py MEASURED_DIR SCRATCH_DIR
+    OMP_NUM_THREADS=1 python docs/bench/solver_choice.py MEASURED_DIR SCRATCH_DIR [INPUT ...]
 
-(MEASURED_DIR: ``../shared/measured``, third-party data not in this repository; SCRATCH_DIR must not exist.)
+(MEASURED_DIR: ``../shared/measured``, third-party data not in this repository; SCRATCH_DIR must not exist;
+INPUT: keys of ``INPUTS``, all of them when none is given. Session 23 added the laser captures.)
 """
 
 from __future__ import annotations
@@ -30,14 +32,20 @@ INPUTS = {
         image_height=720,
         exposure_unit_s=1e-4,
     ),
+    "laser captures": dict(attack="laser_blinding", measured="blinding"),
 }
 SOLVERS = ("lsmr", "exact")
 
 
-def main(measured: Path, scratch: Path) -> None:
+def main(measured: Path, scratch: Path, names: list[str]) -> None:
+    unknown = sorted(set(names) - set(INPUTS))
+    if unknown:
+        raise SystemExit(f"unknown inputs {unknown}; valid: {', '.join(INPUTS)}")
     scratch.mkdir(parents=True)
     scipy_least_squares = core.least_squares
-    for name, options in INPUTS.items():
+    for name in names or INPUTS:
+        options = INPUTS[name]
+        fitted = {}
         for solver in SOLVERS:
             calls: list[tuple[int, int, float]] = []
 
@@ -57,6 +65,7 @@ def main(measured: Path, scratch: Path) -> None:
             report = calibrate(config)
             total = time.process_time() - start
             core.least_squares = scipy_least_squares
+            fitted[solver] = report["extended"]["params"]
             print(
                 f"{name}, {solver}: {total:.1f} s CPU; written {report['extended']['effects']}, "
                 f"held-out {report['extended']['heldout_rmse']:.4f}"
@@ -69,7 +78,13 @@ def main(measured: Path, scratch: Path) -> None:
                     f"  {count:2d} parameters: {len(runs):3d} fits, mean {sum(r[0] for r in runs) / len(runs):5.1f} "
                     f"evaluations, {sum(r[1] for r in runs):5.1f} s CPU"
                 )
+        differences = [abs(fitted["exact"][k] - v) / max(abs(v), 1e-12) for k, v in fitted["lsmr"].items()]
+        print(
+            f"{name}: largest relative difference over {len(differences)} fitted parameters "
+            f"{max(differences, default=0.0):.2e}",
+            flush=True,
+        )
 
 
 if __name__ == "__main__":
-    main(Path(sys.argv[1]), Path(sys.argv[2]))
+    main(Path(sys.argv[1]), Path(sys.argv[2]), sys.argv[3:])

@@ -52,9 +52,10 @@ class ResidualSample:
     neighbours: dict[str, list[tuple[np.ndarray, np.ndarray]]] = field(default_factory=dict)
 
 
-def explained_share(residual: np.ndarray, bins: np.ndarray) -> float:
-    """eta squared: the share of the residual's variance (about 0) explained by its mean per bin."""
-    total = float(np.sum(residual**2))
+def explained_share(residual: np.ndarray, bins: np.ndarray, total: float | None = None) -> float:
+    """eta squared: the share of the residual's variance (about 0) explained by its mean per bin; ``total``: the
+    residual's sum of squares when the caller already has it (a permutation does not change it)."""
+    total = float(np.sum(residual**2)) if total is None else total
     if total <= 0:
         return 0.0
     sums = np.bincount(bins, weights=residual)
@@ -104,9 +105,10 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
     bins = {name: bin_index(v, BINS)[0] for name, v in values.items()}
     # one permutation of the residuals scores every variable: row j of null_shares is one draw of chance for all
     null_shares = np.empty((PERMUTATIONS, len(bins)))
+    total = float(np.sum(residual_all**2))
     for j in range(PERMUTATIONS if bins else 0):
         permuted = rng.permutation(residual_all)
-        null_shares[j] = [explained_share(permuted, b) for b in bins.values()]
+        null_shares[j] = [explained_share(permuted, b, total) for b in bins.values()]
     quantile = 1.0 - FAMILY_ALPHA / max(len(bins), 1)
     starts = np.concatenate([[0], np.cumsum([len(r) for r in sample.residual])])
     for column, (name, values_all) in enumerate(values.items()):
