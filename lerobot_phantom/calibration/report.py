@@ -287,9 +287,17 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
     else:
         lines.append("No extension was both selected and identified: the base model is kept.")
     not_identified = [r for r in report["identification"] if not r["identified"]]
-    if not_identified:
+    # an implied cause was never selected: it is listed under the form that implies it
+    selected = [r for r in not_identified if not r.get("implied_by")]
+    implied = [r for r in not_identified if r.get("implied_by")]
+    if selected:
         lines += ["", "Selected but **not identified** (not a named cause, not in the written model):", ""]
-        lines += [f"- `{r['effect']}`: " + "; ".join(r["reasons"]) for r in not_identified]
+        lines += [f"- `{r['effect']}`: " + "; ".join(r["reasons"]) for r in selected]
+    if implied:
+        lines += ["", "Implied by an identified form but **not identified** (not a named cause):", ""]
+        lines += [
+            f"- `{r['effect']}`, implied by `{r['implied_by']}`: " + "; ".join(r["reasons"]) for r in implied
+        ]
     structure = report["unexplained_structure"]
     lines += [
         "",

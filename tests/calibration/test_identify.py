@@ -25,7 +25,7 @@ from lerobot_phantom.calibration.identify import (
     resample,
     rmse_interval,
 )
-from lerobot_phantom.calibration.report import build_report
+from lerobot_phantom.calibration.report import build_report, write_markdown
 from lerobot_phantom.transforms import physics
 
 CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
@@ -555,6 +555,30 @@ def test_the_report_names_an_implied_or_replacing_cause_with_its_own_evidence(ki
     assert finding["evidence"].startswith(says), finding["evidence"]
     # an implied cause is named, not written; a simpler form in another's place is the written term
     assert (effect in report["extended"]["effects"]) == (kind == "in place")
+
+
+def test_the_markdown_lists_an_implied_cause_that_is_not_identified_under_the_form_that_implies_it(tmp_path):
+    """It was never selected on its own, so it is not "selected but not identified" (session 23)."""
+    problem = ShoulderedCurve(centre=0.0, slope=0.05)
+    report = build_report(
+        problem,
+        input_path=Path("measured"),
+        fit_items=np.arange(20),
+        heldout_items=np.arange(20, 24),
+        base=Fit(frozenset(), {}),
+        base_intervals={},
+        selection=select_curve(problem),
+        steps=CURVE_STEPS,
+        seed=0,
+        margin=0.05,
+        folds=4,
+        draws=20,
+    )
+    write_markdown(report, [], tmp_path / "report.md")
+    text = (tmp_path / "report.md").read_text()
+    assert "Selected but **not identified**" not in text
+    assert "Implied by an identified form but **not identified**" in text
+    assert "- `encoding`, implied by `curve`: the interval of equivalent" in text
 
 
 def test_an_implied_cause_must_be_a_candidate_of_the_problem():
