@@ -162,13 +162,9 @@ class CaptureProblem(Problem):
         return specs
 
     def predict(self, effects, p, pixels: torch.Tensor) -> torch.Tensor:
-        return self.predict_at(effects, p, self.xs[pixels], self.ys[pixels])
-
-    def predict_at(self, effects, p, xs: torch.Tensor, ys: torch.Tensor) -> torch.Tensor:
-        """``predict`` at pixel coordinates ``xs``, ``ys`` (a fit gathers them once, not per evaluation)."""
         # not torch.hypot: its derivative is 0/0 on a pixel at the spot's centre, and forward-mode autodiff spreads
         # that NaN to every column of the Jacobian; 1e-12 px^2 changes no radius that matters
-        radius = torch.sqrt((xs - p["cx"]) ** 2 + (ys - p["cy"]) ** 2 + 1e-12)
+        radius = torch.sqrt((self.xs[pixels] - p["cx"]) ** 2 + (self.ys[pixels] - p["cy"]) ** 2 + 1e-12)
         profile = physics.laser_spot_profile(
             radius,
             p["sigma"],
@@ -191,7 +187,7 @@ class CaptureProblem(Problem):
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         pixels = self.pixels(items, self.max_fit_pixels)
-        target, xs, ys = self.values[pixels], self.xs[pixels], self.ys[pixels]
+        target = self.values[pixels]
         warm = None
         if start is not None:
             warm = dict(start.params)
@@ -203,7 +199,7 @@ class CaptureProblem(Problem):
         refit = start is not None and start.effects == effects  # a bootstrap draw: start from the estimate
         params = fit_least_squares(
             self.param_specs(effects, self.initial_guess(items)),
-            lambda p: (self.predict_at(effects, p, xs, ys) - target).ravel(),
+            lambda p: (self.predict(effects, p, pixels) - target).ravel(),
             warm=warm,
             starts=further_starts(start, effects),
             max_nfev=20 if refit else 60,

@@ -116,8 +116,6 @@ def laser_spot_profile(
     """
     sigma = _as(core_sigma, radius)
     core = torch.exp(-0.5 * (radius / sigma) ** 2)
-    if not torch.is_tensor(halo_amplitude) and halo_amplitude == 0.0:
-        return core  # a spot without glare: calibration fits evaluate this thousands of times
     halo = _as(halo_amplitude, radius) * (1.0 + radius / _as(halo_scale, radius)) ** (
         -_as(halo_exponent, radius)
     )
