@@ -11,6 +11,7 @@ import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
 from lerobot_phantom.calibration.frame_models.common import Pair
+from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
 from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
 from lerobot_phantom.calibration.identify import (
     Interval,
@@ -21,6 +22,7 @@ from lerobot_phantom.calibration.identify import (
     identify,
     identify_selection,
     own_params,
+    parameter_checks,
     percentile_interval,
     resample,
     rmse_interval,
@@ -587,3 +589,22 @@ def test_an_implied_cause_must_be_a_candidate_of_the_problem():
 
     with pytest.raises(ValueError, match="valid: curve"):
         select_curve(Undeclared(1.0, 0.01))
+
+
+def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identified():
+    """A red laser lights the blue channel by a trace: its peak near 0 is the channel's physical limit, reported as
+    a note, not a parameter pinned at a bound (session 23: camsim strip_period, master seed 1524787190, peak_b =
+    0.0028 [0.0020, 0.0038] made the stripe "not identified")."""
+    specs = StripFrames([], seed=0).param_specs(frozenset({"exposure_overlap"}))
+    params = {"peak_r": 0.092, "peak_g": 0.0099, "peak_b": 0.0028, "on_share": 0.16, "exposure_share": 0.018}
+    reasons, notes = parameter_checks(
+        params,
+        {p.name: (p.low, p.high) for p in specs},
+        {},
+        {},
+        {p.name: p.low_limit for p in specs if p.low_limit},
+    )
+    assert reasons == []
+    assert len(notes) == 1 and notes[0].startswith(
+        "peak_b = 0.0028 sits at its low bound, the form's physical limit"
+    )

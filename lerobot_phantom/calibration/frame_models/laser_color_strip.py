@@ -46,7 +46,19 @@ class StripFrames(LatentFrameProblem):
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         if "exposure_overlap" not in effects:
             return [Param(f"strength_{c}", 500.0, 0.0, 20000.0, scale=500.0) for c in "rgb"]
-        specs = [Param(f"peak_{c}", 0.3, 0.0, 4.0, scale=0.3) for c in "rgb"] + [
+        # a laser is nearly monochromatic: a channel whose colour filter blocks its wavelength records almost
+        # none of it, so a peak at 0 is that channel's physical limit, not an edge of the search
+        specs = [
+            Param(
+                f"peak_{c}",
+                0.3,
+                0.0,
+                4.0,
+                scale=0.3,
+                low_limit="a channel whose colour filter passes none of the laser's light",
+            )
+            for c in "rgb"
+        ] + [
             Param("on_share", 0.1, 1e-3, 1.0, scale=0.1),
             Param("exposure_share", 0.05, 0.0, 1.0, scale=0.1),
         ]
