@@ -523,6 +523,24 @@ def test_a_simpler_form_set_aside_by_selection_or_without_a_gain_takes_no_place(
     assert no_gain.identified == [] and no_gain.fit.effects == frozenset()
 
 
+def report_on_twenty_items(problem, selection, steps) -> dict:
+    """The report of a selection made on items 0-19, with four held-out items and the base model empty."""
+    return build_report(
+        problem,
+        input_path=Path("measured"),
+        fit_items=np.arange(20),
+        heldout_items=np.arange(20, 24),
+        base=Fit(frozenset(), {}),
+        base_intervals={},
+        selection=selection,
+        steps=steps,
+        seed=0,
+        margin=0.05,
+        folds=4,
+        draws=20,
+    )
+
+
 @pytest.mark.parametrize("kind", ["implied", "in place"])
 def test_the_report_names_an_implied_or_replacing_cause_with_its_own_evidence(kind):
     if kind == "implied":
@@ -539,20 +557,7 @@ def test_the_report_names_an_implied_or_replacing_cause_with_its_own_evidence(ki
             "power",
             "in place of knee (not identified), the same term's simpler form, inner validation RMSE 2 -> 1.1 ",
         )
-    report = build_report(
-        problem,
-        input_path=Path("measured"),
-        fit_items=np.arange(20),
-        heldout_items=np.arange(20, 24),
-        base=Fit(frozenset(), {}),
-        base_intervals={},
-        selection=selection,
-        steps=steps,
-        seed=0,
-        margin=0.05,
-        folds=4,
-        draws=20,
-    )
+    report = report_on_twenty_items(problem, selection, steps)
     (finding,) = [f for f in report["findings"] if f["effect"] == effect]
     assert finding["evidence"].startswith(says), finding["evidence"]
     # an implied cause is named, not written; a simpler form in another's place is the written term
@@ -562,20 +567,7 @@ def test_the_report_names_an_implied_or_replacing_cause_with_its_own_evidence(ki
 def test_the_markdown_lists_an_implied_cause_that_is_not_identified_under_the_form_that_implies_it(tmp_path):
     """It was never selected on its own, so it is not "selected but not identified" (session 23)."""
     problem = ShoulderedCurve(centre=0.0, slope=0.05)
-    report = build_report(
-        problem,
-        input_path=Path("measured"),
-        fit_items=np.arange(20),
-        heldout_items=np.arange(20, 24),
-        base=Fit(frozenset(), {}),
-        base_intervals={},
-        selection=select_curve(problem),
-        steps=CURVE_STEPS,
-        seed=0,
-        margin=0.05,
-        folds=4,
-        draws=20,
-    )
+    report = report_on_twenty_items(problem, select_curve(problem), CURVE_STEPS)
     write_markdown(report, [], tmp_path / "report.md")
     text = (tmp_path / "report.md").read_text()
     assert "Selected but **not identified**" not in text
