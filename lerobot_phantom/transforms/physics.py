@@ -343,7 +343,8 @@ def rolling_shutter_rows_lit(
       laser light) makes that detection probabilistic near the threshold (a soft threshold).
     - edge spread: blooming and the optics' glare widen every stripe that lights a row by ``spread_rows`` at each
       edge; a stripe narrower than a row time (``lit < row_time``) lights a row only for ``lit / row_time`` of
-      pulse phases, so it adds ``2 spread_rows min(lit, row_time)`` of start time, and it never lights a frame.
+      pulse phases, so it adds ``2 spread_rows min(lit, row_time)`` of start time; it never turns a frame in
+      which no row reaches the threshold into a lit one.
     - phase and aliasing: the pulse phase relative to the frame is unknowable per frame (it drifts when the laser
       and frame rates beat), so the prediction is the expectation over a uniform phase. Which frames the
       measurement averaged over matters at low frequency, where many frames catch no pulse:
