@@ -6,8 +6,8 @@
 # Each pair runs torchrun --nproc_per_node=2 lerobot_phantom.train.train (the tiny SmolVLA config, 6 steps, as
 # tests/train/test_train.py::test_two_processes_share_one_epoch_plan) once from OLD_TREE, then once from NEW_TREE,
 # while two busy-loop processes keep both cores loaded (the test suite's other xdist worker, made worse). A run still
-# alive 50 s after it started is counted as hung; gdb's backtrace of every thread of its ranks is written to OUTDIR
-# before they are killed. Prints one line per run and a summary. See docs/bench/ddp_teardown.md.
+# alive 50 s after it started is counted as hung; gdb's backtrace of every thread of its ranks and torchrun's log
+# are written to OUTDIR before they are killed. Prints one line per run and a summary. See docs/bench/ddp_teardown.md.
 set -u
 old=$(realpath "$1"); new=$(realpath "$2"); pairs=$3; outdir=$4
 mkdir -p "$outdir"
@@ -42,6 +42,7 @@ for i in $(seq 1 "$pairs"); do
         gdb -p "$rank_pid" -batch -ex "thread apply all bt" > "$outdir/gdb_${side}_${i}_$rank_pid.txt" 2>&1
       done
       kill -9 $(pgrep -P $pid) $pid; wait $pid 2>/dev/null
+      cp "$work/log.txt" "$outdir/log_${side}_$i.txt"  # where it stopped: in training or at exit
       echo "pair $i $side hung" | tee -a "$outdir/runs.txt"
       if [ $side = old ]; then hung_old=$((hung_old + 1)); else hung_new=$((hung_new + 1)); fi
     else

@@ -187,12 +187,37 @@ def test_act_run_logs_per_attack_loss_with_log_step_forwards(tmp_path, tiny_data
     assert_reloads_offline(pretrained_dir(out), tiny_dataset_root)
 
 
+def run_or_dump_stacks(command: list[str], env: dict, timeout_s: float) -> tuple[int, str]:
+    """(return code, stderr) of ``command``; if it is still running after ``timeout_s``, every process under it is
+    aborted (with ``PYTHONFAULTHANDLER`` set, a Python process prints its threads' stacks on SIGABRT) and the test
+    fails with the end of the log."""
+    import signal
+    import subprocess
+
+    import psutil  # accelerate's dependency
+
+    process = subprocess.Popen(command, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        _, log = process.communicate(timeout=timeout_s)
+        return process.returncode, log
+    except subprocess.TimeoutExpired:
+        for child in psutil.Process(process.pid).children(recursive=True):
+            child.send_signal(signal.SIGABRT)
+        try:
+            _, log = process.communicate(timeout=30)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            _, log = process.communicate()
+        pytest.fail(
+            f"still running after {timeout_s} s, its processes aborted; the end of its log:\n{log[-8000:]}"
+        )
+
+
 @pytest.mark.slow
 def test_two_processes_share_one_epoch_plan(tmp_path, tiny_dataset_root, tiny_vlm):
     """torchrun (what `accelerate launch` runs) with 2 CPU processes: each rank trains on its share of the sampler,
     and the attacked count over one epoch, summed over both ranks, is still exactly round(rate * N)."""
     import os
-    import subprocess
     import sys
 
     out = tmp_path / "ddp"
@@ -205,14 +230,11 @@ def test_two_processes_share_one_epoch_plan(tmp_path, tiny_dataset_root, tiny_vl
         "-m",
         "lerobot_phantom.train.train",
     ]
-    env = {**os.environ, "HF_HUB_OFFLINE": "1", "OMP_NUM_THREADS": "1"}
-    try:
-        result = subprocess.run([*command, *args], env=env, capture_output=True, text=True, timeout=300)
-    except subprocess.TimeoutExpired as timeout:
-        log = timeout.stderr or b""  # bytes even with text=True (Python 3.11)
-        log = log.decode(errors="replace") if isinstance(log, bytes) else log
-        pytest.fail(f"torchrun still running after {timeout.timeout} s; the end of its log:\n{log[-3000:]}")
-    assert result.returncode == 0, result.stderr[-3000:]
+    # a rank that hangs prints every thread's Python stack when it is aborted (faulthandler), so a rare hang in a
+    # suite run shows where each rank was (session 23: one run stopped before LeRobot's training loop began)
+    env = {**os.environ, "HF_HUB_OFFLINE": "1", "OMP_NUM_THREADS": "1", "PYTHONFAULTHANDLER": "1"}
+    returncode, log = run_or_dump_stacks([*command, *args], env, timeout_s=300)
+    assert returncode == 0, log[-3000:]
     (record,) = loss_log(out)
     assert record["seen"]["total"] == FRAMES  # 6 steps x batch 2 x 2 processes
     assert record["seen"]["attacked"] == round(0.3 * FRAMES)
