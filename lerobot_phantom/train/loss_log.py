@@ -68,6 +68,21 @@ def _select(batch: dict[str, Any], rows: torch.Tensor, batch_size: int) -> dict[
     return out
 
 
+def _own_gloo_group(accelerator: Any):
+    """A gloo process group for the log's sums alone (None in one process); every rank builds it at the same step.
+
+    Not accelerate's ``reduce`` on LeRobot's group: a collective there hands that group's worker thread a tensor made
+    in Python, and the barriers LeRobot queues at the end of training keep the finished work alive. Torch 2.10
+    releases a tensor's Python object (which takes the GIL) whenever the C++ side drops its second-last reference,
+    even if Python still holds the tensor. At the end of training the main thread holds the GIL while it joins that
+    worker (destroying DDP's process group), and the worker waits for the GIL to free the work: a deadlock after
+    "End of training" (docs/bench/ddp_teardown.md). A group of its own has no barriers: its worker frees each
+    reduction as soon as it is done, while the main thread still runs Python code and gives the GIL up."""
+    if accelerator.num_processes <= 1 or not torch.distributed.is_initialized():
+        return None
+    return torch.distributed.new_group(backend="gloo")
+
+
 class PerAttackLossLog:
     """Collects per-group losses during training; see the module docstring."""
 
@@ -95,7 +110,7 @@ class PerAttackLossLog:
         self._window_count = torch.zeros(_NUM_SLOTS, dtype=torch.float64)
         self._seen = torch.zeros(_NUM_SLOTS, dtype=torch.float64)
         self._seen_total = torch.zeros((), dtype=torch.float64)
-        self._last_reduced: torch.Tensor | None = None
+        self._group = _own_gloo_group(accelerator)
         logging.info("lerobot-phantom: per-attack loss logging in %r mode", self.mode)
 
     # -- per-sample forward ---------------------------------------------------------------------------------
@@ -114,8 +129,8 @@ class PerAttackLossLog:
         self.policy.forward = forward
 
     def close(self) -> None:
-        # Called after LeRobot's loop returned: its process group and gloo's threads are gone.
-        self._last_reduced = None
+        # Called after LeRobot's loop returned; its end_training destroyed every process group, this log's too.
+        self._group = None
         if self._original_forward is not None:
             del self.policy.forward
             self._original_forward = None
@@ -164,15 +179,9 @@ class PerAttackLossLog:
     def _flush(self, step: int) -> dict[str, float]:
         # Every process reaches its log steps together (same step counter), so the reduction is collective.
         stacked = torch.stack([self._window_sum, self._window_count, self._seen])
-        stacked = torch.cat([stacked.reshape(-1), self._seen_total.reshape(1)]).to(self.accelerator.device)
-        stacked = self.accelerator.reduce(stacked, reduction="sum")
-        # For a sum, accelerate returns the very tensor gloo reduced. Gloo's worker thread can drop its last reference
-        # to it after the call returned (a barrier queued right after still holds the finished work). Were that the
-        # last reference, freeing the Python tensor would need the GIL, and at the end of training the main thread
-        # holds the GIL while it joins that worker (destroying DDP's process group): a deadlock after "End of
-        # training" (torch 2.10; docs/bench/ddp_teardown.md). Holding the tensor here keeps the last reference ours.
-        self._last_reduced = stacked
-        stacked = stacked.to("cpu", torch.float64)
+        stacked = torch.cat([stacked.reshape(-1), self._seen_total.reshape(1)])
+        if self._group is not None:
+            torch.distributed.all_reduce(stacked, op=torch.distributed.ReduceOp.SUM, group=self._group)
         window_sum, window_count, seen = stacked[:-1].reshape(3, _NUM_SLOTS)
         seen_total = float(stacked[-1])
         self._window_sum.zero_()
