@@ -267,8 +267,10 @@ def implied_results(
     bootstrap refits as the parameters' (``samples``) must exclude its null value (rule 4); its effect size is the
     implying effect's, which passed rule 2."""
     implies = {e.name: e.implies for e in problem.candidates}
-    for effect, implied in ((e, i) for e, names in implies.items() for i in names):
-        if implied not in implies:  # a named cause needs its cause text, which candidates carry
+    for effect, names in implies.items():
+        for implied in set(names) - set(
+            implies
+        ):  # a named cause needs its cause text, which candidates carry
             raise ValueError(
                 f"{effect} implies {implied}, not a candidate of {type(problem).__name__}; valid: {', '.join(implies)}"
             )

@@ -36,9 +36,9 @@ FRAME_RULE_CHOICES = ("auto", *STRIPE_FRAME_RULES)
 # 3-point alike) stop in another offset/threshold minimum, 7.42 rows against the 1.50 forward mode reaches
 STRIPE_JACOBIAN = "forward"
 
-# The kernel's blooming term (spread_rows) is not a candidate: for one stripe per frame at least a row wide it adds
-# the same rows as integration_offset, so the two cannot be told apart from stripe tables; they differ only for
-# stripes narrower than a row time, which bloom in the share of frames that light a row.
+# The kernel's blooming term (spread_rows) is not a candidate, and the model never sets it: for one stripe per frame
+# at least a row wide it adds the same rows as integration_offset, so the two cannot be told apart from stripe
+# tables; they differ only for stripes narrower than a row time, which bloom in the share of frames that light a row.
 EFFECTS = (
     Effect(
         "exposure_overlap",
@@ -275,8 +275,6 @@ class StripeProblem(Problem):
             specs.append(
                 Param("noise_s", 0.3 * shortest, 0.0, exposure + shortest, scale=max(shortest, 1e-7))
             )
-        if "edge_spread" in effects:
-            specs.append(Param("spread_rows", 1.0, 0.0, height / 4.0, scale=5.0))
         return specs
 
     def predict(
@@ -292,7 +290,6 @@ class StripeProblem(Problem):
             image_rows=self.image_height,
             integration_offset_s=params.get("integration_offset_s", 0.0),
             threshold_s=params.get("threshold_s", 0.0),
-            spread_rows=params.get("spread_rows", 0.0),
             noise_s=params.get("noise_s"),
             frames=frames,
         )
@@ -370,7 +367,7 @@ class StripeProblem(Problem):
 
     def start_grid(self, specs: list[Param], first: dict[str, float]) -> dict[str, np.ndarray]:
         """Starting points: frame readouts 0.1 ms .. 200 ms (log grid) x offsets and thresholds in proportion to
-        the table's exposures and pulse widths x spreads of 0 and 2 rows, for the parameters the model has."""
+        the table's exposures and pulse widths, for the parameters the model has."""
         exposure = float(np.median(self.exposure_s))
         shorter = float(np.median(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
         axes = {
@@ -378,7 +375,6 @@ class StripeProblem(Problem):
             "integration_offset_s": exposure * np.array([0.0, 0.1, 0.3, 0.6, 1.0]),
             "threshold_s": shorter * np.array([0.01, 0.03, 0.1, 0.2, 0.4, 0.7, 1.0]),
             "noise_s": shorter * np.array([0.03, 0.3]),
-            "spread_rows": np.array([0.0, 2.0]),
         }
         names = [p.name for p in specs]
         bounds = {p.name: (p.low, p.high) for p in specs}
@@ -392,7 +388,6 @@ class StripeProblem(Problem):
             "integration_offset": {"integration_offset_s": 0.0},
             "detection_threshold": {"threshold_s": 0.0},
             "detection_noise": {"noise_s": 0.0},
-            "edge_spread": {"spread_rows": 0.0},
         }.get(effect, {})
 
     def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -448,14 +443,11 @@ class StripeProblem(Problem):
     def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
         res = self.residual(before, items)
         on = self.duty[items] / self.frequency_hz[items]
-        row_time = before.params.get("row_time_s", after.params.get("row_time_s", 1.0))
         drivers = {
             "exposure_overlap": on + self.exposure_s[items],
             "integration_offset": self.exposure_s[items],
             "detection_threshold": np.minimum(on, self.exposure_s[items]),
             "detection_noise": np.minimum(on, self.exposure_s[items]),
-            # stripes per frame: each brings two spread edges
-            "edge_spread": self.image_height * row_time * self.frequency_hz[items],
         }
         driver = drivers[effect]
         corr = float(np.corrcoef(driver, res)[0, 1]) if np.std(driver) > 0 and np.std(res) > 0 else 0.0
@@ -479,7 +471,6 @@ class StripeProblem(Problem):
             "integration_offset_us": fit.params.get("integration_offset_s", 0.0) * 1e6,
             "threshold_us": fit.params.get("threshold_s", 0.0) * 1e6,
             "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
-            "spread_rows": fit.params.get("spread_rows", 0.0),
             "frames_averaged": fit.extra.get("frames", "lit"),
             "image_height": self.image_height,
             **units,

@@ -35,9 +35,11 @@ DUTIES = (1, 5, 10, 20, 35, 50)
 def simulate_stripe_rows(camera: dict, conditions, rng: np.random.Generator, frames: int) -> np.ndarray:
     """Mean lit-row count per counted frame for each (frequency Hz, duty fraction, exposure s); NaN when the
     frame rule keeps no frame (such a row would not exist in a measured table)."""
-    return np.array(
-        [np.mean(c) if c else np.nan for c in simulate_stripe_counts(camera, conditions, rng, frames)]
-    )
+    return mean_rows(simulate_stripe_counts(camera, conditions, rng, frames))
+
+
+def mean_rows(counts: list[list[int]]) -> np.ndarray:
+    return np.array([np.mean(c) if c else np.nan for c in counts])
 
 
 def simulate_stripe_counts(
@@ -149,7 +151,7 @@ def kernel_against_simulator(seed: int, frames: str, n_frames: int = 300) -> dic
         "kernel": kernel[0],
         "kernel_low": np.min(kernel, axis=0),
         "kernel_high": np.max(kernel, axis=0),
-        "simulated": np.array([np.mean(c) if c else np.nan for c in counts]),
+        "simulated": mean_rows(counts),
         "standard_error": np.array(
             [np.std(c, ddof=1) / np.sqrt(len(c)) if len(c) > 1 else 0.0 for c in counts]
         ),
