@@ -242,19 +242,26 @@ def test_phase_averaged_rows_match_the_simulator(frames):
     )
 
 
-@pytest.mark.parametrize("on_rows", [0.2, 0.7, 2.6])
-def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows):
+@pytest.mark.parametrize(
+    ("on_rows", "period", "frames"),
+    [(0.2, 7.3, "all"), (0.7, 7.3, "all"), (2.6, 7.3, "all"), (0.2, 500.0, "lit"), (2.6, 500.0, "lit")],
+)
+def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows, period, frames):
     """Exact expectation over the pulse phase (a fine phase grid, rows as discrete start times): a stripe narrower
     than a row time lights a row for only part of the phases, and only then blooms (session 23: the kernel added
-    the spread to every stripe, 102.8 rows where the simulator counted 56.8)."""
-    rows, period, window, spread = 200, 7.3, 0.3, 2
+    the spread to every stripe, 102.8 rows where the simulator counted 56.8). A pulse slower than the readout
+    (period 500 rows, 200-row frames) leaves most frames dark; blooming cannot light one, so it does not change
+    which frames the ``lit`` rule counts."""
+    rows, window, spread = 200, 0.3, 2
     starts = np.arange(rows, dtype=float)  # one row time = 1
     counts = []
-    for phase in np.linspace(0.0, period, 7300, endpoint=False):
+    for phase in np.arange(0.0, period, 0.01):
         # a row collects light when its window [t, t + window] overlaps a pulse [phase + k period, + on_rows]
         lit = np.mod(starts - phase + window, period) < on_rows + window
         padded = np.pad(lit, spread)
-        counts.append(np.any([padded[k : k + rows] for k in range(2 * spread + 1)], axis=0).sum())
+        count = np.any([padded[k : k + rows] for k in range(2 * spread + 1)], axis=0).sum()
+        if frames == "all" or count > 0:
+            counts.append(count)
     kernel = physics.rolling_shutter_rows_lit(
         torch.tensor(1.0 / period),
         torch.tensor(on_rows / period),
@@ -262,10 +269,11 @@ def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows):
         1.0,
         image_rows=rows,
         spread_rows=spread,
-        frames="all",
+        frames=frames,
     )
-    # the frame's first and last stripes lose the spread edge that falls outside the frame: under one row here
-    assert float(kernel) == pytest.approx(np.mean(counts), abs=1.0)
+    # a stripe at the frame's edge loses the spread edge that falls outside the frame: under one row with 27 stripes
+    # per frame, a few hundredths of a row with one stripe in a lit frame
+    assert float(kernel) == pytest.approx(np.mean(counts), abs=1.0 if frames == "all" else 0.1)
 
 
 def test_lit_time_is_the_overlap_minus_twice_the_threshold():
