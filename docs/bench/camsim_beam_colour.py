@@ -103,7 +103,9 @@ def main() -> None:
     dark = laser_blinding.dark_level(pattern, centre)
     dark_linear = physics.srgb_to_linear(dark).reshape(3, 1, 1)
     held = (physics.srgb_to_linear(pattern) - dark_linear).numpy()
-    read = (physics.srgb_to_linear(laser_blinding.beam_profile(pattern, dark, centre)) - dark_linear).numpy()
+    read = (
+        physics.srgb_to_linear(laser_blinding.beam_profile(pattern, dark, centre).profile) - dark_linear
+    ).numpy()
     ys, xs = np.mgrid[0 : pattern.shape[1], 0 : pattern.shape[2]]
     radius = np.hypot(xs - centre[0], ys - centre[1])  # working pixels: camsim frames are not resized
     print(

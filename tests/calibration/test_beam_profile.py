@@ -41,7 +41,7 @@ def read_beam(pattern: torch.Tensor) -> np.ndarray:
     """Green channel of the read beam profile, linear light above the dark level."""
     centre = pattern_centre(pattern)
     dark = dark_level(pattern, centre)
-    profile = beam_profile(pattern, dark, centre)
+    profile = beam_profile(pattern, dark, centre).profile
     return (physics.srgb_to_linear(profile) - physics.srgb_to_linear(dark).reshape(3, 1, 1))[1].numpy()
 
 
@@ -77,7 +77,7 @@ def test_a_channel_without_a_measurable_edge_is_named_not_skipped_silently(caplo
     pattern[2] = physics.linear_to_srgb(torch.full_like(pattern[2], DARK))
     centre = pattern_centre(pattern)
     with caplog.at_level("WARNING", logger="lerobot_phantom.calibration.frame_models.laser_blinding"):
-        profile = beam_profile(pattern, dark_level(pattern, centre), centre)
+        profile = beam_profile(pattern, dark_level(pattern, centre), centre).profile
     warned = [record.getMessage() for record in caplog.records]
     assert any("channel 2" in message for message in warned), warned
     assert not any("channel 1" in message for message in warned), warned
@@ -108,7 +108,7 @@ def test_every_channel_carries_the_laser_colour():
     centre = pattern_centre(pattern)
     dark = dark_level(pattern, centre)
     read = (
-        physics.srgb_to_linear(beam_profile(pattern, dark, centre))
+        physics.srgb_to_linear(beam_profile(pattern, dark, centre).profile)
         - physics.srgb_to_linear(dark).reshape(3, 1, 1)
     ).numpy()
     # where only red is measured (0.5-3 noise deviations of light in it, the others far below their floors), the

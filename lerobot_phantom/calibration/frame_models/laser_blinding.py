@@ -39,6 +39,7 @@ from __future__ import annotations
 
 import logging
 from functools import partial
+from typing import NamedTuple
 
 import numpy as np
 import torch
@@ -107,16 +108,29 @@ def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
 SATURATED = 247.5 / 255.0
 
 
-def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
-    """Per-channel median (encoded) of the capture's outer half, by distance from the spot's centre: the dark
-    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
+def outer_half_radii(pattern: torch.Tensor, centre: tuple[float, float]) -> tuple[torch.Tensor, torch.Tensor]:
+    """(flat distances of the capture's pixels from the spot's centre, mask of the outer half by that distance)."""
     _, height, width = pattern.shape
     ys, xs = torch.meshgrid(
         torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
     )
     radius = torch.hypot(xs - centre[0], ys - centre[1]).reshape(-1)
-    outer = radius >= radius.median()
+    return radius, radius >= radius.median()
+
+
+def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
+    """Per-channel median (encoded) of the capture's outer half, by distance from the spot's centre: the dark
+    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
+    _, outer = outer_half_radii(pattern, centre)
     return pattern.reshape(3, -1)[:, outer].median(dim=1).values
+
+
+def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> float:
+    """Capture pixels from the spot at which :func:`dark_level` reads the laser's glare: glare falls with the
+    distance, so the outer half's median holds its value at the half's median distance, and subtracting the dark
+    level takes that much glare out of every pixel of the capture."""
+    radius, outer = outer_half_radii(pattern, centre)
+    return float(radius[outer].median())
 
 
 # the capture's noise is estimated, and removed, on the scale of a few pixels: a beam profile is smooth there
@@ -130,8 +144,18 @@ EDGE_FLOORS = (2.0, 16.0)
 MIN_EDGE_PIXELS = 6
 
 
-def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
-    """The laser's beam profile as the capture measured it, without the capture's noise (encoded values).
+class BeamReading(NamedTuple):
+    profile: (
+        torch.Tensor
+    )  # (3, H, W) encoded values: the beam without the capture's noise, continued below its floor
+    measured: (
+        torch.Tensor
+    )  # (H, W) bool: where the laser's own channel stands above the capture's noise floor
+
+
+def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> BeamReading:
+    """The laser's beam profile as the capture measured it, without the capture's noise (encoded values), and
+    where the capture measured it.
 
     The capture records the beam plus its own dark noise (photon noise of the dark room's light, read noise, 8-bit
     steps, compression). Only the beam grows with the laser's power: read as laser light and scaled by the power
@@ -215,7 +239,7 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
             continue
         ratio = (light[c][both] * light[laser][both]).sum() / (light[laser][both] ** 2).sum()
         beam[c] = torch.where(unsaturated[laser], ratio * beam[laser], beam[c])
-    return physics.linear_to_srgb(beam + dark_linear)
+    return BeamReading(physics.linear_to_srgb(beam + dark_linear), measured[laser])
 
 
 def saturated_depth(pattern: torch.Tensor) -> torch.Tensor:
@@ -273,6 +297,9 @@ class BlindingFrames(PixelProblem):
         super().__init__(pairs, seed)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
         self.dark_levels = [dark_level(p.pattern, c) for p, c in zip(pairs, self.centres, strict=True)]
+        self.dark_radii = [
+            dark_level_radius(p.pattern, c) * p.to_reference for p, c in zip(pairs, self.centres, strict=True)
+        ]
         self.beams = [
             beam_profile(p.pattern, d, c)
             for p, d, c in zip(pairs, self.dark_levels, self.centres, strict=True)
@@ -316,11 +343,15 @@ class BlindingFrames(PixelProblem):
         return {
             "scene": flat_pixels(pair.clean, pixels),
             "pattern": flat_pixels(pair.pattern, pixels),
-            "beam": flat_pixels(self.beams[index], pixels),
+            "beam": flat_pixels(self.beams[index].profile, pixels),
+            "unmeasured": flat_pixels((~self.beams[index].measured).double().expand(3, -1, -1), pixels)[
+                :, :1
+            ],
             "dark": self.dark_levels[index].reshape(1, 3).expand(n, 3),
             "core_depth": flat_pixels(self.core_depths[index], pixels),
             "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
             "radius": radius,
+            "dark_radius": torch.full((n, 1), self.dark_radii[index], dtype=torch.float64),
             "strength": torch.full((n, 1), pair.intensity, dtype=torch.float64),
             "pair": torch.full((n,), index, dtype=torch.long),
             "colour": self.colours[index].reshape(1, 3).expand(n, 3),
@@ -413,8 +444,12 @@ class BlindingFrames(PixelProblem):
             opacity = (params["alpha"] * s).clamp(0.0, 1.0)
             light, scene_weight = opacity * decode(f["pattern"]), 1.0 - opacity
         if "halo_power_law" in effects:
+            # the capture holds the glare, scaled with the beam by the gain, wherever it measured the laser's light,
+            # less the glare its dark level took out (read at the dark level's distance); below its noise floor
+            # it lost the glare altogether
+            glare_at = torch.where(f["unmeasured"] > 0, f["radius"], f["dark_radius"])
             halo = physics.power_law_halo(
-                f["radius"], halo_amplitude(params), params["halo_exponent"], params["halo_scale_ref_px"]
+                glare_at, halo_amplitude(params), params["halo_exponent"], params["halo_scale_ref_px"]
             )
             light = light + s * halo * f["colour"]
         return scene_weight * scene + light
