@@ -225,13 +225,33 @@ def is_triple_table(columns) -> bool:
     return set(TRIPLE_COLUMNS) <= set(columns)
 
 
-class TripleProblem(Problem):
+class ProjectionTerms:
+    """Light projection's model terms, shared by colour-triple tables and frame pairs (mixed in before the
+    problem class, whose abstract methods these answer)."""
+
     attack = "light_projection"
+    extended_model = "additive projector light"
+    candidates = EFFECTS
+
+    def param_specs(self, effects: frozenset[str]) -> list[Param]:
+        return projection_specs(effects)
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        return projection_nulls(effect)
+
+    def implied_statistic(
+        self, effect: str, implied: str, params: dict[str, float]
+    ) -> tuple[str, float, float]:
+        return projection_implied_statistic(effect, implied, params)
+
+    def transform_kwargs(self, fit: Fit) -> dict:
+        return projection_kwargs(fit)
+
+
+class TripleProblem(ProjectionTerms, Problem):
     input_kind = "colour_triples"
     units = "grey levels (0-255)"
     base_model = "alpha blend of surface and projected colour (the paper's light projection)"
-    extended_model = "additive projector light"
-    candidates = EFFECTS
     item_name = "table rows"
 
     def __init__(self, path: Path) -> None:
@@ -285,17 +305,6 @@ class TripleProblem(Problem):
     def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         return (self.residual(fit, items) ** 2).sum(1), np.full(len(items), 3.0)
 
-    def param_specs(self, effects: frozenset[str]) -> list[Param]:
-        return projection_specs(effects)
-
-    def null_values(self, effect: str) -> dict[str, float]:
-        return projection_nulls(effect)
-
-    def implied_statistic(
-        self, effect: str, implied: str, params: dict[str, float]
-    ) -> tuple[str, float, float]:
-        return projection_implied_statistic(effect, implied, params)
-
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         """Per row: the three channels' residuals against channel, surface and projected level."""
         r = self.residual(fit, items)
@@ -342,9 +351,6 @@ class TripleProblem(Problem):
             driver = np.repeat((surface + projected).sum(1, keepdims=True), 3, 1)
         corr = float(np.corrcoef(driver.ravel(), r.ravel())[0, 1]) if np.std(driver) > 0 else 0.0
         return f"before {effect}: residual correlates {corr:+.2f} with its driving variable"
-
-    def transform_kwargs(self, fit: Fit) -> dict:
-        return projection_kwargs(fit)
 
     def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir: Path) -> list[str]:
         import matplotlib

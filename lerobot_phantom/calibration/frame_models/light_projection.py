@@ -6,24 +6,11 @@ import torch
 
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair, PixelProblem, flat_pixels
-from lerobot_phantom.calibration.projection import (
-    EFFECTS as PROJECTION_EFFECTS,
-)
-from lerobot_phantom.calibration.projection import (
-    projection_implied_statistic,
-    projection_kwargs,
-    projection_nulls,
-    projection_predict,
-    projection_specs,
-    projection_warm,
-)
+from lerobot_phantom.calibration.projection import ProjectionTerms, projection_predict, projection_warm
 
 
-class ProjectionFrames(PixelProblem):
-    attack = "light_projection"
+class ProjectionFrames(ProjectionTerms, PixelProblem):
     base_model = "alpha blend of the scene and the projected image (the paper's light projection)"
-    extended_model = "additive projector light"
-    candidates = PROJECTION_EFFECTS
     # a filmic camera's shoulder and the surface's reflectance pay only together: without the reflectance term the
     # shoulder's fit runs its knee to a hard clip (exponent at its bound), and without the shoulder the reflectance
     # term's floor runs to its end (camsim master seed 458072150: additive light alone 3.87 grey levels, + shoulder
@@ -49,19 +36,5 @@ class ProjectionFrames(PixelProblem):
     def predict_features(self, effects, params, feats):
         return projection_predict(feats["surface"], feats["projected"], feats["strength"], effects, params)
 
-    def param_specs(self, effects):
-        return projection_specs(effects)
-
-    def null_values(self, effect: str) -> dict[str, float]:
-        return projection_nulls(effect)
-
-    def implied_statistic(
-        self, effect: str, implied: str, params: dict[str, float]
-    ) -> tuple[str, float, float]:
-        return projection_implied_statistic(effect, implied, params)
-
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
-
-    def transform_kwargs(self, fit: Fit) -> dict:
-        return projection_kwargs(fit)
