@@ -13,16 +13,23 @@ import importlib
 import os
 import sys
 import tempfile
+from collections.abc import Iterator
+from types import ModuleType
 
 sys.path.insert(0, "tests/calibration")
 
 
-def main() -> None:
-    name, seeds = sys.argv[1], sys.argv[2:]
+def cases_per_master_seed(name: str, seeds: list[str]) -> Iterator[tuple[str, ModuleType, object]]:
+    """(master seed, the test module drawn for it, its case ``name``) per seed, as the test draws them."""
     for seed in seeds:
         os.environ["CAMSIM_SEED"] = seed
         sim = importlib.reload(importlib.import_module("test_independent_sim"))
-        case = sim.CASE_BY_NAME[name]
+        yield seed, sim, sim.CASE_BY_NAME[name]
+
+
+def main() -> None:
+    name, seeds = sys.argv[1], sys.argv[2:]
+    for seed, sim, case in cases_per_master_seed(name, seeds):
         with tempfile.TemporaryDirectory() as root:
             result = sim.run_case(name, root)
         report, named = result["report"], sim.named_causes(result["report"])

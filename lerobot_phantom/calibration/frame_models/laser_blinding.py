@@ -454,8 +454,9 @@ class BlindingFrames(PixelProblem):
             # less the glare its dark level took out (read at the dark level's distance). Below its noise floor,
             # the beam's continued edge was fitted to light that held glare too: the two are estimates of one
             # light, the edge's nearer the spot and the glare's beyond, so the larger is taken (their sum counted
-            # the glare twice next to the edge, and the fitted glare flattened to make up for it: on the halo case
-            # on 14 fresh master seeds: 12 named with the larger, 8 of 13 with the sum, docs/bench/camsim_session24.md)
+            # the glare twice next to the edge, and the fitted glare flattened to make up for it: camsim's halo
+            # case named its effects on 12 of 14 master seeds with the larger, 9 with the sum,
+            # docs/bench/camsim_session24.md)
             unmeasured = f["unmeasured"] > 0
             glare_at = torch.where(unmeasured, f["radius"], f["dark_radius"])
             halo = physics.power_law_halo(
