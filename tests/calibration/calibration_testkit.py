@@ -89,13 +89,14 @@ def write_table(folder: Path, rows: list[dict]) -> None:
 
 
 def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np.ndarray, tuple, np.ndarray]:
-    """A recorded laser (no scene): a saturating coloured spot; returns (encoded pattern, centre, laser colour)."""
+    """A laser's light (no scene), linear and unclipped: a coloured spot that saturates a capture; returns (light,
+    centre, laser colour)."""
     colour = np.array(rng.permutation([1.0, rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3)]))
     cx, cy = rng.uniform(0.3, 0.7) * width, rng.uniform(0.3, 0.7) * height
     sigma = rng.uniform(0.06, 0.12) * max(height, width)
     ys, xs = np.mgrid[0:height, 0:width]
     irradiance = rng.uniform(2.0, 6.0) * np.exp(-((xs - cx) ** 2 + (ys - cy) ** 2) / (2 * sigma**2))
-    return srgb_encode(irradiance[..., None] * colour), (cx, cy), colour
+    return irradiance[..., None] * colour, (cx, cy), colour
 
 
 def metered_exposure(blinded: np.ndarray, clean: np.ndarray) -> float:
@@ -115,24 +116,33 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
         "halo_scale": rng.uniform(10.0, 25.0),
         "auto_exposure": rng.uniform(0.7, 1.5),  # power of the meter's exposure (1: a uniform meter)
     }
+    glare = "halo_power_law" in effects
+    if glare:
+        # the glare is the laser's light, so the capture records it too; a beam profile is captured through an
+        # attenuator (tens of times weaker than the attack), where the glare far from the spot sinks below the
+        # capture's 8-bit floor while the frames show it. Drawn apart, so the other draws stay as they were
+        truth["gain"] *= np.random.default_rng([seed, 1]).uniform(20.0, 60.0)
     rows = []
     for i, (height, width) in enumerate(sizes(rng, n_pairs)):
         clean = scene(rng, height, width)
-        pattern, (cx, cy), colour = laser_pattern(rng, height, width)
+        laser, (cx, cy), colour = laser_pattern(rng, height, width)
+        if glare:
+            ys, xs = np.mgrid[0:height, 0:width]
+            r = np.hypot(xs - cx, ys - cy) * 256 / max(height, width)
+            halo = truth["halo_amplitude"] * (1 + r / truth["halo_scale"]) ** -truth["halo_exponent"]
+            laser = laser + halo[..., None] * colour / truth["gain"]
+        pattern = srgb_encode(laser)
         s = rng.uniform(0.3, 1.0)
         linear = "linear_light_saturation" in effects
         decode = srgb_decode if linear else (lambda v: v)
         encode = srgb_encode if linear else (lambda v: np.clip(v, 0, 1))
         x, p = decode(clean), decode(pattern)
-        if linear:
+        if glare:  # the attack's power lights the frames with the whole glare, not only what the capture kept
+            light, weight = s * truth["gain"] * laser, 1.0
+        elif linear:
             light, weight = s * truth["gain"] * p, 1.0
         else:
             light, weight = truth["alpha"] * s * p, 1.0 - truth["alpha"] * s
-        if "halo_power_law" in effects:
-            ys, xs = np.mgrid[0:height, 0:width]
-            r = np.hypot(xs - cx, ys - cy) * 256 / max(height, width)
-            halo = truth["halo_amplitude"] * (1 + r / truth["halo_scale"]) ** -truth["halo_exponent"]
-            light = light + s * halo[..., None] * colour
         total = weight * x + light
         if "auto_exposure" in effects:
             total = total * metered_exposure(total, x) ** truth["auto_exposure"]

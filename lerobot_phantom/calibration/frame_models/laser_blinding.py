@@ -4,8 +4,8 @@ Base: the paper's alpha blend of the scene and the encoded pattern. ``linear_lig
 as laser irradiance instead, which needs three corrections any capture of a laser "alone" calls for:
 
 * the capture's dark level (the dark room's residual light and the sensor's black level) is not laser light and
-  does not grow with the laser's power: the per-channel median of the capture's pixels farthest from the spot (its tenth) is
-  subtracted in linear light;
+  does not grow with the laser's power: the per-channel median of the tenth of the capture's pixels farthest from
+  the spot is subtracted in linear light;
 * where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
   extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
   radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
@@ -21,13 +21,13 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   with its exponent at the bound (measured on the independent simulator).
 
 ``halo_power_law`` is glare, so it adds light and builds on ``linear_light_saturation``; it is fitted by its level
-at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it) and its exponent. The capture holds
-the glare too, at its own power: where it measured the laser's light, its beam already carries the glare (scaled
-with it by the gain) less the share its dark level took out (the glare at :func:`dark_level_radius`), so the halo
-adds back only that share there, and the whole glare only where the capture's reading sank below its noise floor.
-Added everywhere (until session 24), it counted the measured glare twice and missed the dark level's share, and
-fits answered with a glare whose exponent ran to its bound (independent simulator's halo case,
-docs/bench/camsim_session24.md). ``tone_shoulder``
+at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it) and its exponent; its inner scale lies inside
+the clipped core (``GLARE_INNER_SCALE_REF_PX``). The capture holds the glare too, at its own power: where it
+measured the laser's light, its beam already carries the glare (scaled with it by the gain) less the share its dark
+level took out (the glare at :func:`dark_level_radius`), so the halo adds back only that share there; below its
+noise floor the glare is the larger of the halo and the beam's continued edge. Added everywhere (until session 24),
+it counted the measured glare twice and missed the dark level's share, and fits answered with a glare whose exponent
+ran to its bound (independent simulator's halo case, docs/bench/camsim_session24.md). ``tone_shoulder``
 (also on linear light) composes in the log-logistic tone curve of ``calibration/tone.py`` instead of sRGB: a filmic
 camera stores the laser's light on a curve no power law follows (on the independent simulator, a power law fitted
 to one ran to its bound and a halo took over the laser's whole spot). It is an alternative to ``sensor_gamma``, not
@@ -157,12 +157,10 @@ MIN_EDGE_PIXELS = 6
 
 
 class BeamReading(NamedTuple):
-    profile: (
-        torch.Tensor
-    )  # (3, H, W) encoded values: the beam without the capture's noise, continued below its floor
-    measured: (
-        torch.Tensor
-    )  # (H, W) bool: where the laser's own channel stands above the capture's noise floor
+    # (3, H, W) encoded values: the beam without the capture's noise, continued below its floor
+    profile: torch.Tensor
+    # (H, W) bool: where the laser's own channel stands above the capture's noise floor
+    measured: torch.Tensor
 
 
 def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> BeamReading:
@@ -345,6 +343,11 @@ class BlindingFrames(PixelProblem):
     def centre(self, index: int) -> tuple[float, float]:
         return self.centres[index]
 
+    def unmeasured(self, index: int, pixels: torch.Tensor | None) -> torch.Tensor:
+        """(n, 1): 1 where the capture did not measure the laser's light (below its noise floor), else 0."""
+        flat = (~self.beams[index].measured).reshape(-1, 1).double()
+        return flat if pixels is None else flat[pixels]
+
     def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
         pair = self.pairs[index]
         ys, xs = torch.meshgrid(
@@ -361,9 +364,7 @@ class BlindingFrames(PixelProblem):
             "scene": flat_pixels(pair.clean, pixels),
             "pattern": flat_pixels(pair.pattern, pixels),
             "beam": flat_pixels(self.beams[index].profile, pixels),
-            "unmeasured": flat_pixels((~self.beams[index].measured).double().expand(3, -1, -1), pixels)[
-                :, :1
-            ],
+            "unmeasured": self.unmeasured(index, pixels),
             "dark": self.dark_levels[index].reshape(1, 3).expand(n, 3),
             "core_depth": flat_pixels(self.core_depths[index], pixels),
             "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
