@@ -268,12 +268,12 @@ def implied_results(
     implying effect's, which passed rule 2."""
     implies = {e.name: e.implies for e in problem.candidates}
     for effect, names in implies.items():
-        for implied in set(names) - set(
-            implies
-        ):  # a named cause needs its cause text, which candidates carry
-            raise ValueError(
-                f"{effect} implies {implied}, not a candidate of {type(problem).__name__}; valid: {', '.join(implies)}"
-            )
+        for implied in names:
+            if implied not in implies:  # a named cause needs its cause text, which candidates carry
+                raise ValueError(
+                    f"{effect} implies {implied}, not a candidate of {type(problem).__name__}; "
+                    f"valid: {', '.join(implies)}"
+                )
     judged = {r["effect"] for r in results}
     out = []
     for result in results:

@@ -115,8 +115,9 @@ SATURATED = 247.5 / 255.0
 
 
 # the share of a capture's pixels, farthest from the spot, whose median is its dark level: the laser's light falls
-# with the distance, and in the outer half it can stand several times above the dark room's (the beam's bloom at the
-# attack's power, on the independent simulator: 0.023 against 0.005 of the full well)
+# with the distance, and in the outer half it can stand far above the dark room's (the beam's bloom in a capture at the
+# attack's power, on the independent simulator: the outer half's median 0.070 of the full well where the dark room
+# gives 0.0048 at the spot, the farthest tenth's 0.0075; docs/bench/camsim_session24/dark_level_saturation.txt)
 DARK_SHARE = 0.1
 
 
