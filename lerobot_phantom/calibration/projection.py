@@ -31,6 +31,7 @@ from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     equivalent_power_gamma,
+    implied_gamma_statistic,
     shoulder_decode,
     shoulder_encode,
 )
@@ -79,7 +80,7 @@ EFFECTS = (
         # the curve decodes pixels to linear light, as the power law does: as its knee exponent goes to 0 it is
         # the power law of gamma 1 + shoulder (tone.py), and a power-law camera with shot noise and veiling glare
         # can be fitted better by it (camsim, docs/bench/camsim_session22.md); whether the written curve is a gamma
-        # encoding is judged by its equivalent power-law gamma (projection_implied_statistic)
+        # encoding is judged by its equivalent power-law gamma (tone.implied_gamma_statistic)
         implies=("sensor_gamma",),
     ),
 )
@@ -127,17 +128,6 @@ def projection_nulls(effect: str) -> dict[str, float]:
     if effect == "tone_shoulder":  # a knee at infinite light: the power law (or identity) without it
         return {"shoulder": 0.0}
     return {}
-
-
-def projection_implied_statistic(
-    effect: str, implied: str, params: dict[str, float]
-) -> tuple[str, float, float]:
-    """A shouldered curve's gamma encoding: the power-law gamma closest to it (null 1, linear pixel values)."""
-    if (effect, implied) != ("tone_shoulder", "sensor_gamma"):
-        raise ValueError(
-            f"no statistic for {implied} implied by {effect}; valid: sensor_gamma by tone_shoulder"
-        )
-    return "equivalent_gamma", equivalent_power_gamma(params, params.get("gamma")), 1.0
 
 
 def tone_curve(effects, params: dict):
@@ -242,7 +232,7 @@ class ProjectionTerms:
     def implied_statistic(
         self, effect: str, implied: str, params: dict[str, float]
     ) -> tuple[str, float, float]:
-        return projection_implied_statistic(effect, implied, params)
+        return implied_gamma_statistic(effect, implied, params)
 
     def transform_kwargs(self, fit: Fit) -> dict:
         return projection_kwargs(fit)

@@ -70,3 +70,12 @@ def equivalent_power_gamma(params: dict, gamma=None) -> float:
     grid = np.linspace(0.3, 5.0, 941)
     errors = [np.mean((x.numpy() ** (1.0 / g) - curve) ** 2) for g in grid]
     return float(grid[int(np.argmin(errors))])
+
+
+def implied_gamma_statistic(effect: str, implied: str, params: dict[str, float]) -> tuple[str, float, float]:
+    """A shouldered curve's gamma encoding: the power-law gamma closest to it (null 1, linear pixel values)."""
+    if (effect, implied) != ("tone_shoulder", "sensor_gamma"):
+        raise ValueError(
+            f"no statistic for {implied} implied by {effect}; valid: sensor_gamma by tone_shoulder"
+        )
+    return "equivalent_gamma", equivalent_power_gamma(params, params.get("gamma")), 1.0

@@ -316,8 +316,10 @@ def stripe_rows(height: int, on: float, window: float, phase: float, period: flo
 
 def render_laser_color_strip(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:
     """Without effects: the paper's band. ``exposure_overlap``: a stripe across the width wherever the pulse
-    falls; with ``stripe_period`` it repeats."""
+    falls; with ``stripe_period`` it repeats; with ``sensor_gamma`` its light adds to the scene's in linear light
+    under a power-law tone curve (the exponent drawn from its own generator, so the other draws stay as they were)."""
     rng = np.random.default_rng(seed)
+    gamma = np.random.default_rng([seed, 2]).uniform(1.8, 2.6) if "sensor_gamma" in effects else 1.0
     colour = np.array(rng.permutation([1.0, rng.uniform(0.05, 0.3), rng.uniform(0.05, 0.3)]))
     truth = {
         "strength": rng.uniform(150.0, 300.0),  # paper units (grey levels x 1000 / weight)
@@ -325,6 +327,7 @@ def render_laser_color_strip(folder: Path, effects: set[str], seed: int, n_pairs
         "on_share": rng.uniform(0.06, 0.12),
         "exposure_share": rng.uniform(0.03, 0.08),
         "period_share": rng.uniform(0.35, 0.5),
+        "gamma": gamma,
     }
     rows = []
     for i, (height, width) in enumerate(sizes(rng, n_pairs)):
@@ -340,7 +343,7 @@ def render_laser_color_strip(folder: Path, effects: set[str], seed: int, n_pairs
             added = s * truth["peak"] * light[:, None, None] * colour
         else:
             added = s * truth["strength"] * paper_strip_profile(height, width)[..., None] * colour / 255.0
-        attacked = np.clip(clean + added, 0.0, 1.0)
+        attacked = np.clip(clean**gamma + added, 0.0, 1.0) ** (1.0 / gamma)
         save(folder / f"clean_{i}.png", clean, rng)
         save(folder / f"attacked_{i}.png", attacked, rng)
         rows.append({"clean": f"clean_{i}.png", "attacked": f"attacked_{i}.png", "intensity": round(s, 4)})

@@ -37,6 +37,7 @@ CASES = [
     pytest.param("em_truncation", {"free_band_position"}, 51),
     pytest.param("laser_color_strip", {"exposure_overlap"}, 62, marks=SLOW),
     pytest.param("laser_color_strip", {"exposure_overlap", "stripe_period"}, 63, marks=SLOW),
+    pytest.param("laser_color_strip", {"exposure_overlap", "sensor_gamma"}, 64, marks=SLOW),
 ]
 
 
@@ -57,6 +58,8 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     assert planted <= named, f"planted {planted}, named {named}"
     if "auto_exposure" in planted:  # the kit renders the library's own meter: its power is recovered
         assert report["extended"]["params"]["auto_exposure"] == pytest.approx(truth["auto_exposure"], rel=0.1)
+    if attack == "laser_color_strip" and "sensor_gamma" in planted:
+        assert report["extended"]["params"]["gamma"] == pytest.approx(truth["gamma"], rel=0.1)
     assert len(named - planted) <= 1, f"unplanted effects added: {named - planted}"
     assert report["gain"]["rmse_ratio"] >= 1.5
     # findings name the identified effects, plus shot_noise when the likelihood test keeps it (report schema v2)

@@ -11,7 +11,6 @@ from scipy.optimize import least_squares
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.noise import linearise, tone_curve, tone_curve_name
 from lerobot_phantom.calibration.projection import (
-    projection_implied_statistic,
     projection_kwargs,
     projection_nulls,
     projection_predict,
@@ -19,6 +18,7 @@ from lerobot_phantom.calibration.projection import (
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     equivalent_power_gamma,
+    implied_gamma_statistic,
     shoulder_decode,
     shoulder_encode,
 )
@@ -116,7 +116,7 @@ def test_a_vanishing_knee_exponent_is_the_power_law_of_gamma_one_plus_shoulder(s
     linear = torch.linspace(0.0, 1.0, 1001, dtype=torch.float64)
     curve = shoulder_encode(linear, {"shoulder": shoulder, "shoulder_exponent": 1e-4}, None)
     assert torch.allclose(curve, linear.clamp(min=1e-12) ** (1 / (1 + shoulder)), atol=1e-4)
-    name, value, null = projection_implied_statistic(
+    name, value, null = implied_gamma_statistic(
         "tone_shoulder", "sensor_gamma", {"shoulder": shoulder, "shoulder_exponent": 1e-4}
     )
     assert (name, null) == ("equivalent_gamma", 1.0)
@@ -125,7 +125,7 @@ def test_a_vanishing_knee_exponent_is_the_power_law_of_gamma_one_plus_shoulder(s
 
 def test_only_the_declared_implication_has_a_statistic():
     with pytest.raises(ValueError, match="valid: sensor_gamma by tone_shoulder"):
-        projection_implied_statistic("albedo_modulation", "sensor_gamma", {})
+        implied_gamma_statistic("albedo_modulation", "sensor_gamma", {})
 
 
 def test_the_transform_gets_the_closest_power_law():

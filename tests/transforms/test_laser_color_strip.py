@@ -1,3 +1,4 @@
+import math
 import os
 import pickle
 
@@ -117,3 +118,43 @@ def test_random_draws_the_authors_uniform_strength():
     assert float(strength.min()) >= 500 - 1e-3 and float(strength.max()) <= 2500 + 1e-3
     for quantile in (0.25, 0.5, 0.75):
         assert float((strength < 500 + 2000 * quantile).double().mean()) == pytest.approx(quantile, abs=0.03)
+
+
+def _rolling_shutter(gamma):
+    # one pulse a frame lighting about a fifth of the rows, at pulse phase 0 (no generator), adding 0.05 of white
+    return LaserColorStrip(
+        "weak",
+        levels=(0.0, 0.05 * 255 * math.pi / 4, 0.1 * 255 * math.pi / 4, 0.15 * 255 * math.pi / 4),
+        model="rolling_shutter",
+        frequency_hz=0.5,
+        duty=0.1,
+        exposure_s=0.05,
+        row_time_s=1.0 / 48,
+        frame_rows=48,
+        gamma=gamma,
+    )
+
+
+def test_rolling_shutter_gamma_adds_light_before_the_tone_curve():
+    grey = torch.linspace(0.05, 0.95, 32).expand(3, 48, 32).contiguous()  # dark columns left, bright right
+    encoded = _rolling_shutter(None)(grey) - grey
+    linear = _rolling_shutter(2.2)(grey) - grey
+    lit = encoded[0].amax(dim=1) > 0
+    assert 0 < int(lit.sum()) < 48
+    # unlit rows are untouched either way
+    assert torch.allclose(linear[:, ~lit], torch.zeros_like(linear[:, ~lit]), atol=1e-6)
+    # added to encoded values every column gains the same; added in linear light a dark surface gains more
+    # grey levels than a bright one (the power law's slope falls with the value)
+    row = int(torch.nonzero(lit)[0])
+    assert torch.allclose(encoded[0, row], encoded[0, row, :1].expand(32), atol=1e-6)
+    assert bool((linear[0, row, :-1] > linear[0, row, 1:]).all())
+    # a power law of exponent 1 is the encoded composition
+    assert torch.allclose(_rolling_shutter(1.0)(grey), _rolling_shutter(None)(grey), atol=1e-6)
+
+
+def test_gamma_needs_the_rolling_shutter_model():
+    with pytest.raises(ValueError, match="rolling_shutter"):
+        LaserColorStrip(gamma=2.2)
+    with pytest.raises(ValueError, match="gamma > 0"):
+        LaserColorStrip(model="rolling_shutter", gamma=0.0)
+    assert pickle.loads(pickle.dumps(_rolling_shutter(2.2))).gamma == 2.2

@@ -2,13 +2,21 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
-from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
+from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, LatentFrameProblem, Pair
+from lerobot_phantom.calibration.tone import (
+    SHOULDER_PARAMS,
+    equivalent_power_gamma,
+    implied_gamma_statistic,
+    shoulder_decode,
+    shoulder_encode,
+)
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.laser_color_strip import band_rows, strip_profile
 
@@ -25,9 +33,30 @@ STRIP_EFFECTS = (
         "1 / (laser frequency x row time) rows",
         requires=("exposure_overlap",),
     ),
+    # the paper's band is a recipe in grey levels with no amount of light behind it; the tone curve acts on the
+    # light the stripe model measures (pulse x exposure overlap), so it builds on that model
+    dataclasses.replace(SENSOR_GAMMA, requires=("exposure_overlap",)),
+    Effect(
+        "tone_shoulder",
+        "the camera's tone curve rolls off towards white (a filmic / log-logistic shoulder, calibration/tone.py): "
+        "the stripe's light, added in linear irradiance, brightens bright surfaces far less than a power law "
+        "predicts, so one stripe's grey levels change with the scene behind it",
+        requires=("exposure_overlap",),
+        excludes=("sensor_gamma",),
+        # a shouldered curve decodes pixels to linear light as the power law does (tone.py): it is a gamma
+        # encoding too, judged by its equivalent power-law gamma
+        implies=("sensor_gamma",),
+    ),
 )
 SINGLE_PULSE_PERIOD = 4.0  # frame heights: a pulse train this slow puts at most one stripe in any frame
 PHASE_STEP_ROWS = 1.0
+PERIOD_SCAN = (0.05, 2.0)  # frame heights: the period's search range
+PERIOD_SCAN_STEPS = 48
+PERIOD_STARTS = 3
+STRIPE_SHARES_OF_PERIOD = (0.3, 0.5, 0.7)
+TONE_EFFECTS = frozenset({"sensor_gamma", "tone_shoulder"})
+TONE_PARAMS = frozenset({"gamma"} | {p.name for p in SHOULDER_PARAMS})
+ON_SHARES_OF_STRIPE = (0.2, 0.5, 0.8)  # single-stripe starts: the pulse's share of the stripe's rows
 
 
 class StripFrames(LatentFrameProblem):
@@ -35,7 +64,14 @@ class StripFrames(LatentFrameProblem):
     ``exposure_overlap``: ``physics.rolling_shutter_row_light`` in units of frame heights (row time = 1 / h), the
     pulse's on-time and the exposure fitted; ``stripe_period`` fits the pulse period too. Light scales with the
     pair's intensity. The laser is not synchronised with the camera, so the pulse phase is registered on fit
-    frames and, for held-out frames, marginalised over a uniform prior (every stripe position)."""
+    frames and, for held-out frames, marginalised over a uniform prior (every stripe position).
+
+    With ``sensor_gamma`` the laser's light adds to the scene's in linear irradiance, before the camera's tone
+    curve (a power law ``x ** gamma`` decodes the pixels): a stripe brightens dark surfaces by more grey levels
+    than bright ones, and saturates at the sensor's full well. ``tone_shoulder`` decodes through a curve that
+    rolls off towards white instead (calibration/tone.py), a form no power law takes: fitted to a filmic camera,
+    the power law's exponent ran to its bound (independent simulator, strip_period case,
+    docs/bench/camsim_session25.md)."""
 
     attack = "laser_color_strip"
     base_model = "the paper's fixed Gaussian-weighted band (rows h/3 to 2h/3), per-channel strength fitted"
@@ -64,7 +100,23 @@ class StripFrames(LatentFrameProblem):
         ]
         if "stripe_period" in effects:
             specs.append(Param("period_share", 0.5, 0.05, 2.0, scale=0.3))
+        if "sensor_gamma" in effects:
+            specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+        if "tone_shoulder" in effects:
+            specs += list(SHOULDER_PARAMS)
         return specs
+
+    def null_values(self, effect: str) -> dict[str, float]:
+        if effect == "sensor_gamma":  # the stripe adds to the encoded values
+            return {"gamma": 1.0}
+        if effect == "tone_shoulder":  # a knee at infinite light: the power law of gamma 1 (tone.py)
+            return {"shoulder": 0.0}
+        return {}
+
+    def implied_statistic(
+        self, effect: str, implied: str, params: dict[str, float]
+    ) -> tuple[str, float, float]:
+        return implied_gamma_statistic(effect, implied, params)
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
         super().__init__(pairs, seed)
@@ -74,6 +126,7 @@ class StripFrames(LatentFrameProblem):
             full = torch.zeros(pair.height, pair.width, dtype=torch.float64)
             full[start:end] = strip_profile(pair.height, pair.width).double() / 255.0
             self.profiles.append(full)
+        self._period_starts: dict[frozenset[str], list[dict[str, float]]] = {}
 
     # -- the paper's band
     def predict_band(self, params, index: int) -> torch.Tensor:
@@ -103,11 +156,26 @@ class StripFrames(LatentFrameProblem):
     def stripe_gains(self, params) -> torch.Tensor:
         return torch.stack([torch.as_tensor(params[f"peak_{c}"], dtype=torch.float64) for c in "rgb"])
 
+    @staticmethod
+    def decode(params, encoded: torch.Tensor) -> torch.Tensor:
+        """Pixel values -> the light the stripe adds to: through the fitted shoulder, the ``sensor_gamma`` power
+        law, or none (the encoded values)."""
+        if "shoulder" in params:
+            return shoulder_decode(encoded, params)
+        return physics.decode(encoded, params.get("gamma", 1.0))
+
+    @staticmethod
+    def encode(params, linear: torch.Tensor) -> torch.Tensor:
+        """Inverse of ``decode``; light beyond the sensor's full well is clipped first."""
+        if "shoulder" in params:
+            return shoulder_encode(linear, params)
+        return physics.encode(linear, params.get("gamma", 1.0))
+
     def predict_stripe(self, params, index: int, phase_rows) -> torch.Tensor:
         pair = self.pairs[index]
         light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
-        return (pair.clean + added).clamp(0.0, 1.0)
+        return self.encode(params, self.decode(params, pair.clean) + added)
 
     def phase_costs(self, params, index: int) -> tuple[torch.Tensor, np.ndarray]:
         """(pulse phases in rows, SSE of pair ``index`` for each): every stripe position, a row apart."""
@@ -122,7 +190,8 @@ class StripFrames(LatentFrameProblem):
         with torch.no_grad():
             light = self.row_light(params, height, phases)  # (P, H)
             gains = pair.intensity * self.stripe_gains(params).reshape(1, 3, 1, 1)
-            predicted = (pair.clean.unsqueeze(0) + gains * light[:, None, :, None]).clamp(0.0, 1.0)
+            linear = self.decode(params, pair.clean).unsqueeze(0)
+            predicted = self.encode(params, linear + gains * light[:, None, :, None])
             cost = ((predicted - pair.attacked.unsqueeze(0)) ** 2).sum(dim=(1, 2, 3))
         return phases, cost.numpy()
 
@@ -146,24 +215,94 @@ class StripFrames(LatentFrameProblem):
                 return self.predict_band(params, index)
             return self.predict_stripe(fit.params, index, self.best_phase(fit.params, index))
 
-    def initial_stripe(self, items: np.ndarray) -> dict[str, float]:
-        """Start values read from the data: the brightest row's colour and the lit band's height."""
+    def initial_stripe(self, items: np.ndarray, tone: dict[str, float]) -> dict[str, float]:
+        """Start values read from the data: the brightest row's colour and the lit band's height, in the light
+        the tone curve ``tone`` (its start parameters, ``decode``) decodes."""
         peaks, widths = [], []
         for i in items:
             pair = self.pairs[int(i)]
-            rows = (pair.attacked - pair.clean).mean(dim=2) / max(pair.intensity, 1e-3)  # (3, H)
+            added = self.decode(tone, pair.attacked) - self.decode(tone, pair.clean)
+            rows = added.mean(dim=2) / max(pair.intensity, 1e-3)  # (3, H)
             total = rows.sum(0)
             peaks.append(rows[:, int(torch.argmax(total))].clamp(min=0.0).numpy())
             widths.append(float((total > 0.5 * total.max()).double().mean()))
         width = max(float(np.median(widths)), 2.0 / min(p.height for p in self.pairs))
         peak = np.median(np.stack(peaks), axis=0)
-        return {
+        start = {
             "peak_r": float(peak[0]),
             "peak_g": float(peak[1]),
             "peak_b": float(peak[2]),
             "on_share": 0.6 * width,
             "exposure_share": 0.4 * width,
         }
+        return {**start, **tone}
+
+    def period_starts(self, stripe: dict[str, float], items: np.ndarray) -> list[dict[str, float]]:
+        """Start values for a fitted pulse period: the best local minima of the registered cost over a scan of
+        periods. The cost is many-valleyed in the period (a wrong period still matches one stripe in every frame),
+        so a local search from a few fixed periods stops in whichever valley it starts in. ``stripe`` holds the
+        single-stripe start; with a period shorter than the frame each stripe is only part of one period, and the
+        lit share of the rows no longer tells that part, so a few shares of the period are scanned with it."""
+        lit = stripe["on_share"] + stripe["exposure_share"]
+        on_part = stripe["on_share"] / max(lit, 1e-12)
+        candidates = []
+        for period in np.geomspace(PERIOD_SCAN[0], PERIOD_SCAN[1], PERIOD_SCAN_STEPS):
+            heights = [lit * min(float(period), 1.0)]
+            if period < 1.0:
+                heights += [share * float(period) for share in STRIPE_SHARES_OF_PERIOD]
+            best = None
+            for height in heights:
+                params = {
+                    **stripe,
+                    "on_share": on_part * height,
+                    "exposure_share": (1.0 - on_part) * height,
+                    "period_share": float(period),
+                }
+                cost = sum(float(self.phase_costs(params, int(i))[1].min()) for i in items)
+                if best is None or cost < best[0]:
+                    best = (cost, params)
+            candidates.append(best)
+        costs = np.array([c for c, _ in candidates])
+        # valleys of the scan, best first: a scan point no costlier than its neighbours
+        valleys = [
+            k
+            for k in range(len(costs))
+            if costs[k] <= costs[max(k - 1, 0)] and costs[k] <= costs[min(k + 1, len(costs) - 1)]
+        ]
+        valleys.sort(key=lambda k: costs[k])
+        return [candidates[k][1] for k in valleys[:PERIOD_STARTS]]
+
+    def stripe_starts(
+        self, effects: frozenset[str], items: np.ndarray, nested: Fit | None
+    ) -> list[dict[str, float]]:
+        """Start values of a stripe model's fit: read from the data, scanned over the period or over the pulse's
+        share of the stripe, and the ``nested`` model's fit (selection's warm start), if it has a stripe."""
+        tone = {p.name: p.init for p in self.param_specs(effects) if p.name in TONE_PARAMS}
+        data = self.initial_stripe(items, tone)
+        if "stripe_period" in effects:
+            # the scan only picks starting points: run once per model (on the items of its first fit, which
+            # selection draws from the fit split), then reused by the other folds
+            if effects not in self._period_starts:
+                self._period_starts[effects] = self.period_starts(data, items)
+            starts = list(self._period_starts[effects])
+        else:
+            # the stripe is a trapezoid: a plateau |on - exposure| rows long between ramps min(on, exposure) rows
+            # long, so the two durations trade against each other and a local search keeps the split it starts
+            # from (seen: a single-stripe fit 20% costlier than the same stripe reached from another split)
+            lit = data["on_share"] + data["exposure_share"]
+            starts = [
+                {**data, "on_share": share * lit, "exposure_share": (1.0 - share) * lit}
+                for share in ON_SHARES_OF_STRIPE
+            ]
+        if nested is not None and "exposure_overlap" in nested.effects:
+            params = nested.params
+            if TONE_EFFECTS & effects != TONE_EFFECTS & nested.effects:
+                # colour gains measured in other units (light decoded by another curve): only the stripe's geometry
+                params = {
+                    k: v for k, v in params.items() if not k.startswith("peak_") and k not in TONE_PARAMS
+                }
+            starts.insert(0, {**starts[0], **params})
+        return starts
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         if "exposure_overlap" not in effects:
@@ -175,18 +314,11 @@ class StripFrames(LatentFrameProblem):
             )
             return self.with_noise(Fit(effects, params), items)
         specs = self.param_specs(effects)
-        starts = [self.initial_stripe(items)]
-        if "stripe_period" in effects:
-            shares = (0.25, 0.4, 0.6)
-            starts = [{**starts[0], "period_share": share} for share in shares]
-        if start is not None and "exposure_overlap" in start.effects:
-            starts.insert(0, {**starts[0], **start.params})
-        rounds = 2
         if start is not None and start.effects == effects:
-            starts, rounds = (
-                [start.params],
-                1,
-            )  # a refit of the same model (bootstrap draws): from its estimate
+            # a refit of the same model (bootstrap draws): from its estimate
+            starts, rounds = [start.params], 1
+        else:
+            starts, rounds = self.stripe_starts(effects, items, start), 2
         best: tuple[float, dict] | None = None
         for params in starts:
             for _ in range(rounds):  # alternate: phases given the stripe, stripe given the phases
@@ -226,7 +358,8 @@ class StripFrames(LatentFrameProblem):
 
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserColorStrip`` options: the colour split of the fitted light; with ``exposure_overlap`` the
-        rolling-shutter model on a 720-row frame (frame time 1 s scaled away: only shares of the frame matter)."""
+        rolling-shutter model on a 720-row frame (frame time 1 s scaled away: only shares of the frame matter),
+        composed in the light ``sensor_gamma``'s power law decodes."""
         p = fit.params
         if "exposure_overlap" not in fit.effects:
             total = p["strength_r"] + p["strength_g"] + p["strength_b"]
@@ -246,6 +379,9 @@ class StripFrames(LatentFrameProblem):
             "exposure_s": p["exposure_share"],
             "row_time_s": 1.0 / 720,
             "frame_rows": 720,
+            # the transform knows power laws only: a fitted shoulder gives it the closest one
+            **({"gamma": p["gamma"]} if "sensor_gamma" in fit.effects else {}),
+            **({"gamma": equivalent_power_gamma(p)} if "tone_shoulder" in fit.effects else {}),
         }
 
     def derived(self, fit: Fit) -> dict:

@@ -1,0 +1,52 @@
+"""Laser colour strip frame model: the period scan and the tone curves the stripe's light adds under
+(calibration/frame_models/laser_color_strip.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from lerobot_phantom.calibration.frame_models.common import Pair
+from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
+
+HEIGHT, WIDTH = 48, 32
+STRIPE = {"peak_r": 0.35, "peak_g": 0.08, "peak_b": 0.04, "on_share": 0.08, "exposure_share": 0.05}
+
+
+def stripe_pairs(seed: int, period: float, n: int = 8) -> list[Pair]:
+    """Frames lit by the model's own periodic stripes at a random pulse phase, plus read noise."""
+    rng = np.random.default_rng(seed)
+    params = {**STRIPE, "period_share": period}
+    gains = torch.tensor([STRIPE[f"peak_{c}"] for c in "rgb"], dtype=torch.float64).reshape(3, 1, 1)
+    pairs = []
+    for i in range(n):
+        clean = torch.from_numpy(rng.uniform(0.1, 0.6, (3, HEIGHT, WIDTH)))
+        intensity = float(rng.uniform(0.6, 1.0))
+        phase = rng.uniform(0, period * HEIGHT)
+        light = StripFrames.row_light(params, HEIGHT, torch.tensor([phase], dtype=torch.float64))[0]
+        attacked = clean + intensity * gains * light.reshape(1, -1, 1)
+        noise = torch.from_numpy(rng.normal(0.0, 0.004, clean.shape))
+        pairs.append(Pair(f"pair_{i}", clean, (attacked + noise).clamp(0.0, 1.0), None, intensity))
+    return pairs
+
+
+@pytest.mark.parametrize("period", [0.34, 0.47])
+def test_the_period_scan_starts_in_the_planted_periods_valley(period):
+    """The registered cost is many-valleyed in the period; the scan's best start must lie in the planted one, and
+    the fit from it must recover the period."""
+    problem = StripFrames(stripe_pairs(3, period), seed=0)
+    items = np.arange(problem.n_items)
+    starts = problem.period_starts(problem.initial_stripe(items, {}), items)
+    assert starts[0]["period_share"] == pytest.approx(period, rel=0.06)
+    fit = problem.fit(frozenset({"exposure_overlap", "stripe_period"}), items)
+    assert fit.params["period_share"] == pytest.approx(period, rel=0.02)
+
+
+@pytest.mark.parametrize("tone", [{}, {"gamma": 2.2}, {"shoulder": 30.0, "shoulder_exponent": 1.5}])
+def test_the_stripes_tone_curves_invert(tone):
+    encoded = torch.linspace(0.01, 1.0, 200, dtype=torch.float64)
+    linear = StripFrames.decode(tone, encoded)
+    assert torch.allclose(StripFrames.encode(tone, linear), encoded, atol=1e-9)
+    # the light saturates at the sensor's full well: white stays white however much is added
+    assert torch.allclose(StripFrames.encode(tone, linear + 5.0), torch.ones_like(encoded))
