@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 import torch
 
+from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
 
@@ -41,6 +42,18 @@ def test_the_period_scan_starts_in_the_planted_periods_valley(period):
     assert starts[0]["period_share"] == pytest.approx(period, rel=0.06)
     fit = problem.fit(frozenset({"exposure_overlap", "stripe_period"}), items)
     assert fit.params["period_share"] == pytest.approx(period, rel=0.02)
+
+
+def test_a_period_longer_than_the_frame_is_not_named_a_period():
+    problem = StripFrames(stripe_pairs(3, 0.4), seed=0)
+    items = np.arange(problem.n_items)
+    effects = frozenset({"exposure_overlap", "stripe_period"})
+    fit = problem.fit(effects, items)
+    assert problem.identification_checks("stripe_period", fit, items) == []
+    longer = Fit(effects, {**fit.params, "period_share": 1.4})
+    (reason,) = problem.identification_checks("stripe_period", longer, items)
+    assert "longer than the frame" in reason
+    assert problem.identification_checks("exposure_overlap", longer, items) == []
 
 
 @pytest.mark.parametrize("tone", [{}, {"gamma": 2.2}, {"shoulder": 30.0, "shoulder_exponent": 1.5}])

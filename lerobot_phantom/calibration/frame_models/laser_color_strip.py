@@ -356,6 +356,19 @@ class StripFrames(LatentFrameProblem):
         fit.extra["noise_variance"] = self.noise_variance(fit, items)
         return fit
 
+    def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
+        """A pulse period names a repetition: the stripe must come back inside the frame. Fitted longer than the
+        frame, it shows no frame a second stripe; what it fits then is how often a frame holds no stripe at all (a
+        pulse falling between two frames' readouts, seen on the independent simulator's single-stripe case), which
+        is not a period."""
+        period = fit.params.get("period_share")
+        if effect != "stripe_period" or period is None or period < 1.0:
+            return []
+        return [
+            f"the fitted period ({period:.3g} frame heights) is longer than the frame: no frame shows the stripe "
+            "repeat (it fits how often a pulse misses the frame's readout)"
+        ]
+
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserColorStrip`` options: the colour split of the fitted light; with ``exposure_overlap`` the
         rolling-shutter model on a 720-row frame (frame time 1 s scaled away: only shares of the frame matter),
