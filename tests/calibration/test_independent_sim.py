@@ -437,8 +437,9 @@ def test_case(name, root):
     "2860931351 (one inner fold), "
     "projection_crosstalk on filmic cameras (albedo; 4 of 5 on eight fresh seeds in session 18, after the shoulder "
     "was offered to light projection: projection effect cases 20 -> 23 of 32), projection_clipping (the clip "
-    "gains under the margin), strip_period on some draws (its gain interval over 6 fit pairs spans 1; session 22, "
-    "master seed 3042280278). Session 22: projection_sensor_gamma 22 -> 24 of 24 on fresh seeds (a shouldered "
+    "gains under the margin), strip_period until session 25 (7 of 13 master seeds, all misses on filmic cameras; "
+    "13 of 13 once the stripe's light adds under the camera's tone curve and its period starts from a scan: "
+    "docs/bench/camsim_session25.md). Session 22: projection_sensor_gamma 22 -> 24 of 24 on fresh seeds (a shouldered "
     "curve implies the gamma encoding; a richer form that fails gives way to the simpler one). "
     "History and measurements: the README, 'Tested against an independent camera simulator', and "
     "docs/bench/camsim_session*.md",
