@@ -25,10 +25,13 @@ docs/bench/camsim_session12.md, camsim_session18.md).
 
 from __future__ import annotations
 
+from functools import partial
+
 import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import Param
+from lerobot_phantom.transforms import physics
 
 # x ** n at x = 0 has an undefined derivative in n (0 * log 0); the darkest modelled light is one part in 1e12
 TINY = 1e-12
@@ -79,3 +82,14 @@ def implied_gamma_statistic(effect: str, implied: str, params: dict[str, float])
             f"no statistic for {implied} implied by {effect}; valid: sensor_gamma by tone_shoulder"
         )
     return "equivalent_gamma", equivalent_power_gamma(params, params.get("gamma")), 1.0
+
+
+def decode_encode(params: dict, shoulder: bool, gamma):
+    """(decode, encode) between pixel values and linear light, clipped at the sensor's full well: the fitted
+    shoulder of ``params`` under the display gamma ``gamma`` when ``shoulder``, else ``physics``' power law of
+    exponent ``gamma`` (None: sRGB; 1: the encoded values themselves)."""
+    if shoulder:
+        return partial(shoulder_decode, params=params, gamma=gamma), partial(
+            shoulder_encode, params=params, gamma=gamma
+        )
+    return partial(physics.decode, gamma=gamma), partial(physics.encode, gamma=gamma)

@@ -59,7 +59,8 @@ def test_a_period_longer_than_the_frame_is_not_named_a_period():
 @pytest.mark.parametrize("tone", [{}, {"gamma": 2.2}, {"shoulder": 30.0, "shoulder_exponent": 1.5}])
 def test_the_stripes_tone_curves_invert(tone):
     encoded = torch.linspace(0.01, 1.0, 200, dtype=torch.float64)
-    linear = StripFrames.decode(tone, encoded)
-    assert torch.allclose(StripFrames.encode(tone, linear), encoded, atol=1e-9)
+    decode, encode = StripFrames.tone(tone)
+    linear = decode(encoded)
+    assert torch.allclose(encode(linear), encoded, atol=1e-9)
     # the light saturates at the sensor's full well: white stays white however much is added
-    assert torch.allclose(StripFrames.encode(tone, linear + 5.0), torch.ones_like(encoded))
+    assert torch.allclose(encode(linear + 5.0), torch.ones_like(encoded))

@@ -44,7 +44,6 @@ average, as centre-weighted meters do when the spot is central).
 from __future__ import annotations
 
 import logging
-from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -55,9 +54,8 @@ from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, Pair, PixelProblem, flat_pixels
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
+    decode_encode,
     equivalent_power_gamma,
-    shoulder_decode,
-    shoulder_encode,
 )
 from lerobot_phantom.transforms import physics
 
@@ -427,12 +425,7 @@ class BlindingFrames(PixelProblem):
     def tone_curve(cls, effects, params):
         """(decode, encode) between pixel values and the light the model composes: the fitted log-logistic
         shoulder (``calibration/tone.py``, the convention the noise model reads), else a power law or sRGB."""
-        gamma = cls.tone(effects, params)
-        if "tone_shoulder" in effects:
-            return partial(shoulder_decode, params=params, gamma=gamma), partial(
-                shoulder_encode, params=params, gamma=gamma
-            )
-        return partial(physics.decode, gamma=gamma), partial(physics.encode, gamma=gamma)
+        return decode_encode(params, "tone_shoulder" in effects, cls.tone(effects, params))
 
     def compose(self, effects, params, f, decode) -> torch.Tensor:
         """Scene plus laser light (linear in the tone curve ``decode`` inverts), before exposure changes and

@@ -12,10 +12,9 @@ from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squar
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, LatentFrameProblem, Pair
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
+    decode_encode,
     equivalent_power_gamma,
     implied_gamma_statistic,
-    shoulder_decode,
-    shoulder_encode,
 )
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.laser_color_strip import band_rows, strip_profile
@@ -157,25 +156,19 @@ class StripFrames(LatentFrameProblem):
         return torch.stack([torch.as_tensor(params[f"peak_{c}"], dtype=torch.float64) for c in "rgb"])
 
     @staticmethod
-    def decode(params, encoded: torch.Tensor) -> torch.Tensor:
-        """Pixel values -> the light the stripe adds to: through the fitted shoulder, the ``sensor_gamma`` power
-        law, or none (the encoded values)."""
-        if "shoulder" in params:
-            return shoulder_decode(encoded, params)
-        return physics.decode(encoded, params.get("gamma", 1.0))
-
-    @staticmethod
-    def encode(params, linear: torch.Tensor) -> torch.Tensor:
-        """Inverse of ``decode``; light beyond the sensor's full well is clipped first."""
-        if "shoulder" in params:
-            return shoulder_encode(linear, params)
-        return physics.encode(linear, params.get("gamma", 1.0))
+    def tone(params):
+        """(decode, encode) between pixel values and the light the stripe adds to: the fitted shoulder, the
+        ``sensor_gamma`` power law, or the encoded values themselves; light beyond the full well is clipped."""
+        return decode_encode(
+            params, "shoulder" in params, None if "shoulder" in params else params.get("gamma", 1.0)
+        )
 
     def predict_stripe(self, params, index: int, phase_rows) -> torch.Tensor:
         pair = self.pairs[index]
         light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
-        return self.encode(params, self.decode(params, pair.clean) + added)
+        decode, encode = self.tone(params)
+        return encode(decode(pair.clean) + added)
 
     def phase_costs(self, params, index: int) -> tuple[torch.Tensor, np.ndarray]:
         """(pulse phases in rows, SSE of pair ``index`` for each): every stripe position, a row apart."""
@@ -190,8 +183,8 @@ class StripFrames(LatentFrameProblem):
         with torch.no_grad():
             light = self.row_light(params, height, phases)  # (P, H)
             gains = pair.intensity * self.stripe_gains(params).reshape(1, 3, 1, 1)
-            linear = self.decode(params, pair.clean).unsqueeze(0)
-            predicted = self.encode(params, linear + gains * light[:, None, :, None])
+            decode, encode = self.tone(params)
+            predicted = encode(decode(pair.clean).unsqueeze(0) + gains * light[:, None, :, None])
             cost = ((predicted - pair.attacked.unsqueeze(0)) ** 2).sum(dim=(1, 2, 3))
         return phases, cost.numpy()
 
@@ -217,11 +210,12 @@ class StripFrames(LatentFrameProblem):
 
     def initial_stripe(self, items: np.ndarray, tone: dict[str, float]) -> dict[str, float]:
         """Start values read from the data: the brightest row's colour and the lit band's height, in the light
-        the tone curve ``tone`` (its start parameters, ``decode``) decodes."""
+        the tone curve ``tone`` (its start parameters) decodes."""
+        decode, _ = self.tone(tone)
         peaks, widths = [], []
         for i in items:
             pair = self.pairs[int(i)]
-            added = self.decode(tone, pair.attacked) - self.decode(tone, pair.clean)
+            added = decode(pair.attacked) - decode(pair.clean)
             rows = added.mean(dim=2) / max(pair.intensity, 1e-3)  # (3, H)
             total = rows.sum(0)
             peaks.append(rows[:, int(torch.argmax(total))].clamp(min=0.0).numpy())
@@ -288,7 +282,7 @@ class StripFrames(LatentFrameProblem):
         else:
             # the stripe is a trapezoid: a plateau |on - exposure| rows long between ramps min(on, exposure) rows
             # long, so the two durations trade against each other and a local search keeps the split it starts
-            # from (seen: a single-stripe fit 20% costlier than the same stripe reached from another split)
+            # from (docs/bench/camsim_session25.md, cause 3)
             lit = data["on_share"] + data["exposure_share"]
             starts = [
                 {**data, "on_share": share * lit, "exposure_share": (1.0 - share) * lit}
