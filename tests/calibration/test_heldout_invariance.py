@@ -42,29 +42,64 @@ def scores(report: dict) -> tuple[float, float]:
     return report["base"]["heldout_rmse"], report["extended"]["heldout_rmse"]
 
 
-def test_altering_heldout_frames_changes_scores_but_no_fit(tmp_path):
+IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
+N_PAIRS = 7  # two held out
+# one planted effect per attack, so selection and identification have something to decide; the kit's seeds of
+# test_hidden_effects.py, where each is named
+ATTACKS = [
+    pytest.param("laser_blinding", {"linear_light_saturation"}, 11, marks=pytest.mark.slow),
+    pytest.param("light_projection", {"additive_light"}, 21, marks=pytest.mark.slow),
+    pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=pytest.mark.slow),
+    ("em_color_strip", {"bayer_phase_flip"}, 41),
+    ("em_truncation", {"free_band_position"}, 51),
+    pytest.param("laser_color_strip", {"exposure_overlap"}, 62, marks=pytest.mark.slow),
+]
+
+
+def alter_heldout_files(folder: Path, heldout: np.ndarray, rng: np.random.Generator) -> int:
+    """Replace every image that only held-out pairs use (attacked frames, clean frames, patterns) by noise of its
+    own shape; returns how many were replaced. A file a fit pair also uses is left alone."""
+    table = pd.read_csv(folder / "pairs.csv")
+    images = [c for c in table.columns if table[c].astype(str).str.lower().str.endswith(IMAGE_SUFFIXES).all()]
+    heldout_rows = table.index.isin(heldout)
+    fit_files = set(table.loc[~heldout_rows, images].to_numpy().ravel())
+    altered = sorted(set(table.loc[heldout_rows, images].to_numpy().ravel()) - fit_files)
+    for name in altered:
+        path = folder / name
+        shape = np.asarray(Image.open(path)).shape
+        Image.fromarray(rng.integers(0, 256, shape, dtype=np.uint8)).save(path)
+    return len(altered)
+
+
+@pytest.mark.parametrize(("attack", "effects", "kit_seed"), ATTACKS)
+def test_altering_heldout_frames_changes_scores_but_no_fit(tmp_path, attack, effects, kit_seed):
     measured = tmp_path / "measured"
     measured.mkdir()
-    kit.render_em_truncation(measured, {"free_band_position"}, seed=51)
+    kit.RENDERERS[attack](measured, effects, seed=kit_seed, n_pairs=N_PAIRS)
     seed = 5
 
     def run(folder, name):
+        # few pairs, folds and bootstrap draws: whether a fit can see held-out items does not depend on how many
+        # there are, and each attack is calibrated twice
         return calibrate(
             CalibrateConfig(
-                attack="em_truncation", measured=str(folder), out=str(tmp_path / f"out_{name}"), seed=seed
+                attack=attack,
+                measured=str(folder),
+                out=str(tmp_path / f"out_{name}"),
+                seed=seed,
+                folds=2,
+                bootstrap=4,
             )
         )
 
     original = run(measured, "original")
+    assert original["selection"][
+        "selected"
+    ]  # selection had an effect to take, so it had something to leak into
     altered = tmp_path / "altered"
     shutil.copytree(measured, altered)
-    table = pd.read_csv(altered / "pairs.csv")
-    _, heldout = seeded_split(len(table), 0.2, seed)
-    rng = np.random.default_rng(0)
-    for i in heldout:
-        path = altered / table["attacked"][i]
-        shape = np.asarray(Image.open(path)).shape
-        Image.fromarray(rng.integers(0, 256, shape, dtype=np.uint8)).save(path)
+    _, heldout = seeded_split(len(pd.read_csv(altered / "pairs.csv")), 0.2, seed)
+    assert alter_heldout_files(altered, heldout, np.random.default_rng(0)) >= len(heldout)
     changed = run(altered, "altered")
     assert fitted_part(changed) == fitted_part(original)
     assert scores(changed) != scores(original)  # the alteration did reach the held-out scores
@@ -93,5 +128,80 @@ def test_altering_heldout_table_rows_of_the_shared_triples_changes_no_fit(tmp_pa
         )
 
     original, changed = run(source, "original"), run(altered_path, "altered")
+    assert fitted_part(changed) == fitted_part(original)
+    assert scores(changed) != scores(original)
+
+
+@pytest.mark.slow
+def test_altering_heldout_rows_of_a_stripe_table_changes_no_fit(tmp_path):
+    from test_stripes import draw_camera, write_table
+
+    rng = np.random.default_rng(7)
+    camera = draw_camera(rng, "lit")
+    source = tmp_path / "stripes.csv"
+    write_table(source, camera, rng, n_rows=40, frames=30, style="exposure_us")
+    table = pd.read_csv(source)
+    seed = 3
+    _, heldout = seeded_split(len(table), 0.2, seed)
+    altered = table.copy()
+    altered.loc[heldout, "affected_rows_mean"] = rng.uniform(0, camera["height"], len(heldout))
+    altered_path = tmp_path / "altered.csv"
+    altered.to_csv(altered_path, index=False)
+
+    def run(path, name):
+        return calibrate(
+            CalibrateConfig(
+                attack="laser_color_strip",
+                measured=str(path),
+                out=str(tmp_path / f"out_{name}"),
+                seed=seed,
+                image_height=camera["height"],
+                folds=2,
+                bootstrap=4,
+            )
+        )
+
+    original, changed = run(source, "original"), run(altered_path, "altered")
+    assert original["selection"]["selected"]
+    assert fitted_part(changed) == fitted_part(original)
+    assert scores(changed) != scores(original)
+
+
+@pytest.mark.slow
+def test_altering_heldout_tiles_of_a_laser_capture_changes_no_fit(tmp_path):
+    from lerobot_phantom.calibration.captures import CaptureProblem
+
+    rng = np.random.default_rng(8)
+    size = 64  # under --capture-max-side, so the capture's tiles are the file's own 8x8 blocks
+    ys, xs = np.mgrid[0:size, 0:size]
+    r = np.hypot(xs - 31.4, ys - 34.2)
+    profile = np.exp(-0.5 * (r / 3.0) ** 2) + 0.05 * (1 + r / 3.0) ** -2.0
+    source = tmp_path / "laser.png"
+    kit.save(source, kit.srgb_encode(np.array([60.0, 3.0, 1.5]) * profile[..., None] + 0.01), rng)
+    tile = CaptureProblem.tile
+    seed = 4
+    _, heldout = seeded_split((size // tile) ** 2, 0.2, seed)
+    pixels = np.asarray(Image.open(source)).copy()
+    for t in heldout:
+        y, x = divmod(int(t), size // tile)
+        pixels[y * tile : (y + 1) * tile, x * tile : (x + 1) * tile] = rng.integers(0, 256, (tile, tile, 3))
+    altered = tmp_path / "altered" / source.name  # the capture's name is part of its parameters' names
+    altered.parent.mkdir()
+    Image.fromarray(pixels).save(altered)
+
+    def run(path, name):
+        return calibrate(
+            CalibrateConfig(
+                attack="laser_blinding",
+                measured=str(path),
+                out=str(tmp_path / f"out_{name}"),
+                seed=seed,
+                folds=2,
+                bootstrap=4,
+            )
+        )
+
+    original, changed = run(source, "original"), run(altered, "altered")
+    assert original["selection"]["selected"]
     assert fitted_part(changed) == fitted_part(original)
     assert scores(changed) != scores(original)
