@@ -24,10 +24,10 @@ import pandas as pd
 
 from lerobot_phantom._cli import normalize_argv
 from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
-from lerobot_phantom.calibration.core import Problem, fit_chain, forward_select, seeded_split, single_threaded
+from lerobot_phantom.calibration.core import Problem, seeded_split, single_threaded
 from lerobot_phantom.calibration.example import write_example
 from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS, FrameProblem, load_pairs
-from lerobot_phantom.calibration.identify import identify_selection, parameter_intervals
+from lerobot_phantom.calibration.identify import parameter_intervals, select_and_identify
 from lerobot_phantom.calibration.noise import apply_noise_finding, select_shot_noise
 from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
 from lerobot_phantom.calibration.report import build_report, write_outputs
@@ -139,12 +139,8 @@ def calibrate(cfg: CalibrateConfig) -> dict:
         fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
         # selection, fits and parameter intervals see the fit items only; each stage has its own stream, so
         # nothing about the held-out items can change what is fitted or selected
-        _selected, steps = forward_select(
-            problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
-        )
-        chain = fit_chain(problem, steps, fit_items)
-        selection = identify_selection(
-            problem, steps, chain, fit_items, draws=cfg.bootstrap, rng=np.random.default_rng([cfg.seed, 1])
+        steps, chain, selection, withdrawn = select_and_identify(
+            problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds, draws=cfg.bootstrap
         )
         base, extended = chain[0], selection.fit
         base_intervals = parameter_intervals(
@@ -163,6 +159,7 @@ def calibrate(cfg: CalibrateConfig) -> dict:
             margin=cfg.margin,
             folds=cfg.folds,
             draws=cfg.bootstrap,
+            withdrawn=withdrawn,
         )
         if isinstance(problem, FrameProblem):
             # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)

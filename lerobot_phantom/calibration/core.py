@@ -472,8 +472,11 @@ def forward_select(
     margin: float,
     folds: int = 4,
     max_train_items: int = 2500,
+    withdrawn: frozenset[str] = frozenset(),
 ) -> tuple[frozenset[str], list[Step]]:
     """Forward selection of extensions by the inner k-fold validation score, each step needing a ``margin`` gain.
+    ``withdrawn`` effects are not candidates (identify.select_and_identify: an earlier pass selected them and they
+    were not identified).
 
     Only ``fit_items`` are used. Every step keeps each fit item's term of the score, so the effect size of a step
     can be bootstrapped over items (``identify.error_ratio``).
@@ -498,7 +501,7 @@ def forward_select(
     current, parents, per_item = cross_validated(problem, chosen, splits, None)
     steps = [Step([], current, {}, aligned(per_item))]
     while True:
-        open_names = [e.name for e in problem.candidates if e.name not in chosen]
+        open_names = [e.name for e in problem.candidates if e.name not in chosen | withdrawn]
         # new effects -> (score, fold fits, per-item terms), and the name each is reported by (group_label)
         scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
         labels: dict[frozenset[str], str] = {}

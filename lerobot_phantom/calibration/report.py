@@ -11,7 +11,9 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
-  rejected};
+  rejected, withdrawn [{effect, pass, reasons}]: effects an earlier pass selected and identification rejected on
+  their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and ``steps``
+  are the last pass's};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
@@ -30,12 +32,13 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
 
 from lerobot_phantom.calibration.core import SELECTION_SCORES, Fit, Problem, Step
-from lerobot_phantom.calibration.identify import Interval, Selection, error_ratio, rmse_interval
+from lerobot_phantom.calibration.identify import Interval, Selection, Withdrawal, error_ratio, rmse_interval
 from lerobot_phantom.calibration.structure import residual_structure
 
 CALIBRATED_FILE = "calibrated.json"
@@ -86,6 +89,7 @@ def build_report(
     margin: float,
     folds: int,
     draws: int,
+    withdrawn: Sequence[Withdrawal] = (),
 ) -> dict:
     """The report (schema in the module docstring)."""
     extended = selection.fit
@@ -175,7 +179,8 @@ def build_report(
             "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
             "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
             "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
-            "when the interval of its statistic excludes the null value",
+            "when the interval of its statistic excludes the null value; an extension a pass selected and "
+            "identification rejected on its own evidence is withdrawn and selection repeated without it",
             "selected": selection.selected,
             "steps": [
                 {
@@ -187,6 +192,7 @@ def build_report(
                 for s in steps
             ],
             "rejected": dict(steps[-1].tried),
+            "withdrawn": [w.as_dict() for w in withdrawn],
         },
         "unexplained_structure": residual_structure(
             problem,
@@ -361,6 +367,12 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
             + ".",
         ]
     lines += ["", "## Selection", "", report["selection"]["criterion"] + ".", ""]
+    for withdrawal in report["selection"]["withdrawn"]:
+        lines.append(
+            f"- withdrawn after pass {withdrawal['pass']}: `{withdrawal['effect']}`, not identified ("
+            + "; ".join(withdrawal["reasons"])
+            + "); the steps below are the last pass's"
+        )
     for step in report["selection"]["steps"]:
         set_aside = step["set_aside"]
         tried = ", ".join(

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import dataclasses
+import typing
 from pathlib import Path
 
 import numpy as np
 import pytest
 import torch
 
+from lerobot_phantom.calibration import identify as identify_module
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
@@ -26,6 +28,7 @@ from lerobot_phantom.calibration.identify import (
     percentile_interval,
     resample,
     rmse_interval,
+    select_and_identify,
 )
 from lerobot_phantom.calibration.report import build_report, write_markdown
 from lerobot_phantom.transforms import physics
@@ -600,3 +603,92 @@ def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identifi
     assert len(notes) == 1 and notes[0].startswith(
         "peak_b = 0.0028 sits at its low bound, the form's physical limit"
     )
+
+
+class GreedyPowerLaw(Problem):
+    """camsim's blinding auto-exposure case in miniature (master seed 3986568970): a power law alone edges out the
+    meter with linear light by 0.6%, and on all items its exponent runs to its bound; the meter and light are
+    what made the frames. Errors are fixed per model and the same on every item."""
+
+    candidates = (
+        Effect("light", "light adds in linear irradiance"),
+        Effect("meter", "auto-exposure"),
+        Effect("power", "a power-law tone curve"),
+    )
+    errors: typing.ClassVar[dict[str, float]] = {
+        "": 21.0,
+        "light": 30.7,
+        "meter": 20.2,
+        "power": 13.88,
+        "light+meter": 13.96,
+        "light+power": 29.4,
+        "meter+power": 12.8,
+        "light+meter+power": 14.1,
+    }
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def param_specs(self, effects):
+        return [Param("gamma", 2.2, 0.3, 4.0)] if "power" in effects else []
+
+    def fit(self, effects, items, start=None) -> Fit:
+        # the exponent reaches its bound only with every item (the written fit and its bootstrap draws)
+        return Fit(effects, {"gamma": 4.0 if len(items) == 20 else 3.5} if "power" in effects else {})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
+
+
+def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tmp_path):
+    problem = GreedyPowerLaw()
+    items = np.arange(20)
+    steps, chain, selection, withdrawn = select_and_identify(
+        problem, items, seed=0, margin=0.05, folds=4, draws=20
+    )
+    # the first pass took the power law, then the meter on it; the power law failed on its own (at its bound)
+    assert [(w.effect, w.selection_pass) for w in withdrawn] == [("power", 1)]
+    assert any("sits at its high bound 4" in r for r in withdrawn[0].reasons)
+    # the second pass, without it, takes the meter and light together, and both are identified
+    assert selection.selected == ["light", "meter"] and selection.identified == ["light", "meter"]
+    # the pair taken in one step, inside it the better of its two effects alone first
+    assert [s.effects for s in steps] == [[], ["meter"], ["light", "meter"]]
+    assert all("power" not in name for step in steps for name in step.tried)
+    assert chain[-1].effects == {"light", "meter"}
+    report = build_report(
+        problem,
+        input_path=tmp_path,
+        fit_items=items[:16],
+        heldout_items=items[16:],
+        base=chain[0],
+        base_intervals={},
+        selection=selection,
+        steps=steps,
+        seed=0,
+        margin=0.05,
+        folds=4,
+        draws=20,
+        withdrawn=withdrawn,
+    )
+    assert report["selection"]["withdrawn"] == [
+        {"effect": "power", "pass": 1, "reasons": withdrawn[0].reasons}
+    ]
+
+
+def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
+    """``child`` builds on ``parent``, whose rate sits at its bound: ``parent`` is rejected on its own evidence and
+    ``child``, which passes on its own, only with it. Only ``parent`` is withdrawn (without it ``child`` cannot be
+    selected anyway)."""
+
+    class HostAtItsBound(ParentAndChild):
+        def fit(self, effects, items, start=None) -> Fit:
+            names = [p.name for p in self.param_specs(effects)]
+            return Fit(effects, {n: {"rate": 10.0, "threshold": 0.5}[n] for n in names})
+
+    selection = select_parent_and_child(HostAtItsBound(), ONE_AT_A_TIME)
+    reasons = {r["effect"]: r["reasons"] for r in selection.results}
+    assert any("sits at its high bound 10" in r for r in reasons["parent"]), reasons
+    assert reasons["child"] and all(r.startswith("builds on parent") for r in reasons["child"]), reasons
+    rejected = [r["effect"] for r in identify_module.rejected_on_own_evidence(selection)]
+    assert rejected == ["parent"]
