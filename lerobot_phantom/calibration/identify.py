@@ -33,6 +33,11 @@ curve is a gamma encoding too) is judged on the written model by rule 4 alone, o
 (:func:`implied_results`); its effect size is the implying effect's. When the richer of two forms of one term
 (``Effect.excludes``) is not identified, the simpler form that selection scored beside it in the same step is
 judged in its place (:func:`simpler_form_result`): rule 2 on its own scores, rules 3-4 on the refit.
+
+Selection is greedy, so an extension that fails the rule has still shaped every step after the one that took it.
+One that fails on its own evidence (not only because an effect it builds on, or was refitted without, failed) is
+withdrawn, and selection and identification run again without it until a pass withdraws nothing
+(:func:`select_and_identify`; ``selection.withdrawn`` in report.json).
 """
 
 from __future__ import annotations

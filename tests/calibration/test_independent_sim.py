@@ -440,7 +440,10 @@ def test_case(name, root):
     "gains under the margin), strip_period until session 25 (7 of 13 master seeds, all misses on filmic cameras; "
     "13 of 13 once the stripe's light adds under the camera's tone curve and its period starts from a scan: "
     "docs/bench/camsim_session25.md). Session 22: projection_sensor_gamma 22 -> 24 of 24 on fresh seeds (a shouldered "
-    "curve implies the gamma encoding; a richer form that fails gives way to the simpler one). "
+    "curve implies the gamma encoding; a richer form that fails gives way to the simpler one). Session 26: an effect "
+    "identification rejects is withdrawn and selection repeated (blinding_auto_exposure on 3986568970 named); core "
+    "selection on six fresh seeds 61 of 64, projection_crosstalk named on 9 of 9 sRGB and 0 of 3 filmic cameras "
+    "(docs/bench/camsim_session26.md). "
     "History and measurements: the README, 'Tested against an independent camera simulator', and "
     "docs/bench/camsim_session*.md",
     strict=False,
