@@ -526,7 +526,7 @@ def test_a_simpler_form_set_aside_by_selection_or_without_a_gain_takes_no_place(
     assert no_gain.identified == [] and no_gain.fit.effects == frozenset()
 
 
-def report_on_twenty_items(problem, selection, steps) -> dict:
+def report_on_twenty_items(problem, selection, steps, withdrawn=()) -> dict:
     """The report of a selection made on items 0-19, with four held-out items and the base model empty."""
     return build_report(
         problem,
@@ -541,6 +541,7 @@ def report_on_twenty_items(problem, selection, steps) -> dict:
         margin=0.05,
         folds=4,
         draws=20,
+        withdrawn=withdrawn,
     )
 
 
@@ -641,7 +642,7 @@ class GreedyPowerLaw(Problem):
         return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
 
 
-def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tmp_path):
+def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated():
     problem = GreedyPowerLaw()
     items = np.arange(20)
     steps, chain, selection, withdrawn = select_and_identify(
@@ -656,21 +657,7 @@ def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tm
     assert [s.effects for s in steps] == [[], ["meter"], ["light", "meter"]]
     assert all("power" not in name for step in steps for name in step.tried)
     assert chain[-1].effects == {"light", "meter"}
-    report = build_report(
-        problem,
-        input_path=tmp_path,
-        fit_items=items[:16],
-        heldout_items=items[16:],
-        base=chain[0],
-        base_intervals={},
-        selection=selection,
-        steps=steps,
-        seed=0,
-        margin=0.05,
-        folds=4,
-        draws=20,
-        withdrawn=withdrawn,
-    )
+    report = report_on_twenty_items(problem, selection, steps, withdrawn)
     assert report["selection"]["withdrawn"] == [
         {"effect": "power", "pass": 1, "reasons": withdrawn[0].reasons}
     ]
