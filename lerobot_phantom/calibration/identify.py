@@ -44,7 +44,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -63,9 +63,6 @@ from lerobot_phantom.calibration.core import (
 )
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
-# reasons an effect fails because another one did (the start of the reason's text)
-BUILDS_ON = "builds on "
-REFITTED_WITHOUT = "refitted without "
 
 
 @dataclass(frozen=True)
@@ -335,6 +332,9 @@ class Selection:
     results: list[dict]
     fit: Fit  # the model with the identified effects only, fitted on the fit items
     intervals: dict[str, Interval]  # its parameters' intervals
+    # selected effects that failed the rule on their own evidence, not only because an effect they build on or
+    # were refitted without failed (select_and_identify withdraws them)
+    rejected: list[str] = field(default_factory=list)
 
 
 def identify_selection(
@@ -407,6 +407,7 @@ def identify_selection(
             nulls=nulls,
         )
         own[effect] = result
+    rejected = sorted(effect for effect, result in own.items() if not result["identified"])
     results, identified = [], []
     for effect, _before, _after in entries:
         result = own[effect]
@@ -414,7 +415,7 @@ def identify_selection(
         missing = [r for r in requires if r not in identified]
         if missing and result["identified"]:
             result.update(identified=False, status="not identified")
-            result["reasons"].append(f"{BUILDS_ON}{', '.join(missing)}, which is not identified")
+            result["reasons"].append(f"builds on {', '.join(missing)}, which is not identified")
         results.append(result)
         if result["identified"]:
             identified.append(effect)
@@ -430,7 +431,9 @@ def identify_selection(
     kept = frozenset(identified)
     if kept == selected_fit.effects:
         results += implied_results(problem, results, selected_fit, samples)
-        return Selection(sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals)
+        return Selection(
+            sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals, rejected
+        )
     by_effect = {r["effect"]: r for r in results}
     while True:
         # the largest model of the chain inside the kept set starts the refit
@@ -454,7 +457,9 @@ def identify_selection(
                     result["params"] = {p.name: final.params[p.name] for p in specs}
                     result["intervals"] = {p.name: final_intervals[p.name].as_dict() for p in specs}
             results += implied_results(problem, results, final, final_samples)
-            return Selection(sorted(selected_fit.effects), sorted(kept), results, final, final_intervals)
+            return Selection(
+                sorted(selected_fit.effects), sorted(kept), results, final, final_intervals, rejected
+            )
         for effect, reasons in failing.items():
             by_effect[effect].update(identified=False, status="not identified")
             by_effect[effect]["reasons"].extend(reasons)
@@ -462,7 +467,7 @@ def identify_selection(
         for effect in dropped - set(failing):
             by_effect[effect].update(identified=False, status="not identified")
             by_effect[effect]["reasons"].append(
-                f"{BUILDS_ON}{', '.join(sorted(failing))}, which is not identified"
+                f"builds on {', '.join(sorted(failing))}, which is not identified"
             )
         kept = kept - dropped
 
@@ -536,7 +541,7 @@ def refit_reasons(
         {k: v for k, v in problem.null_values(effect).items() if k in fit.params},
         {p.name: p.low_limit for p in specs if p.low_limit},
     )
-    return [f"{REFITTED_WITHOUT}{', '.join(sorted(dropped))}, {reason}" for reason in reasons]
+    return [f"refitted without {', '.join(sorted(dropped))}, {reason}" for reason in reasons]
 
 
 @dataclass
@@ -549,19 +554,6 @@ class Withdrawal:
 
     def as_dict(self) -> dict:
         return {"effect": self.effect, "pass": self.selection_pass, "reasons": list(self.reasons)}
-
-
-def rejected_on_own_evidence(selection: Selection) -> list[dict]:
-    """Results of selected effects that failed for a reason of their own, not only because an effect they build on
-    or were refitted without failed."""
-    return [
-        r
-        for r in selection.results
-        if r["effect"] in selection.selected
-        and not r["identified"]
-        and not r.get("implied_by")
-        and any(not reason.startswith((BUILDS_ON, REFITTED_WITHOUT)) for reason in r["reasons"])
-    ]
 
 
 def select_and_identify(
@@ -595,8 +587,8 @@ def select_and_identify(
         selection = identify_selection(
             problem, steps, chain, fit_items, draws=draws, rng=np.random.default_rng([seed, 1])
         )
-        rejected = rejected_on_own_evidence(selection)
-        if not rejected:
+        if not selection.rejected:
             return steps, chain, selection, withdrawn
         number = 1 + max((w.selection_pass for w in withdrawn), default=0)
-        withdrawn += [Withdrawal(r["effect"], number, list(r["reasons"])) for r in rejected]
+        reasons = {r["effect"]: r["reasons"] for r in selection.results if r["effect"] in selection.rejected}
+        withdrawn += [Withdrawal(effect, number, list(reasons[effect])) for effect in selection.rejected]

@@ -10,7 +10,6 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_phantom.calibration import identify as identify_module
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
@@ -642,7 +641,7 @@ class GreedyPowerLaw(Problem):
         return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
 
 
-def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated():
+def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tmp_path):
     problem = GreedyPowerLaw()
     items = np.arange(20)
     steps, chain, selection, withdrawn = select_and_identify(
@@ -661,6 +660,11 @@ def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated():
     assert report["selection"]["withdrawn"] == [
         {"effect": "power", "pass": 1, "reasons": withdrawn[0].reasons}
     ]
+    write_markdown(report, [], tmp_path / "report.md")
+    assert (
+        "withdrawn after pass 1: `power`, not identified (gamma = 4 sits at its high bound 4)"
+        in (tmp_path / "report.md").read_text()
+    )
 
 
 def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
@@ -677,5 +681,4 @@ def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
     reasons = {r["effect"]: r["reasons"] for r in selection.results}
     assert any("sits at its high bound 10" in r for r in reasons["parent"]), reasons
     assert reasons["child"] and all(r.startswith("builds on parent") for r in reasons["child"]), reasons
-    rejected = [r["effect"] for r in identify_module.rejected_on_own_evidence(selection)]
-    assert rejected == ["parent"]
+    assert selection.rejected == ["parent"]
