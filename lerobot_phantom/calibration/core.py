@@ -492,7 +492,6 @@ def forward_select(
     parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
     of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`)."""
     splits = kfold(fit_items, folds, seed + 1, max_train_items)
-    requires = {e.name: set(e.requires) for e in problem.candidates}
 
     def aligned(per_item: dict[int, float]) -> np.ndarray:
         return np.array([per_item[int(i)] for i in fit_items], np.float64)
@@ -501,48 +500,18 @@ def forward_select(
     current, parents, per_item = cross_validated(problem, chosen, splits, None)
     steps = [Step([], current, {}, aligned(per_item))]
     while True:
-        open_names = [e.name for e in problem.candidates if e.name not in chosen | withdrawn]
-        # new effects -> (score, fold fits, per-item terms), and the name each is reported by (group_label)
-        scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
-        labels: dict[frozenset[str], str] = {}
-        for size in range(1, problem.joint_effects + 1):
-            for members in itertools.combinations(open_names, size):
-                model = chosen | set(members)
-                if any(not requires[e] <= model for e in members) or exclusive(problem.candidates, model):
-                    continue
-                label = group_label(members, chosen, requires)
-                group = frozenset(members)
-                # warm start: the fold fits of the group without its last member (a pair: its first effect's)
-                start = scored.get(frozenset(label[:-1]), (None, parents))[1]
-                scored[group] = cross_validated(problem, model, splits, start)
-                labels[group] = "+".join(label)
+        scored, labels = scored_groups(problem, chosen, withdrawn, splits, parents)
         if not scored:
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
         steps[-1].tried_item_errors = {labels[g]: aligned(v[2]) for g, v in scored.items()}
         set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
         steps[-1].set_aside = {labels[g]: why for g, why in set_aside.items()}
-        eligible = {g: v for g, v in scored.items() if g not in set_aside}
-        best_single = min((g for g in eligible if len(g) == 1), key=lambda g: eligible[g][0], default=None)
-        needed = {}
-        for group in eligible:
-            if len(group) < 2:
-                continue
-            smaller = min((v[0] for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
-            standing = max(1, sum(1 for e in group if not requires[e] & group))
-            needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
-        joint = min(needed, key=lambda g: eligible[g][0] / needed[g], default=None)
-        if joint is not None and scored[joint][0] <= needed[joint]:
-            # the steps inside the group: the order whose every prefix was scored, the best-scoring prefixes first
-            # (a pair: the better of its two effects alone)
-            orders = [
-                [frozenset(order[: k + 1]) for k in range(len(order) - 1)]
-                for order in itertools.permutations(joint)
-            ]
-            inside = min(
-                (o for o in orders if all(p in scored for p in o)), key=lambda o: [scored[p][0] for p in o]
-            )
-            for prefix in inside:
+        eligible = {g: v[0] for g, v in scored.items() if g not in set_aside}
+        joint = joint_group_taken(problem, eligible, current, margin)
+        if joint is not None:
+            # its prefixes may have been set aside alone: they are steps inside it all the same
+            for prefix in steps_inside(joint, {g: v[0] for g, v in scored.items()}):
                 steps.append(
                     Step(
                         sorted(chosen | prefix),
@@ -552,17 +521,71 @@ def forward_select(
                         paired=True,
                     )
                 )
-            chosen = chosen | joint
-            current, parents, per_item = scored[joint]
-            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
-            continue
-        if best_single is not None and scored[best_single][0] <= (1.0 - margin) * current:
-            chosen = chosen | best_single
-            current, parents, per_item = scored[best_single]
-            steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
-            continue
-        break
+            taken = joint
+        else:
+            best_single = min((g for g in eligible if len(g) == 1), key=eligible.get, default=None)
+            if best_single is None or eligible[best_single] > (1.0 - margin) * current:
+                break
+            taken = best_single
+        chosen = chosen | taken
+        current, parents, per_item = scored[taken]
+        steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
     return chosen, steps
+
+
+def scored_groups(
+    problem: Problem,
+    chosen: frozenset[str],
+    withdrawn: frozenset[str],
+    splits,
+    parents: list[Fit],
+) -> tuple[dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]], dict[frozenset[str], str]]:
+    """Every group of up to ``problem.joint_effects`` new effects that is a valid model on top of ``chosen``,
+    cross-validated: new effects -> (score, fold fits, per-item terms), and the name each is reported by
+    (:func:`group_label`)."""
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    open_names = [e.name for e in problem.candidates if e.name not in chosen | withdrawn]
+    scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
+    labels: dict[frozenset[str], str] = {}
+    for size in range(1, problem.joint_effects + 1):
+        for members in itertools.combinations(open_names, size):
+            model = chosen | set(members)
+            if any(not requires[e] <= model for e in members) or exclusive(problem.candidates, model):
+                continue
+            label = group_label(members, chosen, requires)
+            group = frozenset(members)
+            # warm start: the fold fits of the group without its last member (a pair: its first effect's)
+            start = scored.get(frozenset(label[:-1]), (None, parents))[1]
+            scored[group] = cross_validated(problem, model, splits, start)
+            labels[group] = "+".join(label)
+    return scored, labels
+
+
+def joint_group_taken(
+    problem: Problem, eligible: dict[frozenset[str], float], current: float, margin: float
+) -> frozenset[str] | None:
+    """The group of two or more new effects a step takes, or None: the one furthest under what it needs, if it
+    is under it. It needs ``margin`` under the best smaller eligible group and, over the ``current`` score, the
+    margin once per member that stands on its own (one that builds on another member only carries it)."""
+    requires = {e.name: set(e.requires) for e in problem.candidates}
+    needed = {}
+    for group in eligible:
+        if len(group) < 2:
+            continue
+        smaller = min((v for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
+        standing = max(1, sum(1 for e in group if not requires[e] & group))
+        needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
+    joint = min(needed, key=lambda g: eligible[g] / needed[g], default=None)
+    return joint if joint is not None and eligible[joint] <= needed[joint] else None
+
+
+def steps_inside(joint: frozenset[str], scores: dict[frozenset[str], float]) -> list[frozenset[str]]:
+    """The steps inside a group taken at once: the order whose every prefix was scored, the best-scoring prefixes
+    first (a pair: the better of its two effects alone)."""
+    orders = [
+        [frozenset(order[: k + 1]) for k in range(len(order) - 1)] for order in itertools.permutations(joint)
+    ]
+    return min((o for o in orders if all(p in scores for p in o)), key=lambda o: [scores[p] for p in o])
 
 
 def group_label(members, chosen: frozenset[str], requires: dict[str, set[str]]) -> tuple[str, ...]:

@@ -350,20 +350,64 @@ def identify_selection(
     selected_fit = chain[-1]
     samples = parameter_draws(problem, selected_fit, fit_items, draws=draws, rng=rng)
     intervals = draw_intervals(selected_fit, samples)
-    # (effect, index of the step before it, index of the step with it) in the order selection added them
+    entries = selection_entries(steps)
+    own = own_evidence_results(
+        problem, steps, entries, selected_fit, intervals, fit_items, draws=draws, rng=rng
+    )
+    # taken before the passes below add collateral reasons (an effect it builds on, or a refit without one, failed)
+    rejected = sorted(effect for effect, result in own.items() if not result["identified"])
+    results, identified = requirement_results(problem, entries, own)
+    for effect, before, after in entries:
+        if not own[effect]["identified"]:
+            fallback = simpler_form_result(
+                problem, steps, effect, before, after, identified, draws=draws, rng=rng
+            )
+            if fallback is not None:
+                results.append(fallback)
+                if fallback["identified"]:
+                    identified.append(fallback["effect"])
+    final, final_intervals, final_samples = selected_fit, intervals, samples
+    if frozenset(identified) != selected_fit.effects:
+        final, final_intervals, final_samples = refit_identified(
+            problem, chain, results, frozenset(identified), fit_items, draws=draws, rng=rng
+        )
+    results += implied_results(problem, results, final, final_samples)
+    return Selection(
+        sorted(selected_fit.effects), sorted(final.effects), results, final, final_intervals, rejected
+    )
+
+
+def selection_entries(steps: list[Step]) -> list[tuple[str, int, int]]:
+    """(effect, index of the step before it, index of the step with it) in the order selection added them; the
+    effects of a group taken in one step (interacting, each useless alone) are judged by what they bring together,
+    from the step before the group to the step after it."""
     entries = []
     for k, (before, after) in enumerate(itertools.pairwise(steps)):
         (effect,) = set(after.effects) - set(before.effects)
-        # a group of interacting effects (each useless alone) is judged by what they bring together
         first, last = k, k + 1
         while steps[first].paired:
             first -= 1
         while steps[last].paired:
             last += 1
         entries.append((effect, first, last))
+    return entries
+
+
+def own_evidence_results(
+    problem: Problem,
+    steps: list[Step],
+    entries: list[tuple[str, int, int]],
+    selected_fit: Fit,
+    intervals: Mapping[str, Interval],
+    fit_items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+) -> dict[str, dict]:
+    """Each selected effect's result by the rule on its own evidence: its validation ratio and its own parameters
+    in the selected model. Leaves first: an effect that hosts others (the form their parameters live in) is judged
+    with those of them that pass on their own, because the model without it cannot have them either."""
     own: dict[str, dict] = {}
-    # leaves first: an effect that hosts others (the form their parameters live in) is judged with those of them
-    # that pass on their own, because the model without it cannot have them either
     for effect, before, after in reversed(entries):
         hosted = {d for d in dependants(problem, selected_fit.effects, effect) if own[d]["identified"]}
         if hosted:
@@ -378,12 +422,13 @@ def identify_selection(
                 score=problem.selection_score,
             )
         specs = own_params(problem, selected_fit.effects, effect)
+        params = {p.name: selected_fit.params[p.name] for p in specs}
         nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
         outcome = identify(
             effect,
             selected=True,
             validation_ratio=ratio,
-            params={p.name: selected_fit.params[p.name] for p in specs},
+            params=params,
             bounds={p.name: (p.low, p.high) for p in specs},
             intervals={p.name: intervals[p.name] for p in specs},
             nulls=nulls,
@@ -402,12 +447,19 @@ def identify_selection(
             # the selection steps the ratio compares (an interacting pair: from the step before the pair)
             compared_steps=[before, after],
             judged_with=sorted(hosted),
-            params={p.name: selected_fit.params[p.name] for p in specs},
+            params=params,
             intervals={p.name: intervals[p.name].as_dict() for p in specs},
             nulls=nulls,
         )
         own[effect] = result
-    rejected = sorted(effect for effect, result in own.items() if not result["identified"])
+    return own
+
+
+def requirement_results(
+    problem: Problem, entries: list[tuple[str, int, int]], own: dict[str, dict]
+) -> tuple[list[dict], list[str]]:
+    """The results in selection order, an effect that builds on one not identified failing with it, and the
+    identified effects."""
     results, identified = [], []
     for effect, _before, _after in entries:
         result = own[effect]
@@ -419,21 +471,24 @@ def identify_selection(
         results.append(result)
         if result["identified"]:
             identified.append(effect)
-    for effect, before, after in entries:
-        if not own[effect]["identified"]:
-            fallback = simpler_form_result(
-                problem, steps, effect, before, after, identified, draws=draws, rng=rng
-            )
-            if fallback is not None:
-                results.append(fallback)
-                if fallback["identified"]:
-                    identified.append(fallback["effect"])
-    kept = frozenset(identified)
-    if kept == selected_fit.effects:
-        results += implied_results(problem, results, selected_fit, samples)
-        return Selection(
-            sorted(selected_fit.effects), sorted(kept), results, selected_fit, intervals, rejected
-        )
+    return results, identified
+
+
+def refit_identified(
+    problem: Problem,
+    chain: list[Fit],
+    results: list[dict],
+    kept: frozenset[str],
+    fit_items: np.ndarray,
+    *,
+    draws: int,
+    rng: np.random.Generator,
+) -> tuple[Fit, dict[str, Interval], list[dict[str, float]]]:
+    """The model with the identified effects only, refitted on the fit items, with its parameters' intervals and
+    draws. Its own parameters are held to rules 3 and 4 too: without a dropped effect, one that passed may fall to
+    its null (a meter that only balanced a glare, refitted without the glare). An effect that fails, and those that
+    build on it, are marked in ``results`` and dropped, and the rest refitted until none fails."""
+    selected_effects = chain[-1].effects
     by_effect = {r["effect"]: r for r in results}
     while True:
         # the largest model of the chain inside the kept set starts the refit
@@ -441,14 +496,10 @@ def identify_selection(
         final = start if start.effects == kept else problem.fit(kept, fit_items, start)
         final_samples = parameter_draws(problem, final, fit_items, draws=draws, rng=rng)
         final_intervals = draw_intervals(final, final_samples)
-        # the written model's own parameters are held to rules 3 and 4 too: without a dropped effect, one that
-        # passed may fall to its null (a meter that only balanced a glare, refitted without the glare)
         failing = {
             effect: reasons
             for effect in sorted(kept)
-            if (
-                reasons := refit_reasons(problem, final, final_intervals, effect, selected_fit.effects - kept)
-            )
+            if (reasons := refit_reasons(problem, final, final_intervals, effect, selected_effects - kept))
         }
         if not failing:
             for result in results:
@@ -456,10 +507,7 @@ def identify_selection(
                     specs = own_params(problem, final.effects, result["effect"])
                     result["params"] = {p.name: final.params[p.name] for p in specs}
                     result["intervals"] = {p.name: final_intervals[p.name].as_dict() for p in specs}
-            results += implied_results(problem, results, final, final_samples)
-            return Selection(
-                sorted(selected_fit.effects), sorted(kept), results, final, final_intervals, rejected
-            )
+            return final, final_intervals, final_samples
         for effect, reasons in failing.items():
             by_effect[effect].update(identified=False, status="not identified")
             by_effect[effect]["reasons"].extend(reasons)
@@ -566,13 +614,10 @@ def select_and_identify(
     draws: int,
 ) -> tuple[list[Step], list[Fit], Selection, list[Withdrawal]]:
     """Forward selection and identification, repeated without the effects identification rejects on their own
-    evidence until a pass rejects none: (steps, chain, selection) of the last pass and what was withdrawn.
-
-    Selection is greedy, so an effect taken early shapes every later step. One that is then not identified (a
-    tone exponent run to the end of its range, say) has spent a step the physical effects needed: on camsim's
-    blinding auto-exposure case (master seed 3986568970) a power law at its bound 4 beat the meter with linear
-    light by 0.6% at the first step, and linear light no longer paid after it. Each pass sees the fit items only
-    and has the same seeds, so a pass that withdraws nothing is the single pass of before."""
+    evidence (the module docstring says why) until a pass rejects none: (steps, chain, selection) of the last pass
+    and what was withdrawn. Each pass sees the fit items only and has the same seeds, so a pass that withdraws
+    nothing is the single pass of before. Measured case: camsim's blinding auto-exposure (master seed 3986568970),
+    where a power law at its bound 4 beat the meter with linear light by 0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
     while True:
         _selected, steps = forward_select(

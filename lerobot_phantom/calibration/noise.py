@@ -47,6 +47,7 @@ never as an effect of the written (mean) model.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
 import numpy as np
@@ -229,18 +230,9 @@ def select_shot_noise(
     def joined(items) -> NoiseSample:
         return NoiseSample.join([samples[int(i)] for i in items])
 
-    validation = {"read": 0.0, "shot": 0.0}
-    count = 0
-    for train, val in kfold(fit_items, folds, seed + 1):
-        trained, scored = joined(train), joined(val)
-        if len(trained.residual) == 0 or len(scored.residual) == 0:
-            continue
-        for name in validation:
-            validation[name] += mean_nll(scored, fit_variance(trained, name == "shot")) * len(scored.residual)
-        count += len(scored.residual)
-    if count == 0:
+    validation_ratio = validation_noise_scale_ratio(joined, fit_items, folds=folds, seed=seed)
+    if validation_ratio is None:
         return {"kept": False, "reasons": ["no unclipped pixels to judge the noise by"]}
-    validation_ratio = math.exp((validation["read"] - validation["shot"]) / count)
     fitted, heldout = joined(fit_items), joined(heldout_items)
     curve = tone_curve(fit)
     without, with_shot = fit_variance(fitted, False), fit_variance(fitted, True)
@@ -254,6 +246,60 @@ def select_shot_noise(
     intervals: dict[str, Interval] = bootstrap(
         statistic, np.asarray(fit_items), draws=draws, rng=np.random.default_rng([seed, 4])
     )
+    reasons, curve_fails = shot_noise_reasons(validation_ratio, intervals, curve)
+    return {
+        "kept": not reasons,
+        "status": "identified" if not reasons else "not identifiable" if curve_fails else "not identified",
+        "reasons": reasons,
+        "criterion": "Gaussian likelihood of the residuals with variance quantisation + detail D + J^2 (read^2 + "
+        f"shot x) in linear light (J: tone-curve slope, D: local 3x3 variance) vs shot = 0, {folds}-fold "
+        "validation on the fit pairs; named if the validation noise-scale ratio exp(NLL gain) is above 1, the "
+        f"{100 * intervals['shot'].level:.0f}% bootstrap interval of shot (over fit pairs) excludes 0 and photon "
+        f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance",
+        "tone_curve": tone_curve_name(curve),
+        "validation_noise_scale_ratio": validation_ratio,
+        "heldout_noise_scale_ratio": heldout_ratio,
+        "shot_share": intervals["share"].as_dict(),
+        "variance_trend": intervals["trend"].as_dict(),
+        "constant": {"read_noise_grey": 255.0 * math.sqrt(without["read_var"])},
+        # linear-light grey levels (linear light x 255): read noise sd, shot variance per grey level of signal
+        "shot_noise": {
+            "read_noise_grey": 255.0 * math.sqrt(with_shot["read_var"]),
+            "shot_gain_grey": 255.0 * with_shot["shot"],
+            "detail_gain": with_shot["detail"],
+        },
+        "intervals": {
+            "read_noise_grey": _scaled(intervals["read_var"], lambda v: 255.0 * math.sqrt(max(v, 0.0))),
+            "shot_gain_grey": _scaled(intervals["shot"], lambda v: 255.0 * v),
+        },
+        "residual_vs_signal": binned_rmse(255.0 * heldout.signal, heldout.residual),
+    }
+
+
+def validation_noise_scale_ratio(
+    joined: Callable[[np.ndarray], NoiseSample], fit_items: np.ndarray, *, folds: int, seed: int
+) -> float | None:
+    """exp(mean NLL without photon noise - with it) over k-fold validation pairs of the fit items; None when no
+    fold has unclipped pixels on both sides."""
+    validation = {"read": 0.0, "shot": 0.0}
+    count = 0
+    for train, val in kfold(fit_items, folds, seed + 1):
+        trained, scored = joined(train), joined(val)
+        if len(trained.residual) == 0 or len(scored.residual) == 0:
+            continue
+        for name in validation:
+            validation[name] += mean_nll(scored, fit_variance(trained, name == "shot")) * len(scored.residual)
+        count += len(scored.residual)
+    if count == 0:
+        return None
+    return math.exp((validation["read"] - validation["shot"]) / count)
+
+
+def shot_noise_reasons(
+    validation_ratio: float, intervals: Mapping[str, Interval], curve: float | dict | None
+) -> tuple[list[str], bool]:
+    """Why ``shot_noise`` is not named (the module docstring's conditions 1-4), and whether the tone curve is the
+    reason (condition 4: then it is not identifiable rather than absent)."""
     reasons = []
     if not validation_ratio > 1.0:
         reasons.append(
@@ -284,33 +330,7 @@ def select_shot_noise(
             f"photon noise is {intervals['share'].estimate:.0%} of the residual's modelled variance (named from "
             f"{SHOT_SHARE:.0%}): present, but not what the residual mostly is"
         )
-    return {
-        "kept": not reasons,
-        "status": "identified" if not reasons else "not identifiable" if curve_fails else "not identified",
-        "reasons": reasons,
-        "criterion": "Gaussian likelihood of the residuals with variance quantisation + detail D + J^2 (read^2 + "
-        f"shot x) in linear light (J: tone-curve slope, D: local 3x3 variance) vs shot = 0, {folds}-fold "
-        "validation on the fit pairs; named if the validation noise-scale ratio exp(NLL gain) is above 1, the "
-        f"{100 * intervals['shot'].level:.0f}% bootstrap interval of shot (over fit pairs) excludes 0 and photon "
-        f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance",
-        "tone_curve": tone_curve_name(curve),
-        "validation_noise_scale_ratio": validation_ratio,
-        "heldout_noise_scale_ratio": heldout_ratio,
-        "shot_share": intervals["share"].as_dict(),
-        "variance_trend": intervals["trend"].as_dict(),
-        "constant": {"read_noise_grey": 255.0 * math.sqrt(without["read_var"])},
-        # linear-light grey levels (linear light x 255): read noise sd, shot variance per grey level of signal
-        "shot_noise": {
-            "read_noise_grey": 255.0 * math.sqrt(with_shot["read_var"]),
-            "shot_gain_grey": 255.0 * with_shot["shot"],
-            "detail_gain": with_shot["detail"],
-        },
-        "intervals": {
-            "read_noise_grey": _scaled(intervals["read_var"], lambda v: 255.0 * math.sqrt(max(v, 0.0))),
-            "shot_gain_grey": _scaled(intervals["shot"], lambda v: 255.0 * v),
-        },
-        "residual_vs_signal": binned_rmse(255.0 * heldout.signal, heldout.residual),
-    }
+    return reasons, curve_fails
 
 
 def _scaled(interval: Interval, f) -> dict:

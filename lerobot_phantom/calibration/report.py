@@ -97,44 +97,11 @@ def build_report(
     base_scores, base_squared = heldout_scores(problem, base, heldout_items, draws=max(draws, 200), rng=rng)
     ext_scores, ext_squared = heldout_scores(problem, extended, heldout_items, draws=max(draws, 200), rng=rng)
     ratio = error_ratio(base_squared, ext_squared, draws=max(draws, 200), rng=rng)
-    causes = {e.name: e.cause for e in problem.candidates}
-    score_name = SELECTION_SCORES[problem.selection_score]
-    findings = []
-    for result in selection.results:
-        if not result["identified"]:
-            continue
-        effect = result["effect"]
-        before, step = (steps[k] for k in result["compared_steps"])
-        hosted = result.get("judged_with", [])
-        implying, replaced = result.get("implied_by"), result.get("in_place_of")
-        # a pair taken in one selection step (or effects selected between it and those it hosts) are in the
-        # ratio too: the evidence names them
-        together = sorted(set(step.effects) - set(before.effects) - {effect, replaced} - set(hosted))
-        interval = result["validation_ratio"]
-        # a simpler form in place of a richer one that is not identified: the score its own group had in that step
-        after = result["scored"]["validation_error"] if replaced else step.validation_error
-        evidence = (
-            (f"the fitted form of {implying}, identified with " if implying else "")
-            + (f"in place of {replaced} (not identified), the same term's simpler form, " if replaced else "")
-            + f"inner validation {score_name} {before.validation_error:.3g} -> {after:.3g} "
-            f"{problem.units} "
-            + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
-            + (f"together with {', '.join(together)}, in the same comparison " if together else "")
-            + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
-            f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
-        )
-        if result["intervals"]:
-            evidence += "; " + ", ".join(
-                f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
-                for k, v in result["intervals"].items()
-            )
-        if result.get("notes"):
-            evidence += "; " + "; ".join(result["notes"])
-        # the base's residual on the fit items; an implied cause has no term of its own to add to the base
-        detail = None if implying else problem.evidence(effect, base, extended, fit_items)
-        if detail:
-            evidence += "; " + detail
-        findings.append({"effect": effect, "cause": causes[effect], "evidence": evidence})
+    findings = [
+        finding(problem, result, steps, base, extended, fit_items)
+        for result in selection.results
+        if result["identified"]
+    ]
     report = {
         "attack": problem.attack,
         "input": {"path": str(input_path), "kind": problem.input_kind},
@@ -165,35 +132,7 @@ def build_report(
             "rmse_reduction": 1.0 - ext_scores["heldout_rmse"] / max(base_scores["heldout_rmse"], 1e-12),
             "selection_margin": margin,
         },
-        "selection": {
-            "score": score_name,
-            "criterion": f"forward selection on the fit items by {folds}-fold cross-validated {score_name}"
-            + (f" ({problem.selection_score_reason})" if problem.selection_score != "rmse" else "")
-            + "; each kept "
-            f"extension must lower it by >= {100 * margin:.0f}% (a group of up to {problem.joint_effects} "
-            f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
-            f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group; a group is set "
-            "aside when a member's own parameter sits at a bound of its range in most folds, and the richer of two "
-            f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one); then each kept "
-            "extension must pass the identification rule "
-            "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
-            "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
-            "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
-            "when the interval of its statistic excludes the null value; an extension a pass selected and "
-            "identification rejected on its own evidence is withdrawn and selection repeated without it",
-            "selected": selection.selected,
-            "steps": [
-                {
-                    "effects": s.effects,
-                    "validation_error": s.validation_error,
-                    "tried": s.tried,
-                    "set_aside": s.set_aside,
-                }
-                for s in steps
-            ],
-            "rejected": dict(steps[-1].tried),
-            "withdrawn": [w.as_dict() for w in withdrawn],
-        },
+        "selection": selection_section(problem, selection, steps, withdrawn, margin=margin, folds=folds),
         "unexplained_structure": residual_structure(
             problem,
             extended,
@@ -212,6 +151,88 @@ def build_report(
             "extended": problem.per_capture_rmse(extended, heldout_items),
         }
     return _clean(report)
+
+
+def finding(problem: Problem, result: dict, steps: list[Step], base: Fit, extended: Fit, fit_items) -> dict:
+    """An identified effect's entry in ``findings``: its cause, and the evidence that names it."""
+    effect = result["effect"]
+    before, step = (steps[k] for k in result["compared_steps"])
+    hosted = result.get("judged_with", [])
+    implying, replaced = result.get("implied_by"), result.get("in_place_of")
+    # a pair taken in one selection step (or effects selected between it and those it hosts) are in the ratio too:
+    # the evidence names them
+    together = sorted(set(step.effects) - set(before.effects) - {effect, replaced} - set(hosted))
+    interval = result["validation_ratio"]
+    # a simpler form in place of a richer one that is not identified: the score its own group had in that step
+    after = result["scored"]["validation_error"] if replaced else step.validation_error
+    evidence = (
+        (f"the fitted form of {implying}, identified with " if implying else "")
+        + (f"in place of {replaced} (not identified), the same term's simpler form, " if replaced else "")
+        + f"inner validation {SELECTION_SCORES[problem.selection_score]} {before.validation_error:.3g} -> "
+        f"{after:.3g} {problem.units} "
+        + (f"with the effects it hosts ({', '.join(hosted)}) " if hosted else "")
+        + (f"together with {', '.join(together)}, in the same comparison " if together else "")
+        + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
+        f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
+    )
+    if result["intervals"]:
+        evidence += "; " + ", ".join(
+            f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
+            for k, v in result["intervals"].items()
+        )
+    if result.get("notes"):
+        evidence += "; " + "; ".join(result["notes"])
+    # the base's residual on the fit items; an implied cause has no term of its own to add to the base
+    detail = None if implying else problem.evidence(effect, base, extended, fit_items)
+    if detail:
+        evidence += "; " + detail
+    cause = next(e.cause for e in problem.candidates if e.name == effect)
+    return {"effect": effect, "cause": cause, "evidence": evidence}
+
+
+def selection_section(
+    problem: Problem,
+    selection: Selection,
+    steps: list[Step],
+    withdrawn: Sequence[Withdrawal],
+    *,
+    margin: float,
+    folds: int,
+) -> dict:
+    """report.json's ``selection``: the criterion in words, the last pass's steps and what was withdrawn."""
+    score_name = SELECTION_SCORES[problem.selection_score]
+    criterion = (
+        f"forward selection on the fit items by {folds}-fold cross-validated {score_name}"
+        + (f" ({problem.selection_score_reason})" if problem.selection_score != "rmse" else "")
+        + "; each kept "
+        f"extension must lower it by >= {100 * margin:.0f}% (a group of up to {problem.joint_effects} "
+        f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
+        f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group; a group is set "
+        "aside when a member's own parameter sits at a bound of its range in most folds, and the richer of two "
+        f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one); then each kept "
+        "extension must pass the identification rule "
+        "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
+        "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
+        "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
+        "when the interval of its statistic excludes the null value; an extension a pass selected and "
+        "identification rejected on its own evidence is withdrawn and selection repeated without it"
+    )
+    return {
+        "score": score_name,
+        "criterion": criterion,
+        "selected": selection.selected,
+        "steps": [
+            {
+                "effects": s.effects,
+                "validation_error": s.validation_error,
+                "tried": s.tried,
+                "set_aside": s.set_aside,
+            }
+            for s in steps
+        ],
+        "rejected": dict(steps[-1].tried),
+        "withdrawn": [w.as_dict() for w in withdrawn],
+    }
 
 
 def calibrated_payload(problem: Problem, extended: Fit, report: dict) -> dict:
@@ -260,9 +281,25 @@ def plot_analysis(report: dict, out_dir: Path) -> list[str]:
 
 
 def write_markdown(report: dict, figures: list[str], path: Path) -> None:
+    lines = (
+        _problem_lines(report)
+        + _cause_lines(report)
+        + _structure_lines(report["unexplained_structure"])
+        + _extended_lines(report)
+        + (_noise_lines(report["noise"]) if "criterion" in report.get("noise", {}) else [])
+        + _selection_lines(report["selection"])
+        + ["", "## Figures", ""]
+        + [f"![{name}]({name})" for name in figures]
+        + [""]
+    )
+    path.write_text("\n".join(lines))
+
+
+def _problem_lines(report: dict) -> list[str]:
+    """The input, the split, and the base model's held-out error."""
     units = report["units"]
-    base, ext, gain = report["base"], report["extended"], report["gain"]
-    lines = [
+    base, ext = report["base"], report["extended"]
+    return [
         f"# Calibration of `{report['attack']}` against measured data",
         "",
         f"Input: `{report['input']['path']}` ({report['input']['kind']}); {report['n_fit']} {report['split']['items']} "
@@ -285,6 +322,11 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         ),
         "",
     ]
+
+
+def _cause_lines(report: dict) -> list[str]:
+    """The named causes with their evidence, then the selected effects that were not identified and why."""
+    lines = []
     if report["findings"]:
         lines.append("Named causes (selected on the fit items and identified by the rule below):")
         lines.append("")
@@ -304,16 +346,18 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         lines += [
             f"- `{r['effect']}`, implied by `{r['implied_by']}`: " + "; ".join(r["reasons"]) for r in implied
         ]
-    structure = report["unexplained_structure"]
-    lines += [
-        "",
-        "## Unexplained structure",
-        "",
-        structure["summary"] + ".",
-        "",
-        f"Rule: {structure['rule']}.",
-    ]
-    lines += [
+    return lines
+
+
+def _structure_lines(structure: dict) -> list[str]:
+    return ["", "## Unexplained structure", "", structure["summary"] + ".", "", f"Rule: {structure['rule']}."]
+
+
+def _extended_lines(report: dict) -> list[str]:
+    """The written model, its held-out error against the base's, its parameters and derived quantities."""
+    units = report["units"]
+    base, ext, gain = report["base"], report["extended"], report["gain"]
+    lines = [
         "",
         "## Extended model and gain",
         "",
@@ -342,51 +386,55 @@ def write_markdown(report: dict, figures: list[str], path: Path) -> None:
         per = report["per_capture_heldout_rmse"]
         for name, value in per["base"].items():
             lines.append(f"| {name} | {value:.2f} | {per['extended'][name]:.2f} |")
-    if "noise" in report and "criterion" in report["noise"]:
-        noise = report["noise"]
-        lines += [
-            "",
-            "## Noise model (`shot_noise`)",
-            "",
-            "Noise cannot be predicted pixel by pixel and never lowers an RMSE, so `shot_noise` is judged as a "
-            "model of the residual's distribution instead: " + noise["criterion"] + ". "
-            f"Inner validation noise-scale ratio {noise['validation_noise_scale_ratio']:.3f}, held out "
-            f"{noise['heldout_noise_scale_ratio']:.3f}: "
-            + ("kept" if noise["kept"] else "not kept (" + "; ".join(noise["reasons"]) + ")")
-            + f". Tone curve that linearises the frames: {noise['tone_curve']}. Fitted, in linear-light grey "
-            "levels (linear light x 255, before the tone curve): read noise "
-            f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
-            "(variance per unit of signal). Held-out residual RMSE (output grey levels) vs predicted signal "
-            "(linear-light grey levels): "
-            + ", ".join(
-                f"{x:.0f}: {r:.2f}"
-                for x, r in zip(
-                    noise["residual_vs_signal"]["x"], noise["residual_vs_signal"]["rmse"], strict=True
-                )
+    return lines
+
+
+def _noise_lines(noise: dict) -> list[str]:
+    """The noise model's verdict and fit (noise.py)."""
+    return [
+        "",
+        "## Noise model (`shot_noise`)",
+        "",
+        "Noise cannot be predicted pixel by pixel and never lowers an RMSE, so `shot_noise` is judged as a "
+        "model of the residual's distribution instead: " + noise["criterion"] + ". "
+        f"Inner validation noise-scale ratio {noise['validation_noise_scale_ratio']:.3f}, held out "
+        f"{noise['heldout_noise_scale_ratio']:.3f}: "
+        + ("kept" if noise["kept"] else "not kept (" + "; ".join(noise["reasons"]) + ")")
+        + f". Tone curve that linearises the frames: {noise['tone_curve']}. Fitted, in linear-light grey "
+        "levels (linear light x 255, before the tone curve): read noise "
+        f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
+        "(variance per unit of signal). Held-out residual RMSE (output grey levels) vs predicted signal "
+        "(linear-light grey levels): "
+        + ", ".join(
+            f"{x:.0f}: {r:.2f}"
+            for x, r in zip(
+                noise["residual_vs_signal"]["x"], noise["residual_vs_signal"]["rmse"], strict=True
             )
-            + ".",
-        ]
-    lines += ["", "## Selection", "", report["selection"]["criterion"] + ".", ""]
-    for withdrawal in report["selection"]["withdrawn"]:
+        )
+        + ".",
+    ]
+
+
+def _selection_lines(selection: dict) -> list[str]:
+    """The criterion, what was withdrawn, and every step with the candidates it tried."""
+    lines = ["", "## Selection", "", selection["criterion"] + ".", ""]
+    for withdrawal in selection["withdrawn"]:
         lines.append(
             f"- withdrawn after pass {withdrawal['pass']}: `{withdrawal['effect']}`, not identified ("
             + "; ".join(withdrawal["reasons"])
             + "); the steps below are the last pass's"
         )
-    for step in report["selection"]["steps"]:
+    for step in selection["steps"]:
         set_aside = step["set_aside"]
         tried = ", ".join(
             f"{k}: {v:.3g}" + (f" (not eligible: {set_aside[k]})" if k in set_aside else "")
             for k, v in step["tried"].items()
         )
         lines.append(
-            f"- {step['effects'] or ['base']}: validation {report['selection']['score']} "
+            f"- {step['effects'] or ['base']}: validation {selection['score']} "
             f"{step['validation_error']:.3g}" + (f"; candidates tried next: {tried}" if tried else "")
         )
-    lines += ["", "## Figures", ""]
-    lines += [f"![{name}]({name})" for name in figures]
-    lines.append("")
-    path.write_text("\n".join(lines))
+    return lines
 
 
 def _interval(interval: dict | None) -> str:

@@ -129,7 +129,35 @@ def read_stripe_table(
             f"{path}: the table mixes cameras {sorted(map(str, table['camera'].unique()))}; camera parameters "
             "(row time, threshold) differ per camera, so calibrate one camera per table"
         )
-    sources = {}
+    sources: dict[str, str] = {}
+    exposure, data_unit = _exposure_values_and_unit(path, table, exposure_unit_s, sources)
+    image_height = _image_height(path, table, image_height, sources)
+    frequency_hz = _frequencies_hz(table["frequency"])
+    duty = np.array([_value_and_unit(v, "duty_cycle")[0] for v in table["duty_cycle"]]) / 100.0
+    sources["frequency"] = "Hz (unit written in the values, or plain numbers read as Hz)"
+    sources["duty_cycle"] = "percent of the laser period"
+    rows = table["affected_rows_mean"].to_numpy(dtype=np.float64)
+    if (frequency_hz <= 0).any() or not np.isfinite(rows).all() or ((duty <= 0) | (duty > 1)).any():
+        raise ValueError(
+            f"{path}: frequencies must be positive, duty cycles in (0, 100] and row counts finite"
+        )
+    meta = {
+        "frequency_hz": frequency_hz,
+        "duty": duty,
+        "exposure_s": exposure * data_unit,
+        "exposure_setting": exposure,
+        "rows": rows,
+        "image_height": int(image_height),
+        "sources": sources,
+    }
+    return table, meta
+
+
+def _exposure_values_and_unit(
+    path: Path, table: pd.DataFrame, exposure_unit_s: float | None, sources: dict[str, str]
+) -> tuple[np.ndarray, float]:
+    """The exposure settings and seconds per unit: from the column's name, the values' written units, or
+    ``--exposure-unit-s``, whichever states it (two that disagree are an error); records the source."""
     named = [c for c in EXPOSURE_COLUMN_UNITS if c in table.columns]
     found = [*named, *(["exposure"] if "exposure" in table.columns else [])]
     if len(found) > 1:
@@ -159,6 +187,12 @@ def read_stripe_table(
             f"{path}: --exposure-unit-s {exposure_unit_s} contradicts the table ({sources['exposure']}: "
             f"{data_unit} s per unit); drop the flag"
         )
+    return exposure, data_unit
+
+
+def _image_height(path: Path, table: pd.DataFrame, image_height: int | None, sources: dict[str, str]) -> int:
+    """The frame height in rows: from an image_height column or ``--image-height`` (one that contradicts the
+    other is an error); records the source."""
     heights = [c for c in HEIGHT_COLUMNS if c in table.columns]
     if heights:
         values = table[heights[0]].unique()
@@ -181,25 +215,7 @@ def read_stripe_table(
         sources["image_height"] = "--image-height"
     if image_height <= 0:
         raise ValueError(f"--image-height must be positive, got {image_height}")
-    frequency_hz = _frequencies_hz(table["frequency"])
-    duty = np.array([_value_and_unit(v, "duty_cycle")[0] for v in table["duty_cycle"]]) / 100.0
-    sources["frequency"] = "Hz (unit written in the values, or plain numbers read as Hz)"
-    sources["duty_cycle"] = "percent of the laser period"
-    rows = table["affected_rows_mean"].to_numpy(dtype=np.float64)
-    if (frequency_hz <= 0).any() or not np.isfinite(rows).all() or ((duty <= 0) | (duty > 1)).any():
-        raise ValueError(
-            f"{path}: frequencies must be positive, duty cycles in (0, 100] and row counts finite"
-        )
-    meta = {
-        "frequency_hz": frequency_hz,
-        "duty": duty,
-        "exposure_s": exposure * data_unit,
-        "exposure_setting": exposure,
-        "rows": rows,
-        "image_height": int(image_height),
-        "sources": sources,
-    }
-    return table, meta
+    return int(image_height)
 
 
 class StripeProblem(Problem):

@@ -26,6 +26,7 @@ structure is left and where; it never names a library effect.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -94,13 +95,25 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
     if sample is None or not sample.residual:
         out["summary"] = "not tested (this input has no residual sample)"
         return out
-    index = np.arange(len(sample.residual))
     residual_all = np.concatenate(sample.residual)
     mean_square = float(np.mean(residual_all**2))
 
     def share_of_base(statistic: float) -> float:
         return statistic * mean_square / max(base_mse, 1e-300)
 
+    out["tests"] = dependence_tests(sample, share_of_base, rng) + neighbour_tests(sample, share_of_base, rng)
+    found = [t for t in out["tests"] if t["significant"]]
+    out["structure_remains"] = bool(found)
+    out["summary"] = structure_summary(found)
+    return out
+
+
+def dependence_tests(
+    sample: ResidualSample, share_of_base: Callable[[float], float], rng: np.random.Generator
+) -> list[dict]:
+    """Per covariate: the share of the residual variance its binned mean explains, against the permutation null."""
+    residual_all = np.concatenate(sample.residual)
+    index = np.arange(len(sample.residual))
     values = {name: np.concatenate(per_item) for name, per_item in sample.covariates.items()}
     bins = {name: bin_index(v, BINS)[0] for name, v in values.items()}
     # one permutation of the residuals scores every variable: row j of null_shares is one draw of chance for all
@@ -111,10 +124,11 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
         null_shares[j] = [explained_share(permuted, b, total) for b in bins.values()]
     quantile = 1.0 - FAMILY_ALPHA / max(len(bins), 1)
     starts = np.concatenate([[0], np.cumsum([len(r) for r in sample.residual])])
+    tests = []
     for column, (name, values_all) in enumerate(values.items()):
         bins_all = bins[name]
 
-        def statistic(chosen, bins_all=bins_all, values_all=values_all, starts=starts):
+        def statistic(chosen, bins_all=bins_all, values_all=values_all):
             take = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in chosen])
             return {
                 "eta2": explained_share(residual_all[take], bins_all[take]),
@@ -128,7 +142,7 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
         significant = (
             eta.low > max(MIN_EXPLAINED, chance) and share_of_base(eta.estimate) >= MIN_SHARE_OF_BASE
         )
-        out["tests"].append(
+        tests.append(
             {
                 "variable": name,
                 "statistic": "eta2",
@@ -143,6 +157,14 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
                 "where": _where(values_all, residual_all, bins_all),
             }
         )
+    return tests
+
+
+def neighbour_tests(
+    sample: ResidualSample, share_of_base: Callable[[float], float], rng: np.random.Generator
+) -> list[dict]:
+    """Per direction with neighbour pairs: the correlation of residuals ``LAG`` values apart (smooth structure)."""
+    tests = []
     for name, pairs in sample.neighbours.items():
 
         def lag_statistic(chosen, pairs=pairs):
@@ -151,7 +173,7 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
             return {"r": _correlation(a, b)}
 
         r = bootstrap(lag_statistic, np.arange(len(pairs)), draws=DRAWS, rng=rng)["r"]
-        out["tests"].append(
+        tests.append(
             {
                 "variable": name,
                 "statistic": f"lag-{LAG} correlation",
@@ -162,17 +184,17 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
                 "where": f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
             }
         )
-    found = [t for t in out["tests"] if t["significant"]]
-    out["structure_remains"] = bool(found)
-    if found:
-        out["summary"] = "unexplained structure: " + "; ".join(
-            f"residual {'depends on ' + t['variable'] if t['statistic'] == 'eta2' else 'is smooth: ' + t['where']} "
-            f"({t['statistic']} {t['value']:.3f}, 90% interval "
-            f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}"
-            + (f", r = {t['r']['estimate']:+.2f}" if "r" in t else "")
-            + (f"; {t['where']})" if t["statistic"] == "eta2" else ")")
-            for t in found
-        )
-    else:
-        out["summary"] = "no structure left in the held-out residual by the stated rule"
-    return out
+    return tests
+
+
+def structure_summary(found: list[dict]) -> str:
+    if not found:
+        return "no structure left in the held-out residual by the stated rule"
+    return "unexplained structure: " + "; ".join(
+        f"residual {'depends on ' + t['variable'] if t['statistic'] == 'eta2' else 'is smooth: ' + t['where']} "
+        f"({t['statistic']} {t['value']:.3f}, 90% interval "
+        f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}"
+        + (f", r = {t['r']['estimate']:+.2f}" if "r" in t else "")
+        + (f"; {t['where']})" if t["statistic"] == "eta2" else ")")
+        for t in found
+    )
