@@ -171,19 +171,7 @@ def collect(cfg: CollectConfig) -> CollectResult:
     from lerobot_phantom.envs.experts import scripted_expert
     from lerobot_phantom.envs.table_env import make_phantom_env
 
-    if cfg.episodes < 1:
-        raise ValueError("--episodes must be at least 1")
-    if not 0.0 <= cfg.action_noise <= 1.0:
-        raise ValueError(f"--action-noise must be in [0, 1] (relative std), got {cfg.action_noise}")
-    if not 0.0 <= cfg.grasp_miss_rate <= 1.0:
-        raise ValueError(
-            f"--grasp-miss-rate must be in [0, 1] (a share of episodes), got {cfg.grasp_miss_rate}"
-        )
-    if not 0.0 < cfg.grasp_miss_min_m <= cfg.grasp_miss_max_m:
-        raise ValueError(
-            "--grasp-miss-min-m and --grasp-miss-max-m must satisfy 0 < min <= max (metres), got "
-            f"{cfg.grasp_miss_min_m} and {cfg.grasp_miss_max_m}"
-        )
+    _check_config(cfg)
     plan = _task_plan(cfg)
     repo_id = cfg.repo_id or f"local/phantom_{cfg.suite}"
     root = Path(cfg.root) if cfg.root is not None else HF_LEROBOT_HOME / repo_id
@@ -218,26 +206,9 @@ def collect(cfg: CollectConfig) -> CollectResult:
                     env = make_phantom_env(suite, image_size=cfg.image_size)
                     envs[suite] = (env, scripted_expert(env))
                 env, expert = envs[suite]
-                while True:
-                    episode_seed = int(rng.integers(2**31 - 1))
-                    # its own stream, so that a dataset without misses is the one collected before they existed
-                    miss_offset = grasp_miss_offset(
-                        np.random.default_rng([episode_seed, 1]),
-                        cfg.grasp_miss_rate,
-                        cfg.grasp_miss_min_m,
-                        cfg.grasp_miss_max_m,
-                    )
-                    success, length = _record_episode(
-                        env, expert, episode_seed, task_id, dataset, cfg.action_noise, miss_offset
-                    )
-                    if success:
-                        break
-                    dataset.clear_episode_buffer()
-                    failed += 1
-                    if failed > cfg.max_failed_attempts:
-                        raise RuntimeError(
-                            f"the scripted expert failed {failed} times (last: suite {suite}, task {task_id})"
-                        )
+                length, failed = _record_until_success(
+                    env, expert, rng, cfg, dataset, suite=suite, task_id=task_id, failed=failed
+                )
                 dataset.save_episode(parallel_encoding=False)
                 frames += length
                 bar.update(1)
@@ -248,6 +219,57 @@ def collect(cfg: CollectConfig) -> CollectResult:
         for env, _ in envs.values():
             env.close()
     return CollectResult(root, repo_id, cfg.episodes, frames, failed, time.perf_counter() - start)
+
+
+def _check_config(cfg: CollectConfig) -> None:
+    if cfg.episodes < 1:
+        raise ValueError("--episodes must be at least 1")
+    if not 0.0 <= cfg.action_noise <= 1.0:
+        raise ValueError(f"--action-noise must be in [0, 1] (relative std), got {cfg.action_noise}")
+    if not 0.0 <= cfg.grasp_miss_rate <= 1.0:
+        raise ValueError(
+            f"--grasp-miss-rate must be in [0, 1] (a share of episodes), got {cfg.grasp_miss_rate}"
+        )
+    if not 0.0 < cfg.grasp_miss_min_m <= cfg.grasp_miss_max_m:
+        raise ValueError(
+            "--grasp-miss-min-m and --grasp-miss-max-m must satisfy 0 < min <= max (metres), got "
+            f"{cfg.grasp_miss_min_m} and {cfg.grasp_miss_max_m}"
+        )
+
+
+def _record_until_success(
+    env,
+    expert,
+    rng: np.random.Generator,
+    cfg: CollectConfig,
+    dataset,
+    *,
+    suite: str,
+    task_id: int,
+    failed: int,
+) -> tuple[int, int]:
+    """Record episodes of ``task_id`` (fresh episode seeds from ``rng``) until the expert succeeds, dropping the
+    failed ones from the dataset's buffer: (length of the successful episode, failed attempts so far)."""
+    while True:
+        episode_seed = int(rng.integers(2**31 - 1))
+        # its own stream, so that a dataset without misses is the one collected before they existed
+        miss_offset = grasp_miss_offset(
+            np.random.default_rng([episode_seed, 1]),
+            cfg.grasp_miss_rate,
+            cfg.grasp_miss_min_m,
+            cfg.grasp_miss_max_m,
+        )
+        success, length = _record_episode(
+            env, expert, episode_seed, task_id, dataset, cfg.action_noise, miss_offset
+        )
+        if success:
+            return length, failed
+        dataset.clear_episode_buffer()
+        failed += 1
+        if failed > cfg.max_failed_attempts:
+            raise RuntimeError(
+                f"the scripted expert failed {failed} times (last: suite {suite}, task {task_id})"
+            )
 
 
 _BARE_FLAGS = ("video", "overwrite", "progress")

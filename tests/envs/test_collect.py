@@ -3,6 +3,7 @@ import pytest
 from lerobot.datasets.lerobot_dataset import LeRobotDataset
 
 from lerobot_phantom.envs import SUITES
+from lerobot_phantom.envs import collect as collect_module
 from lerobot_phantom.envs.collect import CollectConfig, collect, main, normalize_argv
 
 REPO_ID = "local/phantom_test"
@@ -54,6 +55,30 @@ def test_collection_is_deterministic_for_a_seed(goal_dataset, tmp_path):
         == np.asarray(third["observation.state"])[0].tolist()
     )
     assert first["action"] != third["action"]  # another seed, other layouts
+
+
+def test_a_failed_rollout_is_dropped_and_retried_with_a_new_seed(tmp_path, monkeypatch):
+    """The expert's failures never reach the dataset: the failed rollout's frames are cleared from the episode
+    buffer, the task is tried again, and the attempts past ``max_failed_attempts`` stop the collection."""
+    recorded = collect_module._record_episode
+    calls = []
+
+    def first_attempt_fails(env, expert, seed, *args, **kwargs):
+        success, length = recorded(env, expert, seed, *args, **kwargs)
+        calls.append(seed)
+        return (success and len(calls) > 1), length
+
+    monkeypatch.setattr(collect_module, "_record_episode", first_attempt_fails)
+    result = _collect(tmp_path / "retried", seed=3)
+    assert result.failed_attempts == 1 and len(calls) == 3
+    assert calls[0] != calls[1]  # the retry is a new episode, not the failed one again
+    dataset = LeRobotDataset(REPO_ID, root=result.root)
+    assert dataset.num_episodes == 2
+    assert dataset.num_frames == result.frames  # no frame of the failed rollout was saved
+
+    monkeypatch.setattr(collect_module, "_record_episode", lambda *args, **kwargs: (False, 1))
+    with pytest.raises(RuntimeError, match=r"failed 3 times \(last: suite goal, task 0\)"):
+        _collect(tmp_path / "hopeless", max_failed_attempts=2)
 
 
 def test_refuses_to_overwrite_unless_told(goal_dataset, tmp_path):
