@@ -247,8 +247,9 @@ def parameter_checks(
 def parameter_draws(
     problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
 ) -> list[dict[str, float]]:
-    """The parameters of ``fit``'s model refitted on ``draws`` resamples of the fit ``items``, each refit
-    warm-started from ``fit`` (the estimate)."""
+    """The parameters of ``fit``'s model refitted on ``draws`` resamples of the fit ``items``, each refit started
+    from ``fit`` (the estimate); a problem whose fit searches several starting points searches them again (a
+    stripe table's row-time regimes), so a draw may leave the estimate's local minimum as the estimator would."""
     return [problem.fit(fit.effects, resample(items, rng), start=fit).params for _ in range(draws)]
 
 

@@ -325,6 +325,30 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
     )
 
 
+@pytest.mark.parametrize("factor", [0.5, 2.0, 4.0])
+def test_a_bootstrap_refit_searches_the_regimes_again(tmp_path, factor):
+    """A bootstrap refit starts from the estimate. Started in another stripe-count regime (the row time a factor
+    off), it must reach the regime that fits the rows, as the estimator's own search does: refits kept in the
+    start's regime made the row time's interval that regime's width (the Logitech table: 47.8-48.9 us, where a
+    4x readout fits as well)."""
+    rng = np.random.default_rng([SEED, 5])
+    camera = draw_camera(rng, "interior")
+    table = tmp_path / "table.csv"
+    write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
+    items = np.arange(problem.n_items)
+    effects = frozenset({"exposure_overlap", "integration_offset"})
+    estimate = problem.fit(effects, items)
+    moved = {**estimate.params, "row_time_s": estimate.params["row_time_s"] * factor}
+    refit = problem.fit(effects, items, start=Fit(effects, moved, dict(estimate.extra)))
+
+    def rmse(fit):
+        return float(np.sqrt(np.mean(problem.residual(fit, items) ** 2)))
+
+    about = f"{camera_summary(camera)}\nestimate {estimate.params} {rmse(estimate):.2f} rows, refit {refit.params}"
+    assert rmse(refit) <= 1.02 * rmse(estimate) + 0.1, about
+
+
 # -- a second camera, end to end ---------------------------------------------------------------------------------
 @pytest.mark.slow
 @pytest.mark.parametrize(
