@@ -3,7 +3,7 @@
 Usage: ``python docs/bench/calibration_shared_data.py MEASURED_DIR OUT_JSON [--note TEXT]``
 (MEASURED_DIR: ``../shared/measured``, third-party data that is not in this repository). Each input is calibrated
 by the console script in a subprocess (seed 0, 20% held out, the CLI's defaults) into a scratch directory; the
-JSON keeps the fitted numbers and scores of each ``report.json`` and the run's user CPU seconds (the children's
+JSON keeps the fitted numbers (with their intervals since session 27) and scores of each ``report.json`` and the run's user CPU seconds (the children's
 ``getrusage``, as ``/usr/bin/time`` reports them). Refuses to overwrite OUT_JSON.
 """
 
@@ -38,6 +38,7 @@ def summarise(report: dict) -> dict:
         "named_causes": sorted(report["extended"]["effects"]),
         "not_identified": sorted(r["effect"] for r in report["identification"] if not r["identified"]),
         "extended_params": report["extended"]["params"],
+        "extended_param_intervals": report["extended"]["param_intervals"],
         "derived": report["extended"].get("derived", {}),
         "unexplained_structure": report["unexplained_structure"]["summary"],
     }
