@@ -3,8 +3,9 @@
 Usage: ``python docs/bench/calibration_shared_data.py MEASURED_DIR OUT_JSON [--note TEXT]``
 (MEASURED_DIR: ``../shared/measured``, third-party data that is not in this repository). Each input is calibrated
 by the console script in a subprocess (seed 0, 20% held out, the CLI's defaults) into a scratch directory; the
-JSON keeps the fitted numbers (with their intervals since session 27) and scores of each ``report.json`` and the run's user CPU seconds (the children's
-``getrusage``, as ``/usr/bin/time`` reports them). Refuses to overwrite OUT_JSON.
+JSON keeps the fitted numbers (with their intervals since session 27) and scores of each ``report.json`` and the
+run's user CPU seconds (the children's ``getrusage``, as ``/usr/bin/time`` reports them). Refuses to overwrite
+OUT_JSON.
 """
 
 from __future__ import annotations

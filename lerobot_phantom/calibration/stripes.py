@@ -314,9 +314,10 @@ class StripeProblem(Problem):
         """Least squares per frame rule (which frames the table averaged; see ``rolling_shutter_rows_lit``),
         keeping the rule with the lower fit error; row time is started from several frame readouts.
 
-        A refit of the same model on resampled rows (a bootstrap draw: ``start`` is the estimate) repeats the search,
-        every frame rule and other stripe-count regimes included, as the estimator did: one started only from the
-        estimate stays in its regime, and the interval then measures that regime's width, not the row time's
+        A refit of the same model on resampled rows (a bootstrap draw: ``start`` is the estimate) keeps the
+        estimate's frame rule, a discrete choice of model like its effects, which intervals are conditional on. It
+        repeats a first fit's search over stripe-count regimes, and starts from the estimate too: one started only
+        from the estimate stays in its regime, and the interval then measures that regime's width, not the row time's
         uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms readout alike; refits
         from the estimate alone gave a row time of 47.8-48.9 us, refits that search 48.0-191 us)."""
         target = torch.as_tensor(self.rows[items])
@@ -335,10 +336,12 @@ class StripeProblem(Problem):
         grid = self.start_grid(specs, first)
         best = None
         # every rule starts from the given values and the grid's best points of distinct row times (five for a
-        # first fit: neighbouring stripe-count regimes, e.g. a row time and its double, are separate minima), two
-        # points of each (offset/threshold minima within a regime)
-        n_grid = 2 if start is not None and "frames" in start.extra else 5
-        for rule in self.frame_rules:
+        # first fit and a bootstrap refit: neighbouring stripe-count regimes, e.g. a row time and its double, are
+        # separate minima, and the grid's ranking of them is coarse), two points of each (offset/threshold minima
+        # within a regime)
+        refit = start is not None and start.effects == effects and "frames" in start.extra
+        n_grid = 2 if start is not None and "frames" in start.extra and not refit else 5
+        for rule in (start.extra["frames"],) if refit else self.frame_rules:
             with torch.no_grad():
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
                 sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
