@@ -316,9 +316,9 @@ class StripeProblem(Problem):
 
         A refit of the same model on resampled rows (a bootstrap draw: ``start`` is the estimate) keeps the
         estimate's frame rule, a discrete choice of model like its effects, which intervals are conditional on. It
-        repeats a first fit's search over stripe-count regimes, and starts from the estimate too: one started only
-        from the estimate stays in its regime, and the interval then measures that regime's width, not the row time's
-        uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms readout alike; refits
+        repeats a first fit's search (its starts and five stripe-count regimes), and starts from the estimate too:
+        one started only from the estimate stays in its regime, and the interval then measures that regime's width,
+        not the row time's uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms readout alike; refits
         from the estimate alone gave a row time of 47.8-48.9 us, refits that search 48.0-191 us)."""
         target = torch.as_tensor(self.rows[items])
         specs = self.param_specs(effects)
@@ -346,9 +346,12 @@ class StripeProblem(Problem):
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
                 sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
             order = torch.argsort(torch.nan_to_num(sse, nan=float("inf"))).tolist()
-            tries = [first] + [
-                {k: float(v[i]) for k, v in grid.items()} for i in self.regime_starts(grid, order, n_grid)
-            ]
+            # a refit also starts where a first fit does: its starts hold every start of a first fit under its rule
+            tries = (
+                [first]
+                + ([{p.name: p.init for p in specs}] if refit else [])
+                + [{k: float(v[i]) for k, v in grid.items()} for i in self.regime_starts(grid, order, n_grid)]
+            )
             for initial in tries:
                 params = fit_least_squares(
                     specs,
