@@ -344,7 +344,7 @@ def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOL
 
 def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozenset[str]:
     """The effects in ``effects`` that build on ``effect``, directly or through another one (``Effect.requires``)."""
-    requires = {e.name: set(e.requires) for e in problem.candidates}
+    requires = requirements(problem)
     found: set[str] = set()
     frontier = {effect}
     while frontier:
@@ -543,7 +543,7 @@ def scored_groups(
     """Every group of up to ``problem.joint_effects`` new effects that is a valid model on top of ``chosen``,
     cross-validated: new effects -> (score, fold fits, per-item terms), and the name each is reported by
     (:func:`group_label`)."""
-    requires = {e.name: set(e.requires) for e in problem.candidates}
+    requires = requirements(problem)
     open_names = [e.name for e in problem.candidates if e.name not in chosen | withdrawn]
     scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]] = {}
     labels: dict[frozenset[str], str] = {}
@@ -567,7 +567,7 @@ def joint_group_taken(
     """The group of two or more new effects a step takes, or None: the one furthest under what it needs, if it
     is under it. It needs ``margin`` under the best smaller eligible group and, over the ``current`` score, the
     margin once per member that stands on its own (one that builds on another member only carries it)."""
-    requires = {e.name: set(e.requires) for e in problem.candidates}
+    requires = requirements(problem)
     needed = {}
     for group in eligible:
         if len(group) < 2:
@@ -586,6 +586,11 @@ def steps_inside(joint: frozenset[str], scores: dict[frozenset[str], float]) -> 
         [frozenset(order[: k + 1]) for k in range(len(order) - 1)] for order in itertools.permutations(joint)
     ]
     return min((o for o in orders if all(p in scores for p in o)), key=lambda o: [scores[p] for p in o])
+
+
+def requirements(problem: Problem) -> dict[str, set[str]]:
+    """Each candidate effect's ``requires``, by name."""
+    return {e.name: set(e.requires) for e in problem.candidates}
 
 
 def group_label(members, chosen: frozenset[str], requires: dict[str, set[str]]) -> tuple[str, ...]:

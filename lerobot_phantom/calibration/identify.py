@@ -58,6 +58,7 @@ from lerobot_phantom.calibration.core import (
     forward_select,
     group_label,
     own_params,
+    requirements,
     selection_value,
     simpler_forms,
 )
@@ -542,7 +543,7 @@ def simpler_form_result(
     result says whose place it took (``in_place_of``) and the score it was selected by (``scored``)."""
     chosen = frozenset(steps[before].effects)
     group = frozenset(steps[after].effects) - chosen
-    requires = {e.name: set(e.requires) for e in problem.candidates}
+    requires = requirements(problem)
     if steps[before].item_errors is None:
         return None
     for alternative in simpler_forms(problem, chosen | group, effect):
