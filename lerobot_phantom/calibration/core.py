@@ -95,11 +95,13 @@ def further_starts(start: Fit | None, effects: frozenset[str]) -> list[dict[str,
 
 
 # how fit_least_squares takes a Jacobian: scipy's forward finite differences ("2-point", one residual evaluation
-# per parameter) or torch forward mode under vmap ("forward"). Finite differences are the default: forward mode runs
-# each elementwise op on a 0-dim parameter as a Python decomposition (torch 2.10), which cost more than the n
-# evaluations on every shared input, with the same fits (docs/bench/jacobian_choice.py); stripe fits keep forward
-# mode (stripes.STRIPE_JACOBIAN: a regression draw where finite differences stop in another minimum)
-JACOBIANS = ("2-point", "forward")
+# per parameter), torch forward mode under vmap ("forward") or reverse mode under vmap ("reverse", one backward pass
+# per residual, batched). Finite differences are the default: forward mode runs each elementwise op that mixes a
+# parameter with a plain tensor or number as a Python decomposition (torch 2.10), which cost more than the n
+# evaluations on every shared input, with the same fits (docs/bench/jacobian_choice.py). Stripe fits need exact
+# derivatives (stripes.STRIPE_JACOBIAN: a regression draw where finite differences stop in another minimum) and
+# take reverse mode, which has no such decomposition: the same Jacobian to 1e-12 in 1/16 of forward mode's time
+JACOBIANS = ("2-point", "forward", "reverse")
 JACOBIAN = "2-point"
 
 
@@ -142,7 +144,8 @@ def fit_least_squares(
             return call(torch.from_numpy(z)).numpy()
 
     def jac(z: np.ndarray) -> np.ndarray:
-        return torch.func.jacfwd(call)(torch.from_numpy(z)).detach().numpy()
+        transform = torch.func.jacfwd if jacobian == "forward" else torch.func.jacrev
+        return transform(call)(torch.from_numpy(z)).detach().numpy()
 
     best: tuple[float, dict[str, float]] | None = None
     default = {p.name: p.init for p in params}
@@ -154,7 +157,7 @@ def fit_least_squares(
         result = least_squares(
             fun,
             z0,
-            jac=jac if jacobian == "forward" else "2-point",
+            jac="2-point" if jacobian == "2-point" else jac,
             bounds=(low, high),
             max_nfev=max_nfev,
             x_scale=1.0,

@@ -31,10 +31,10 @@ HEIGHT_COLUMNS = ("image_height", "image_rows")
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9}
 FREQUENCY_UNITS = {"hz": 1.0, "khz": 1e3, "mhz": 1e6}
 FRAME_RULE_CHOICES = ("auto", *STRIPE_FRAME_RULES)
-# stripe fits keep torch forward mode, though finite differences are 3x faster on the Logitech table with the same
-# fit: on test_the_first_fit_finds_the_stripe_count_regime_of_the_camera[24-interior] finite differences (2- and
-# 3-point alike) stop in another offset/threshold minimum, 7.42 rows against the 1.50 forward mode reaches
-STRIPE_JACOBIAN = "forward"
+# stripe fits take exact derivatives (torch reverse mode; core.JACOBIANS says why not forward mode): on
+# test_the_first_fit_finds_the_stripe_count_regime_of_the_camera[24-interior] finite differences (2- and 3-point
+# alike) stop in another offset/threshold minimum, 7.42 rows against the 1.50 exact derivatives reach
+STRIPE_JACOBIAN = "reverse"
 
 # The kernel's blooming term (spread_rows) is not a candidate, and the model never sets it: for one stripe per frame
 # at least a row wide it adds the same rows as integration_offset, so the two cannot be told apart from stripe
