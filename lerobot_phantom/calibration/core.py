@@ -67,7 +67,8 @@ class Param:
     ``low_limit``, when given, says what the model *is* at the low bound: a bound where the form converges to a
     physical limit the frames cannot tell from it (a glare's inner scale far inside the clipped core: a pure power
     law), rather than an edge of the search. A value there is reported as "at its limit" (an upper bound on the
-    quantity), not as a parameter pinned at a bound (identify.py, rule 3)."""
+    quantity), not as a parameter pinned at a bound (identify.py, rule 3). ``high_limit`` says the same of the
+    high bound (a phase that drifts over a whole period covers every phase: drifting further changes nothing)."""
 
     name: str
     init: float
@@ -75,6 +76,21 @@ class Param:
     high: float
     scale: float = 1.0
     low_limit: str = ""
+    high_limit: str = ""
+
+    def limit(self, side: str) -> str:
+        """What the model is at bound ``side`` ("low"/"high") when that bound is a physical limit, else ""."""
+        return self.low_limit if side == "low" else self.high_limit
+
+
+def physical_limits(specs: Sequence[Param]) -> dict[str, dict[str, str]]:
+    """Parameter -> {bound side: what the model is there} for the bounds declared physical limits."""
+    limits = {p.name: {"low": p.low_limit, "high": p.high_limit} for p in specs}
+    return {
+        name: {side: text for side, text in sides.items() if text}
+        for name, sides in limits.items()
+        if any(sides.values())
+    }
 
 
 @dataclass
@@ -370,19 +386,20 @@ def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[P
 
 
 def pinned_in_most_folds(spec: Param, fits: list[Fit]) -> str | None:
-    """Why ``spec`` counts as pinned in ``fits`` (at one bound in more than half of them; a low bound declared a
+    """Why ``spec`` counts as pinned in ``fits`` (at one bound in more than half of them; a bound declared a
     physical limit excepted), or None."""
     sides = [at_bound(f.params[spec.name], spec.low, spec.high) for f in fits]
     for side, bound in (("low", spec.low), ("high", spec.high)):
         count = sides.count(side)
-        if 2 * count > len(fits) and not (side == "low" and spec.low_limit):
+        if 2 * count > len(fits) and not spec.limit(side):
             return f"{spec.name} at its {side} bound {bound:g} in {count} of {len(fits)} folds"
     return None
 
 
 def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[Fit]) -> dict[str, str]:
     """The members of a scored group with an own parameter at one bound of its search range in most fold fits
-    (:func:`pinned_in_most_folds`; a low bound declared a physical limit, ``Param.low_limit``, excepted), with why.
+    (:func:`pinned_in_most_folds`; a bound declared a physical limit, ``Param.low_limit``/``high_limit``, excepted), with
+    why.
 
     Identification's rule 3 refuses to name such an effect (identify.py): its score measures the end of the range,
     not the camera. Selection applies the same rule before taking a group, so a pinned form cannot take the step

@@ -16,9 +16,9 @@ The rule (:func:`identify`): an extension is a named cause only if
    what it makes possible is);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
    range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare
-   whose inner scale lies far inside the clipped core is a pure power law where the frames show it); a value there
-   is reported in the result's ``notes`` as at its limit, an upper bound on the quantity, and the effect is judged
-   by the rest;
+   whose inner scale lies far inside the clipped core is a pure power law where the frames show it;
+   ``Param.high_limit``: a phase drifting over a whole period covers every phase); a value there is reported in the
+   result's ``notes`` as at its limit (a bound on the quantity), and the effect is judged by the rest;
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
    least one such parameter excludes its null value;
@@ -58,6 +58,7 @@ from lerobot_phantom.calibration.core import (
     forward_select,
     group_label,
     own_params,
+    physical_limits,
     requirements,
     selection_value,
     simpler_forms,
@@ -179,7 +180,7 @@ def identify(
     bounds: Mapping[str, tuple[float, float]],
     intervals: Mapping[str, Interval],
     nulls: Mapping[str, float],
-    limits: Mapping[str, str] | None = None,
+    limits: Mapping[str, Mapping[str, str]] | None = None,
 ) -> Identification:
     """Apply the module's rule to one extension.
 
@@ -187,8 +188,8 @@ def identify(
     bootstrap intervals; ``nulls``: the parameter values at which the extension reduces to the model without it
     (empty when it has none: a change of functional form); ``validation_ratio``: the paired bootstrap interval
     of the inner cross-validated error ratio without / with the extension (None if it was never scored);
-    ``limits``: parameter -> what the model is at its low bound, for bounds that are the form's physical limit
-    (``Param.low_limit``)."""
+    ``limits``: parameter -> {bound side: what the model is there}, for bounds that are the form's physical limit
+    (``core.physical_limits``: ``Param.low_limit``/``high_limit``)."""
     limits = limits or {}
     reasons = []
     if not selected:
@@ -211,16 +212,18 @@ def parameter_checks(
     bounds: Mapping[str, tuple[float, float]],
     intervals: Mapping[str, Interval],
     nulls: Mapping[str, float],
-    limits: Mapping[str, str],
+    limits: Mapping[str, Mapping[str, str]],
 ) -> tuple[list[str], list[str]]:
     """Rules 3 and 4 on an extension's own parameters: (reasons it fails them, notes of values at their limit)."""
     reasons, notes = [], []
     for name, value in params.items():
         side = at_bound(value, *bounds[name])
-        if side == "low" and limits.get(name):
+        limit = limits.get(name, {}).get(side, "") if side is not None else ""
+        if limit:
+            quantity = "an upper bound" if side == "low" else "a lower bound"
             notes.append(
-                f"{name} = {value:.4g} sits at its low bound, the form's physical limit: {limits[name]}; the value "
-                "is an upper bound, not a measurement"
+                f"{name} = {value:.4g} sits at its {side} bound, the form's physical limit: {limit}; the value "
+                f"is {quantity}, not a measurement"
             )
         elif side is not None:
             reasons.append(
@@ -434,7 +437,7 @@ def own_evidence_results(
             bounds={p.name: (p.low, p.high) for p in specs},
             intervals={p.name: intervals[p.name] for p in specs},
             nulls=nulls,
-            limits={p.name: p.low_limit for p in specs if p.low_limit},
+            limits=physical_limits(specs),
         )
         result = outcome.as_dict()
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
@@ -589,7 +592,7 @@ def refit_reasons(
         {p.name: (p.low, p.high) for p in specs},
         intervals,
         {k: v for k, v in problem.null_values(effect).items() if k in fit.params},
-        {p.name: p.low_limit for p in specs if p.low_limit},
+        physical_limits(specs),
     )
     return [f"refitted without {', '.join(sorted(dropped))}, {reason}" for reason in reasons]
 

@@ -10,7 +10,15 @@ import numpy as np
 import pytest
 import torch
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, Step
+from lerobot_phantom.calibration.core import (
+    Effect,
+    Fit,
+    Param,
+    Problem,
+    Step,
+    physical_limits,
+    pinned_in_most_folds,
+)
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
 from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
@@ -135,7 +143,7 @@ def test_a_parameter_at_its_declared_physical_limit_is_a_note_not_a_reason():
         "params": {"halo_amplitude": 0.5, "halo_exponent": 2.5, "halo_scale": 0.3},
         "bounds": {"halo_amplitude": (0.0, 50.0), "halo_exponent": (0.2, 8.0), "halo_scale": (0.3, 200.0)},
     }
-    limit = {"halo_scale": "a pure power law"}
+    limit = {"halo_scale": {"low": "a pure power law"}}
     at_limit = identified(**arguments, limits=limit)
     assert at_limit.identified and at_limit.reasons == ()
     assert len(at_limit.notes) == 1 and "halo_scale = 0.3" in at_limit.notes[0]
@@ -146,6 +154,20 @@ def test_a_parameter_at_its_declared_physical_limit_is_a_note_not_a_reason():
         **{**arguments, "params": {**arguments["params"], "halo_scale": 200.0}}, limits=limit
     )
     assert not at_high.identified and "sits at its high bound" in at_high.reasons[0]
+
+
+def test_a_high_bound_declared_a_physical_limit_is_a_note_and_never_pins():
+    """A recording's phase drift at 1 covers the whole laser period (any phase): a high bound that is the form's
+    limit. It is a note, a lower bound on the quantity, and selection does not set aside an effect for it; the low
+    side of the same parameter, undeclared, still counts as pinned."""
+    spec = Param("drift", 0.0, 0.0, 1.0, high_limit="a phase that covers the whole period")
+    reasons, notes = parameter_checks({"drift": 1.0}, {"drift": (0.0, 1.0)}, {}, {}, physical_limits([spec]))
+    assert reasons == [] and len(notes) == 1
+    assert "sits at its high bound, the form's physical limit" in notes[0] and "a lower bound" in notes[0]
+    high = [Fit(frozenset({"x"}), {"drift": 1.0}) for _ in range(3)]
+    assert pinned_in_most_folds(spec, high) is None
+    low = [Fit(frozenset({"x"}), {"drift": 0.0}) for _ in range(3)]
+    assert pinned_in_most_folds(spec, low) == "drift at its low bound 0 in 3 of 3 folds"
 
 
 def test_a_change_of_functional_form_needs_no_null_value():
@@ -597,7 +619,7 @@ def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identifi
         {p.name: (p.low, p.high) for p in specs},
         {},
         {},
-        {p.name: p.low_limit for p in specs if p.low_limit},
+        physical_limits(specs),
     )
     assert reasons == []
     assert len(notes) == 1 and notes[0].startswith(
