@@ -23,7 +23,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   ``scored`` {group, validation_error} (identify.simpler_form_result);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
-  interval, significant, where, ...}]} (``calibration/structure.py``);
+  interval, significant, where, ...}; the outlying-item test: {variable "items", value, outlying_items,
+  largest_fit_item_error, significant, where}]} (``calibration/structure.py``);
 - ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs);
   ``per_capture_heldout_rmse`` (laser captures).
 """
@@ -139,6 +140,7 @@ def build_report(
             heldout_items,
             base_mse=base_scores["heldout_rmse"] ** 2,
             rng=np.random.default_rng([seed, 4]),
+            fit_items=fit_items,
         ),
         "residual_analysis": {
             "base": problem.analyse(base, heldout_items),

@@ -3,8 +3,11 @@
 Base (the paper): a fixed band of rows whatever the laser and exposure settings (fitted height; the paper uses
 H/3). Extensions follow the rolling shutter term by term (``physics.rolling_shutter_rows_lit`` documents each):
 row readout time, the pulse/exposure overlap, the sensor's extra integration time, the detection threshold that
-drops partly lit rows, and blooming at stripe edges. Every prediction is the mean over a uniformly random pulse
-phase (the phase of one frame cannot be known in advance), so no held-out row informs its own prediction.
+drops partly lit rows, blooming at stripe edges, and the phase drift of a recording whose laser beats slowly with
+the frame rate (``phase_drift``: one drift per recording, the rows of one laser frequency and exposure setting).
+Every prediction is an expectation over the pulse phase (the phase of one frame cannot be known in advance: uniform,
+or a whole-stripe placement and the recording's drift from it), so no held-out row informs its own prediction; a
+recording's drift is fitted on its fit rows only.
 
 Units and geometry come from the table when it says them (``exposure_us``/``exposure_ms``/``exposure_s`` columns
 or values such as ``32us``; an ``image_height``/``image_rows`` column); otherwise ``--exposure-unit-s`` and
@@ -27,6 +30,7 @@ from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutt
 STRIPE_COLUMNS = ("frequency", "exposure", "duty_cycle", "affected_rows_mean")
 EXPOSURE_COLUMN_UNITS = {"exposure_s": 1.0, "exposure_ms": 1e-3, "exposure_us": 1e-6}
 HEIGHT_COLUMNS = ("image_height", "image_rows")
+SPREAD_COLUMN = "affected_rows_std"
 # unit suffixes a value may carry (case-insensitive); "u" and the micro sign both mean microseconds
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9}
 FREQUENCY_UNITS = {"hz": 1.0, "khz": 1e3, "mhz": 1e6}
@@ -64,7 +68,23 @@ EFFECTS = (
         "not in others, so conditions at the edge of visibility still light a share of rows",
         requires=("detection_threshold",),
     ),
+    Effect(
+        "phase_drift",
+        "a laser whose frequency is close to a multiple of the frame rate beats with it slowly: within one "
+        "recording the stripes start where they were placed whole in view and drift over part of a laser period, "
+        "so wide stripes are cut by the frame's edges in part of the frames; how far the phase drifted belongs to "
+        "each recording (the rows of one laser frequency and exposure setting)",
+        requires=("exposure_overlap",),
+    ),
 )
+# a recording's drift, as a share of the laser period, is searched on this grid before the joint fit: at 0 the
+# error is flat in it (a small drift cuts no stripe), so a fit started there never leaves
+DRIFT_GRID = np.concatenate([[0.0], np.geomspace(0.01, 1.0, 24)])
+# a recording's drift is one parameter per recording: with fewer rows per recording on average it is a fudge per
+# row, not a measurement, and phase_drift is not offered (the report says so)
+MIN_ROWS_PER_RECORDING = 4
+# the drift's grid makes its error piecewise: finite differences reach the forward-mode fit at a third of the CPU
+DRIFT_JACOBIAN = "2-point"
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:
@@ -141,7 +161,10 @@ def read_stripe_table(
         raise ValueError(
             f"{path}: frequencies must be positive, duty cycles in (0, 100] and row counts finite"
         )
+    # the frames' spread of each row's count, when the table gives it: a diagnosis of rows whose frames disagree
+    spread = table[SPREAD_COLUMN].to_numpy(dtype=np.float64) if SPREAD_COLUMN in table.columns else None
     meta = {
+        "spread": spread,
         "frequency_hz": frequency_hz,
         "duty": duty,
         "exposure_s": exposure * data_unit,
@@ -256,6 +279,18 @@ class StripeProblem(Problem):
         self.exposure_s = meta["exposure_s"]
         self.exposure_setting = meta["exposure_setting"]
         self.rows = meta["rows"]
+        self.spread = meta["spread"]
+        # a recording: the rows of one laser frequency and exposure setting (a duty-cycle sweep), which share the
+        # phase relation of the laser and frame clocks
+        keys = np.c_[self.frequency_hz, self.exposure_s]
+        _, first, self.recording = np.unique(keys, axis=0, return_index=True, return_inverse=True)
+        self.recording = self.recording.ravel()
+        self.drift_names = [
+            f"drift_{self.frequency_hz[i]:g}Hz_exposure{self.exposure_setting[i]:g}" for i in first
+        ]
+        self.rows_per_recording = self.n_items / len(self.drift_names)
+        if not self.drift_offer().startswith("yes"):
+            self.candidates = tuple(e for e in EFFECTS if e.name != "phase_drift")
 
     @property
     def n_items(self) -> int:
@@ -291,6 +326,19 @@ class StripeProblem(Problem):
             specs.append(
                 Param("noise_s", 0.3 * shortest, 0.0, exposure + shortest, scale=max(shortest, 1e-7))
             )
+        if "phase_drift" in effects:
+            specs += [
+                Param(
+                    name,
+                    0.0,
+                    0.0,
+                    1.0,
+                    scale=0.1,
+                    low_limit="a phase locked to the frame rate: every frame sees the stripes where they were placed",
+                    high_limit="a phase that covers the whole laser period: any phase, as under the 'lit' rule",
+                )
+                for name in self.drift_names
+            ]
         return specs
 
     def predict(
@@ -298,6 +346,13 @@ class StripeProblem(Problem):
     ) -> torch.Tensor:
         if "exposure_overlap" not in effects:
             return torch.as_tensor(params["band_rows"], dtype=torch.float64).expand(len(items))
+        drift = None
+        if "phase_drift" in effects:
+            # a drift is a placement's: the model has it under the interior rule only (fit)
+            drift = torch.stack(
+                [torch.as_tensor(params[n], dtype=torch.float64) for n in self.drift_names], -1
+            )
+            drift = drift[..., torch.as_tensor(self.recording[items])]
         return rolling_shutter_rows_lit(
             torch.as_tensor(self.frequency_hz[items]),
             torch.as_tensor(self.duty[items]),
@@ -308,6 +363,7 @@ class StripeProblem(Problem):
             threshold_s=params.get("threshold_s", 0.0),
             noise_s=params.get("noise_s"),
             frames=frames,
+            drift=drift,
         )
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
@@ -320,6 +376,14 @@ class StripeProblem(Problem):
         one started only from the estimate stays in its regime, and the interval then measures that regime's width,
         not the row time's uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms readout alike; refits
         from the estimate alone gave a row time of 47.8-48.9 us, refits that search 48.0-191 us)."""
+        if "phase_drift" in effects:
+            return self.fit_drift(effects, items, start)
+        return self.fit_rules(effects, items, start, self.frame_rules)
+
+    def fit_rules(
+        self, effects: frozenset[str], items: np.ndarray, start: Fit | None, rules: tuple[str, ...]
+    ) -> Fit:
+        """``fit`` under the frame ``rules`` given (a refit keeps its estimate's)."""
         target = torch.as_tensor(self.rows[items])
         specs = self.param_specs(effects)
         if "exposure_overlap" not in effects:
@@ -341,7 +405,7 @@ class StripeProblem(Problem):
         # within a regime)
         refit = start is not None and start.effects == effects and "frames" in start.extra
         n_grid = 2 if start is not None and "frames" in start.extra and not refit else 5
-        for rule in (start.extra["frames"],) if refit else self.frame_rules:
+        for rule in (start.extra["frames"],) if refit else rules:
             with torch.no_grad():
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
                 sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
@@ -366,6 +430,40 @@ class StripeProblem(Problem):
                     best = (error, params, rule)
         assert best is not None
         return Fit(effects, best[1], {"frames": best[2]})
+
+    def fit_drift(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
+        """The model with ``phase_drift``: the locked model (every drift 0) fitted under the interior rule, whose
+        placements the drift starts from, by ``fit``'s search (or ``start`` itself when it is that model, fitted on
+        these items by the selection step it extends); then each recording's drift from ``DRIFT_GRID``
+        (recordings share no drift, so one batched evaluation scores every recording at every grid value); then
+        all parameters jointly from there."""
+        locked = effects - {"phase_drift"}
+        if start is not None and start.effects == locked and start.extra.get("frames") == "interior":
+            base = start  # the locked model on these very items (the selection step's fit it extends)
+        else:
+            shared = None
+            if start is not None:
+                kept = {k: v for k, v in start.params.items() if k not in self.drift_names}
+                shared = Fit(locked, kept, {"frames": "interior"})
+            base = self.fit_rules(locked, items, shared, ("interior",))
+        target = torch.as_tensor(self.rows[items])
+        grid = torch.as_tensor(DRIFT_GRID)
+        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in base.params.items()}
+        with torch.no_grad():
+            predicted = self.predict(effects, values | {n: grid for n in self.drift_names}, items, "interior")
+        squared = ((predicted - target) ** 2).numpy()
+        recordings = self.recording[items]
+        warm = dict(base.params)
+        for index, name in enumerate(self.drift_names):
+            mine = recordings == index
+            warm[name] = float(DRIFT_GRID[np.argmin(squared[:, mine].sum(1))]) if mine.any() else 0.0
+        params = fit_least_squares(
+            self.param_specs(effects),
+            lambda p: self.predict(effects, p, items, "interior") - target,
+            warm=warm,
+            jacobian=DRIFT_JACOBIAN,
+        )
+        return Fit(effects, params, {"frames": "interior"})
 
     @staticmethod
     def regime_starts(
@@ -406,6 +504,7 @@ class StripeProblem(Problem):
             "integration_offset": {"integration_offset_s": 0.0},
             "detection_threshold": {"threshold_s": 0.0},
             "detection_noise": {"noise_s": 0.0},
+            "phase_drift": dict.fromkeys(self.drift_names, 0.0),
         }.get(effect, {})
 
     def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -445,6 +544,20 @@ class StripeProblem(Problem):
         )
 
     # -- reporting -----------------------------------------------------------------------------------------
+    def item_label(self, item: int) -> str:
+        """A table row by its settings, and its frames' spread next to the table's median when the table has it
+        (frames that disagree far more than the rest: a stripe cut by the frame's edge in part of them)."""
+        label = (
+            f"row {item} ({self.frequency_hz[item]:g} Hz, exposure {self.exposure_setting[item]:g}, "
+            f"duty {100 * self.duty[item]:g}%"
+        )
+        if self.spread is not None:
+            label += (
+                f", frames' spread {self.spread[item]:.3g} rows against the table's median "
+                f"{np.median(self.spread):.3g}"
+            )
+        return label + ")"
+
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:
         residual = self.residual(fit, items)
         on = self.duty[items] / self.frequency_hz[items]
@@ -466,6 +579,8 @@ class StripeProblem(Problem):
             "integration_offset": self.exposure_s[items],
             "detection_threshold": np.minimum(on, self.exposure_s[items]),
             "detection_noise": np.minimum(on, self.exposure_s[items]),
+            # drift cuts wide stripes: the locked model errs on them
+            "phase_drift": on + self.exposure_s[items],
         }
         driver = drivers[effect]
         corr = float(np.corrcoef(driver, res)[0, 1]) if np.std(driver) > 0 and np.std(res) > 0 else 0.0
@@ -473,6 +588,15 @@ class StripeProblem(Problem):
             f"before {effect}: residual mean {np.mean(res):+.1f} rows, correlation with its driving variable "
             f"{corr:+.2f}"
         )
+
+    def drift_offer(self) -> str:
+        """Whether selection was offered ``phase_drift``, and why not when it was not."""
+        rows = f"{self.rows_per_recording:.3g} rows per recording ({len(self.drift_names)} recordings)"
+        if "interior" not in self.frame_rules:
+            return "no: a drift starts from whole stripes in view, and --stripe-frames excludes the interior rule"
+        if self.rows_per_recording < MIN_ROWS_PER_RECORDING:
+            return f"no: {rows}, a recording's drift needs >= {MIN_ROWS_PER_RECORDING}"
+        return f"yes: {rows}"
 
     def derived(self, fit: Fit) -> dict:
         units = {f"unit_source_{k}": v for k, v in self.sources.items()}
@@ -490,6 +614,7 @@ class StripeProblem(Problem):
             "threshold_us": fit.params.get("threshold_s", 0.0) * 1e6,
             "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
             "frames_averaged": fit.extra.get("frames", "lit"),
+            "phase_drift_offered": self.drift_offer(),
             "image_height": self.image_height,
             **units,
         }

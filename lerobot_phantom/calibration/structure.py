@@ -16,9 +16,16 @@ Run on the held-out residual of the model that is written (base + identified eff
   that is a smooth image, not noise): structure remains when the interval's lower end exceeds ``MIN_LAG_CORR``.
   Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
 
-Either finding also needs to matter: the structured part of the residual (eta squared, or the lag correlation,
-times the residual's mean square) must be at least ``MIN_SHARE_OF_BASE`` (0.5%) of the base model's held-out mean
-squared error - a remnant of a model that is otherwise right is not reported as a missing cause.
+- **items outside the model's error distribution**: a held-out item whose error exceeds ``OUTLIER_FACTOR`` times
+  the largest error of any fit item (exchangeable items exceed that largest error with probability 1/(n_fit + 1)
+  each, before the fit's own optimism), when such items carry at least ``OUTLIER_SHARE`` of the held-out squared
+  error: the model fails on a few items, not everywhere, and the finding names them (``Problem.item_label``: a
+  stripe table's row with its settings and, when the table has it, its frames' spread).
+
+Every finding also needs to matter: the structured part of the residual (eta squared, the lag correlation or the
+outlying items' share, times the residual's mean square) must be at least ``MIN_SHARE_OF_BASE`` (0.5%) of the
+base model's held-out mean squared error - a remnant of a model that is otherwise right is not reported as a
+missing cause.
 
 A problem supplies its residuals through ``Problem.residual_sample`` (None: not tested). The finding names what
 structure is left and where; it never names a library effect.
@@ -42,6 +49,9 @@ LAG = 3
 FAMILY_ALPHA = 0.01
 PERMUTATIONS = 2000
 DRAWS = 200
+OUTLIER_FACTOR = 2.0
+OUTLIER_SHARE = 0.5
+MIN_FIT_ITEMS = 5  # a largest fit error over fewer items is no reference
 
 
 @dataclass
@@ -78,16 +88,27 @@ def _where(values: np.ndarray, residual: np.ndarray, bins: np.ndarray) -> str:
     return f"largest mean residual {means[worst]:+.3g} for values {inside.min():.3g}-{inside.max():.3g}"
 
 
-def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng: np.random.Generator) -> dict:
+def residual_structure(
+    problem,
+    fit,
+    items: np.ndarray,
+    *,
+    base_mse: float,
+    rng: np.random.Generator,
+    fit_items: np.ndarray | None = None,
+) -> dict:
     """The tests of the module docstring on ``fit``'s residual over ``items`` (``base_mse``: the base model's
-    held-out mean squared error); a JSON-ready dict."""
+    held-out mean squared error; ``fit_items``: the items ``fit`` was fitted on, the reference of the outlying-item
+    test, which runs only with them); a JSON-ready dict."""
     sample = problem.residual_sample(fit, items, rng)
     out: dict = {
         "tested_on": "held-out residual of the written model (base + identified effects)",
         "rule": f"a variable's binned mean explains > max({MIN_EXPLAINED}, the permutation null's 1 - "
         f"{FAMILY_ALPHA}/k quantile, k the variables tested) of the residual variance at the low end of a 90% "
-        f"item-bootstrap interval; neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; and "
-        f"the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's held-out mean squared error",
+        f"item-bootstrap interval; neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
+        f"whose error exceeds {OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the "
+        f"held-out squared error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
+        "held-out mean squared error",
         "tests": [],
         "structure_remains": False,
         "summary": "",
@@ -102,6 +123,8 @@ def residual_structure(problem, fit, items: np.ndarray, *, base_mse: float, rng:
         return statistic * mean_square / max(base_mse, 1e-300)
 
     out["tests"] = dependence_tests(sample, share_of_base, rng) + neighbour_tests(sample, share_of_base, rng)
+    if fit_items is not None:
+        out["tests"] += outlying_item_tests(problem, fit, items, fit_items, share_of_base)
     found = [t for t in out["tests"] if t["significant"]]
     out["structure_remains"] = bool(found)
     out["summary"] = structure_summary(found)
@@ -187,14 +210,62 @@ def neighbour_tests(
     return tests
 
 
+def item_errors(problem, fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(each item's RMSE, each item's sum of squared errors) of ``fit`` over ``items``."""
+    squared, counts = problem.item_squared_errors(fit, items)
+    squared = np.asarray(squared, np.float64)
+    return np.sqrt(squared / np.maximum(np.asarray(counts, np.float64), 1.0)), squared
+
+
+def outlying_item_tests(
+    problem, fit, items: np.ndarray, fit_items: np.ndarray, share_of_base: Callable[[float], float]
+) -> list[dict]:
+    """Held-out items whose error exceeds ``OUTLIER_FACTOR`` x the largest fit item's, and their share of the
+    held-out squared error (the module docstring's third test); [] with fewer than ``MIN_FIT_ITEMS`` fit items."""
+    if len(fit_items) < MIN_FIT_ITEMS or len(items) == 0:
+        return []
+    reference = float(item_errors(problem, fit, np.asarray(fit_items))[0].max())
+    errors, squared = item_errors(problem, fit, np.asarray(items))
+    outlying = errors > OUTLIER_FACTOR * reference
+    share = float(squared[outlying].sum() / max(squared.sum(), 1e-300))
+    label = getattr(problem, "item_label", lambda i: f"item {i}")
+    where = ", ".join(
+        f"{label(int(i))}: {e:.3g}"
+        for i, e in sorted(zip(items[outlying], errors[outlying], strict=True), key=lambda t: -t[1])
+    )
+    return [
+        {
+            "variable": "items",
+            "statistic": "outlying items' share of the squared error",
+            "value": share,
+            "outlying_items": [int(i) for i in items[outlying]],
+            "largest_fit_item_error": reference,
+            "share_of_base_mse": share_of_base(share),
+            "significant": bool(share >= OUTLIER_SHARE and share_of_base(share) >= MIN_SHARE_OF_BASE),
+            "where": f"{int(outlying.sum())} of {len(items)} held-out items err by over {OUTLIER_FACTOR:g}x the "
+            f"largest fit item's error ({reference:.3g}): {where or 'none'}",
+        }
+    ]
+
+
 def structure_summary(found: list[dict]) -> str:
     if not found:
         return "no structure left in the held-out residual by the stated rule"
-    return "unexplained structure: " + "; ".join(
-        f"residual {'depends on ' + t['variable'] if t['statistic'] == 'eta2' else 'is smooth: ' + t['where']} "
-        f"({t['statistic']} {t['value']:.3f}, 90% interval "
-        f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}"
-        + (f", r = {t['r']['estimate']:+.2f}" if "r" in t else "")
-        + (f"; {t['where']})" if t["statistic"] == "eta2" else ")")
-        for t in found
-    )
+
+    def sentence(t: dict) -> str:
+        if t["variable"] == "items":
+            return (
+                f"the model fails on a few items ({t['where']}; {100 * t['value']:.0f}% of the squared error)"
+            )
+        if t["statistic"] == "eta2":
+            return (
+                f"residual depends on {t['variable']} (eta2 {t['value']:.3f}, 90% interval "
+                f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}, r = {t['r']['estimate']:+.2f}; "
+                f"{t['where']})"
+            )
+        return (
+            f"residual is smooth: {t['where']} ({t['statistic']} {t['value']:.3f}, 90% interval "
+            f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f})"
+        )
+
+    return "unexplained structure: " + "; ".join(sentence(t) for t in found)

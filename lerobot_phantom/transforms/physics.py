@@ -326,6 +326,7 @@ def rolling_shutter_rows_lit(
     spread_rows: float | torch.Tensor = 0.0,
     noise_s: float | torch.Tensor | None = None,
     frames: str = "lit",
+    drift: float | torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Mean number of rows a pulsed laser lights per counted frame, over a uniformly random pulse phase.
 
@@ -352,6 +353,13 @@ def rolling_shutter_rows_lit(
       catches a pulse with probability ``((rows - 1) min(lit, row_time) + lit) / period``, capped at 1);
       ``"interior"`` only frames whose first and last rows are dark (cameras with dead lines: every stripe fully
       visible; the count is the stripe width times the mean number of whole stripes that fit).
+    - phase drift within a recording (``drift``, per condition, a share of the laser period; ``"interior"`` only):
+      a laser whose frequency is close to a multiple of the frame rate beats with it slowly, so one recording
+      does not see a random phase per frame: its stripes start where they were placed whole in view and the phase
+      advances steadily by ``drift`` of a period over the recording, and frames with a lit row count. Wide
+      stripes are then cut by the frame's edges in part of the frames. ``drift=0`` is the interior rule above
+      (a locked phase), ``drift=1`` the ``"lit"`` rule (the phase covers the period); with ``drift`` given, the
+      average over the placement and the arc is taken on a grid (``_drifting_interior_rows``), also at 0.
     """
     if frames not in STRIPE_FRAME_RULES:
         raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
@@ -375,22 +383,67 @@ def rolling_shutter_rows_lit(
     lit_frames = torch.where(lit_time > 0, lit_frames, torch.zeros_like(lit_frames))
     if frames == "lit":
         return lit_frames
-    # interior: in rows, with period p and stripe width w; given row 0 dark, the first stripe starts c rows in,
-    # c uniform on (0, p - w]; with c' = H - c the last row is dark when c' mod p >= w and ceil(c'/p) stripes fit
     p, w = period / row_time, lit_time / row_time
+    placements = _interior_placements(p, w, height)
+    total = sum(length for _, _, length in placements)
+    possible = (total > 0) & (w < p)
+    if drift is not None:
+        drift = torch.as_tensor(drift, dtype=torch.float64)
+        interior = _drifting_interior_rows(p, w, height, placements, drift)
+    else:
+        weighted = sum(length * stripes for _, stripes, length in placements)
+        interior = w * weighted / total.clamp(min=1e-12)
+    return torch.where(possible, interior, lit_frames)
+
+
+def _interior_placements(
+    p: torch.Tensor, w: torch.Tensor, height: torch.Tensor
+) -> list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]]:
+    """Where the stripes of a frame with dark first and last rows can lie, in rows (period ``p``, stripe width
+    ``w``): ``(lowest c', whole stripes, length)`` of each interval of ``c' = H - c``, where ``c``, the first
+    stripe's start, is uniform on (0, p - w] given row 0 dark; the last row is dark when ``c' mod p >= w``, and then
+    ``ceil(c' / p)`` stripes fit."""
     lowest = height - p + w
-    total = torch.zeros_like(p)
-    weighted = torch.zeros_like(p)
     first = torch.floor(lowest / p)
+    out = []
     for j in (first, first + 1.0):
         start = torch.maximum(torch.maximum(j * p + w, lowest), torch.zeros_like(p))
         stop = torch.minimum((j + 1.0) * p, height)
-        length = (stop - start).clamp(min=0.0)
-        total = total + length
-        weighted = weighted + length * (j + 1.0)
-    interior = w * weighted / total.clamp(min=1e-12)
-    possible = (total > 0) & (w < p)
-    return torch.where(possible, interior, lit_frames)
+        out.append((start, j + 1.0, (stop - start).clamp(min=0.0)))
+    return out
+
+
+DRIFT_PLACEMENTS = 16  # grid points per interval of whole-stripe placements
+DRIFT_STEPS = 64  # grid points along the drift arc
+
+
+def _drifting_interior_rows(
+    p: torch.Tensor,
+    w: torch.Tensor,
+    height: torch.Tensor,
+    placements: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]],
+    drift: torch.Tensor,
+) -> torch.Tensor:
+    """Mean over recordings of a recording's mean lit rows over its frames with a lit row, when each recording
+    starts from a whole-stripe placement (``_interior_placements``, uniform) and its phase then advances steadily
+    by ``drift`` of a period (midpoint grids over both; the direction does not matter: the placements and the
+    count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)`` rows, ``C(y)`` the lit length of
+    ``[0, y)`` under stripes of width ``w`` every ``p`` rows (``cumulative_on_time``)."""
+    grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
+    starts, weights = [], []
+    for lowest, _, length in placements:
+        c_prime = lowest.unsqueeze(-1) + length.unsqueeze(-1) * grid
+        starts.append(height - c_prime)
+        weights.append((length / DRIFT_PLACEMENTS).unsqueeze(-1).expand_as(c_prime))
+    start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
+    arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
+    p3, w3 = p.unsqueeze(-1).unsqueeze(-1), w.unsqueeze(-1).unsqueeze(-1)
+    s = start.unsqueeze(-1) + (drift * p).unsqueeze(-1).unsqueeze(-1) * arc
+    rows = cumulative_on_time(height - s, p3, w3) - cumulative_on_time(-s, p3, w3)
+    # a table row is one recording's mean over its lit frames (its first frame is lit: whole stripes in view)
+    lit = (rows > 1e-9).to(rows.dtype)
+    recording = (rows * lit).sum(-1) / lit.sum(-1).clamp(min=1.0)
+    return (recording * weight).sum(-1) / weight.sum(-1).clamp(min=1e-300)
 
 
 # ---------------------------------------------------------------------------------------------------------------

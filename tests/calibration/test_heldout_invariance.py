@@ -67,6 +67,7 @@ def assert_fits_ignore_the_alteration(
     assert before["selection"]["selected"] or before["selection"]["withdrawn"]
     assert fitted_part(after) == fitted_part(before)
     assert scores(after) != scores(before)  # the alteration did reach the held-out scores
+    return before
 
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
@@ -148,6 +149,31 @@ def test_altering_heldout_rows_of_a_stripe_table_changes_no_fit(tmp_path):
     assert_fits_ignore_the_alteration(
         tmp_path, "laser_color_strip", source, altered_path, seed, image_height=camera["height"]
     )
+
+
+@pytest.mark.slow
+def test_altering_heldout_rows_of_drifting_recordings_changes_no_drift(tmp_path):
+    """A recording's phase drift is fitted on its fit rows only: held-out rows of the drifting recordings, altered,
+    move no drift, parameter or selection (phase_drift is selected on this table)."""
+    from test_stripes import draw_camera, drifting_table
+
+    rng = np.random.default_rng(8)
+    camera = draw_camera(rng, "interior")
+    source = tmp_path / "drifting.csv"
+    drifting_table(source, camera, rng, np.array([0.0, 0.5, 0.0, 0.4, 0.0]))
+    table = pd.read_csv(source)
+    seed = 3
+    _, heldout = seeded_split(len(table), 0.2, seed)
+    altered = table.copy()
+    altered.loc[heldout, "affected_rows_mean"] = rng.uniform(0, camera["height"], len(heldout))
+    altered_path = tmp_path / "altered.csv"
+    altered.to_csv(altered_path, index=False)
+
+    report = assert_fits_ignore_the_alteration(
+        tmp_path, "laser_color_strip", source, altered_path, seed, image_height=camera["height"]
+    )
+    withdrawn = [w["effect"] for w in report["selection"]["withdrawn"]]
+    assert "phase_drift" in report["selection"]["selected"] + withdrawn, report["selection"]
 
 
 @pytest.mark.slow

@@ -22,7 +22,7 @@ from scipy.signal import lfilter
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
-from lerobot_phantom.calibration.core import Fit, fit_least_squares
+from lerobot_phantom.calibration.core import Fit, fit_least_squares, seeded_split
 from lerobot_phantom.calibration.stripes import StripeProblem, read_stripe_table
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
@@ -46,28 +46,11 @@ def simulate_stripe_counts(
     camera: dict, conditions, rng: np.random.Generator, frames: int
 ) -> list[list[int]]:
     """Lit-row count of every frame the frame rule keeps, for each (frequency Hz, duty fraction, exposure s)."""
-    height, dt = camera["height"], camera["dt"]
-    starts = np.arange(height) * camera["row_time"]
     kept = []
     for frequency, duty, exposure in conditions:
-        period = 1.0 / frequency
-        window = exposure + camera["offset"]
-        grid = np.arange(-period, starts[-1] + window + dt, dt)
         counts = []
         for _ in range(frames):
-            phase = rng.uniform(0.0, period)
-            square = (np.mod(grid - phase, period) < duty * period).astype(float)
-            decay = np.exp(-dt / camera["rise"])
-            light = lfilter([1.0 - decay], [1.0, -decay], square)  # one period of lead-in settles the filter
-            energy = np.concatenate([[0.0], np.cumsum(light) * dt])
-            knots = grid[0] + np.arange(len(energy)) * dt
-            collected = np.interp(starts + window, knots, energy) - np.interp(starts, knots, energy)
-            grey = camera["gain"] * collected + rng.normal(0.0, camera["read_noise"], height)
-            lit = grey >= camera["threshold_grey"]
-            spread = camera["spread"]
-            if spread:
-                padded = np.pad(lit, spread)
-                lit = np.any([padded[k : k + height] for k in range(2 * spread + 1)], axis=0)
+            lit = frame_lit_rows(camera, frequency, duty, exposure, rng.uniform(0.0, 1.0 / frequency), rng)
             count = int(lit.sum())
             if camera["frames"] in ("lit", "interior") and count == 0:
                 continue
@@ -76,6 +59,60 @@ def simulate_stripe_counts(
             counts.append(count)
         kept.append(counts)
     return kept
+
+
+def frame_lit_rows(
+    camera: dict, frequency: float, duty: float, exposure: float, phase: float, rng: np.random.Generator
+) -> np.ndarray:
+    """Which rows of one frame read lit, for a pulse train starting ``phase`` seconds into the frame's readout."""
+    height, dt = camera["height"], camera["dt"]
+    starts = np.arange(height) * camera["row_time"]
+    period = 1.0 / frequency
+    window = exposure + camera["offset"]
+    grid = np.arange(-period, starts[-1] + window + dt, dt)
+    square = (np.mod(grid - phase, period) < duty * period).astype(float)
+    decay = np.exp(-dt / camera["rise"])
+    light = lfilter([1.0 - decay], [1.0, -decay], square)  # one period of lead-in settles the filter
+    energy = np.concatenate([[0.0], np.cumsum(light) * dt])
+    knots = grid[0] + np.arange(len(energy)) * dt
+    collected = np.interp(starts + window, knots, energy) - np.interp(starts, knots, energy)
+    grey = camera["gain"] * collected + rng.normal(0.0, camera["read_noise"], height)
+    lit = grey >= camera["threshold_grey"]
+    spread = camera["spread"]
+    if spread:
+        padded = np.pad(lit, spread)
+        lit = np.any([padded[k : k + height] for k in range(2 * spread + 1)], axis=0)
+    return lit
+
+
+def simulate_drifting_recordings(
+    camera: dict, condition, drift: float, rng: np.random.Generator, recordings: int, frames: int
+) -> np.ndarray:
+    """Each recording's mean lit-row count over its frames with a lit row, for one (frequency Hz, duty, exposure
+    s): a recording starts at a phase where the frame shows whole stripes (its first and last rows dark, a row
+    lit; found by drawing phases until one does), then the laser and frame clocks beat, and the phase advances by
+    ``drift`` of a laser period over the recording's ``frames``."""
+    frequency, duty, exposure = condition
+    period = 1.0 / frequency
+    means = []
+    for _ in range(recordings):
+        for _ in range(1000):
+            start = rng.uniform(0.0, period)
+            lit = frame_lit_rows(camera, frequency, duty, exposure, start, rng)
+            if lit.any() and not lit[0] and not lit[-1]:
+                break
+        else:
+            raise AssertionError(f"no phase shows whole stripes at {condition}")
+        counts = [
+            int(
+                frame_lit_rows(
+                    camera, frequency, duty, exposure, start + drift * period * k / frames, rng
+                ).sum()
+            )
+            for k in range(frames)
+        ]
+        means.append(np.mean([c for c in counts if c > 0]))
+    return np.array(means)
 
 
 def draw_camera(rng: np.random.Generator, frames: str) -> dict:
@@ -363,6 +400,102 @@ def test_a_bootstrap_refit_searches_the_regimes_again(tmp_path, factor):
 
     about = f"{camera_summary(camera)}\nestimate {estimate.params} {rmse(estimate):.2f} rows, refit {refit.params}"
     assert rmse(refit) <= 1.02 * rmse(estimate) + 0.1, about
+
+
+@pytest.mark.parametrize("drift", [0.1, 0.4])
+def test_a_drifting_recording_matches_the_simulator(drift):
+    """A laser at the frame rate (phase locked, placed with whole stripes in view) whose clock beats with the
+    camera's by ``drift`` of a period per recording: the kernel's expectation over placements equals the simulated
+    recordings' mean, for a stripe that fills most of the frame (cut at the edges) and a narrow one."""
+    rng = np.random.default_rng([SEED, 6])
+    camera = draw_camera(rng, "interior") | {"rise": 1e-9, "read_noise": 0.0, "spread": 0, "dt": 4e-6}
+    readout = camera["height"] * camera["row_time"]
+    frequency = 1.0 / (2.0 * readout)  # one stripe per frame, a period of two readouts
+    for duty in (0.4, 0.05):
+        condition = (frequency, duty, camera["exposures_us"][0] * 1e-6)
+        means = simulate_drifting_recordings(camera, condition, drift, rng, recordings=60, frames=24)
+        kernel = physics.rolling_shutter_rows_lit(
+            torch.tensor([frequency]),
+            torch.tensor([duty]),
+            torch.tensor([condition[2]]),
+            camera["row_time"],
+            image_rows=camera["height"],
+            integration_offset_s=camera["offset"],
+            threshold_s=camera["threshold_grey"] / camera["gain"],
+            frames="interior",
+            drift=torch.tensor([drift]),
+        )
+        locked = physics.rolling_shutter_rows_lit(
+            torch.tensor([frequency]),
+            torch.tensor([duty]),
+            torch.tensor([condition[2]]),
+            camera["row_time"],
+            image_rows=camera["height"],
+            integration_offset_s=camera["offset"],
+            threshold_s=camera["threshold_grey"] / camera["gain"],
+            frames="interior",
+        )
+        error = 4.0 * means.std(ddof=1) / np.sqrt(len(means)) + 0.02 * float(kernel) + 2.0
+        about = f"{camera_summary(camera)} duty {duty} drift {drift}: kernel {float(kernel):.1f} (locked "
+        about += f"{float(locked):.1f}), simulated {means.mean():.1f} +- {means.std(ddof=1) / np.sqrt(len(means)):.1f}"
+        assert abs(float(kernel) - means.mean()) <= error, about
+        if (
+            duty == 0.4 and drift == 0.4
+        ):  # a wide stripe cut this much: the simulation tells drift from a lock
+            assert float(locked) - means.mean() > error, about
+
+
+def drifting_table(path, camera: dict, rng: np.random.Generator, drifts: np.ndarray) -> None:
+    """A duty sweep per exposure setting at a laser near the frame rate (one stripe per frame, a period of two
+    readouts): each row is one recording of 24 frames, whose phase drifts by ``drifts[k]`` of a period at the k-th
+    exposure (0: locked)."""
+    frequency = round(1.0 / (2.0 * camera["height"] * camera["row_time"]), 1)
+    lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean"]
+    for exposure, drift in zip(camera["exposures_us"], drifts, strict=True):
+        for duty in (2, 5, 10, 15, 20, 25, 30, 35):
+            condition = (frequency, duty / 100.0, exposure * 1e-6)
+            mean = simulate_drifting_recordings(camera, condition, drift, rng, recordings=1, frames=24)[0]
+            lines.append(f"{frequency:g}Hz,{exposure:g},{duty},{mean:.3f}")
+    path.write_text("\n".join(lines) + "\n")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("drifting", [True, False], ids=["two recordings drift", "null: locked"])
+def test_recordings_that_drift_are_named_and_locked_ones_are_not(tmp_path, drifting):
+    """Two of five recordings drift by a third to two thirds of a period (the rest are locked): phase_drift is
+    named, a drifting recording's interval excludes 0 and the held-out rows are predicted better than by the locked
+    model; with every recording locked, phase_drift is not named."""
+    rng = np.random.default_rng([SEED, 7])
+    camera = draw_camera(rng, "interior")
+    drifts = np.zeros(5)
+    if drifting:
+        drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
+    table = tmp_path / "drifting.csv"
+    drifting_table(table, camera, rng, drifts)
+    report = calibrate(
+        CalibrateConfig(
+            attack="laser_color_strip",
+            measured=str(table),
+            out=str(tmp_path / "out"),
+            image_height=camera["height"],
+            seed=SEED % 1000,
+            bootstrap=10,  # the suite's budget: a third of the default draws behind each parameter's interval
+        )
+    )
+    named = {f["effect"] for f in report["findings"]}
+    about = f"{camera_summary(camera)} drifts {drifts}\nnamed {sorted(named)}\n{report['selection']['steps']}"
+    assert "exposure_overlap" in named, about
+    if not drifting:
+        assert "phase_drift" not in named, about
+        return
+    assert "phase_drift" in named, about
+    intervals = report["extended"]["param_intervals"]
+    drifted = [k for k in intervals if k.startswith("drift_") and intervals[k]["low"] > 0.05]
+    assert drifted, about
+    problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
+    fit_items, heldout = seeded_split(problem.n_items, 0.2, SEED % 1000)
+    locked = problem.fit(frozenset(report["extended"]["effects"]) - {"phase_drift"}, fit_items)
+    assert report["extended"]["heldout_rmse"] < problem.rmse(locked, heldout), about
 
 
 # -- a second camera, end to end ---------------------------------------------------------------------------------

@@ -139,3 +139,41 @@ def test_chance_is_judged_over_all_the_variables_tested():
     # 24 rows in up to 12 levels: chance alone explains a large share of noise, and more at a stricter quantile
     assert 0.5 < first_alone["chance"] < first_among_ten["chance"] < 1.0
     assert not among_ten["structure_remains"], among_ten["summary"]
+
+
+class ItemTable:
+    """One value per item: residuals of a table whose fitted model is right (noise) except on ``broken`` items."""
+
+    def __init__(self, n: int, broken: dict[int, float], seed: int) -> None:
+        self.residuals = np.random.default_rng(seed).normal(0.0, 2.0, n)
+        for item, error in broken.items():
+            self.residuals[item] = error
+
+    def item_label(self, item: int) -> str:
+        return f"row {item}"
+
+    def item_squared_errors(self, fit, items):
+        return self.residuals[items] ** 2, np.ones(len(items))
+
+    def residual_sample(self, fit, items, rng):
+        return ResidualSample(
+            [np.array([r]) for r in self.residuals[items]], {"setting": [np.array([i]) for i in items]}
+        )
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_a_few_held_out_items_outside_the_fit_errors_are_reported_by_name(seed):
+    """Three held-out rows a model cannot predict (errors of 80-230 where the fit rows err by a few): the finding
+    names them and their share of the squared error; the same table without them reports nothing."""
+    fit_items, heldout = np.arange(90), np.arange(90, 112)
+    broken = ItemTable(112, {95: 231.6, 99: 132.2, 104: 80.3}, seed)
+    rng = np.random.default_rng(seed)
+    result = residual_structure(broken, None, heldout, base_mse=191.0**2, rng=rng, fit_items=fit_items)
+    items = next(t for t in result["tests"] if t["variable"] == "items")
+    assert result["structure_remains"] and items["significant"], result["summary"]
+    assert sorted(items["outlying_items"]) == [95, 99, 104]
+    assert "row 95: 232" in result["summary"] and "the model fails on a few items" in result["summary"]
+    clean = ItemTable(112, {}, seed)
+    result = residual_structure(clean, None, heldout, base_mse=191.0**2, rng=rng, fit_items=fit_items)
+    assert not result["structure_remains"], result["summary"]
+    assert next(t for t in result["tests"] if t["variable"] == "items")["outlying_items"] == []

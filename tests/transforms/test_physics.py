@@ -133,3 +133,39 @@ def test_em_colour_map_and_masks():
     assert flip.flatten().tolist() == [0.0] * 4 + [1.0] * 6
     bands = physics.periodic_band_mask(8, 4.0)
     assert bands.flatten().tolist() == [1, 1, 0, 0, 1, 1, 0, 0]
+
+
+def test_a_recording_that_does_not_drift_is_the_interior_rule_and_a_whole_period_is_the_lit_rule():
+    """Phase drift bridges the two frame rules: a locked phase (drift 0) sees the whole stripes the interior rule
+    counts, exactly; a phase that covers the whole period (drift 1) any phase, as the lit rule does (to the
+    grid's resolution). One stripe per frame (25 Hz) and several (750 Hz)."""
+    f = torch.tensor([25.0, 25.0, 25.0, 750.0, 300.0])
+    duty = torch.tensor([0.3, 0.1, 0.01, 0.2, 0.05])
+    exposure = torch.tensor([5e-5, 1e-3, 5e-5, 3.2e-5, 2e-3])
+    kwargs = {"image_rows": 720, "integration_offset_s": 3e-4}
+    interior = physics.rolling_shutter_rows_lit(f, duty, exposure, 2e-5, frames="interior", **kwargs)
+    lit = physics.rolling_shutter_rows_lit(f, duty, exposure, 2e-5, frames="lit", **kwargs)
+    locked = physics.rolling_shutter_rows_lit(
+        f, duty, exposure, 2e-5, frames="interior", drift=torch.zeros(5), **kwargs
+    )
+    covering = physics.rolling_shutter_rows_lit(
+        f, duty, exposure, 2e-5, frames="interior", drift=torch.ones(5), **kwargs
+    )
+    torch.testing.assert_close(locked, interior, rtol=1e-9, atol=1e-9)
+    torch.testing.assert_close(covering, lit, rtol=0.02, atol=0.5)
+    assert float((interior - lit).abs().max()) > 100  # the two rules differ here, so both checks could fail
+
+
+def test_drift_cuts_wide_stripes_first():
+    """A drifting phase cuts a stripe at the frame's edges in part of the frames: the count falls as the drift
+    grows, and a stripe filling most of the frame loses a larger share than a narrow one."""
+    drift = torch.tensor([0.0, 0.05, 0.2, 0.5])
+    kwargs = {"image_rows": 720, "frames": "interior", "drift": drift}
+    wide = physics.rolling_shutter_rows_lit(
+        torch.full((4,), 25.0), torch.full((4,), 0.3), 5e-5, 2e-5, **kwargs
+    )
+    narrow = physics.rolling_shutter_rows_lit(
+        torch.full((4,), 25.0), torch.full((4,), 0.02), 5e-5, 2e-5, **kwargs
+    )
+    assert (wide[1:] < wide[:-1]).all() and (narrow[1:] <= narrow[:-1]).all(), (wide, narrow)
+    assert float(wide[-1] / wide[0]) < float(narrow[-1] / narrow[0]) - 0.1, (wide, narrow)
