@@ -83,7 +83,8 @@ DRIFT_GRID = np.concatenate([[0.0], np.geomspace(0.01, 1.0, 24)])
 # a recording's drift is one parameter per recording: with fewer rows per recording on average it is a fudge per
 # row, not a measurement, and phase_drift is not offered (the report says so)
 MIN_ROWS_PER_RECORDING = 4
-# the drift's grid makes its error piecewise: finite differences reach the forward-mode fit at a third of the CPU
+# the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
+# forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
 
 
@@ -289,7 +290,8 @@ class StripeProblem(Problem):
             f"drift_{self.frequency_hz[i]:g}Hz_exposure{self.exposure_setting[i]:g}" for i in first
         ]
         self.rows_per_recording = self.n_items / len(self.drift_names)
-        if not self.drift_offer().startswith("yes"):
+        self.drift_offered, self.drift_offer_reason = self.drift_offer()
+        if not self.drift_offered:
             self.candidates = tuple(e for e in EFFECTS if e.name != "phase_drift")
 
     @property
@@ -348,7 +350,7 @@ class StripeProblem(Problem):
             return torch.as_tensor(params["band_rows"], dtype=torch.float64).expand(len(items))
         drift = None
         if "phase_drift" in effects:
-            # a drift is a placement's: the model has it under the interior rule only (fit)
+            # a drift starts from the interior rule's placements: fit_drift fits it under that rule only
             drift = torch.stack(
                 [torch.as_tensor(params[n], dtype=torch.float64) for n in self.drift_names], -1
             )
@@ -374,8 +376,9 @@ class StripeProblem(Problem):
         estimate's frame rule, a discrete choice of model like its effects, which intervals are conditional on. It
         repeats a first fit's search (its starts and five stripe-count regimes), and starts from the estimate too:
         one started only from the estimate stays in its regime, and the interval then measures that regime's width,
-        not the row time's uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms readout alike; refits
-        from the estimate alone gave a row time of 47.8-48.9 us, refits that search 48.0-191 us)."""
+        not the row time's uncertainty (the Logitech table's single laser frequency fits a 35 ms and a 138 ms
+        readout alike; refits from the estimate alone gave a row time of 47.8-48.9 us, refits that search
+        48.0-191 us). A model with ``phase_drift`` is fitted by ``fit_drift``."""
         if "phase_drift" in effects:
             return self.fit_drift(effects, items, start)
         return self.fit_rules(effects, items, start, self.frame_rules)
@@ -589,14 +592,17 @@ class StripeProblem(Problem):
             f"{corr:+.2f}"
         )
 
-    def drift_offer(self) -> str:
-        """Whether selection was offered ``phase_drift``, and why not when it was not."""
+    def drift_offer(self) -> tuple[bool, str]:
+        """Whether selection is offered ``phase_drift``, and why (or why not)."""
         rows = f"{self.rows_per_recording:.3g} rows per recording ({len(self.drift_names)} recordings)"
         if "interior" not in self.frame_rules:
-            return "no: a drift starts from whole stripes in view, and --stripe-frames excludes the interior rule"
+            return (
+                False,
+                "a drift starts from whole stripes in view, and --stripe-frames excludes the interior rule",
+            )
         if self.rows_per_recording < MIN_ROWS_PER_RECORDING:
-            return f"no: {rows}, a recording's drift needs >= {MIN_ROWS_PER_RECORDING}"
-        return f"yes: {rows}"
+            return False, f"{rows}, a recording's drift needs >= {MIN_ROWS_PER_RECORDING}"
+        return True, rows
 
     def derived(self, fit: Fit) -> dict:
         units = {f"unit_source_{k}": v for k, v in self.sources.items()}
@@ -614,7 +620,7 @@ class StripeProblem(Problem):
             "threshold_us": fit.params.get("threshold_s", 0.0) * 1e6,
             "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
             "frames_averaged": fit.extra.get("frames", "lit"),
-            "phase_drift_offered": self.drift_offer(),
+            "phase_drift_offered": f"{'yes' if self.drift_offered else 'no'}: {self.drift_offer_reason}",
             "image_height": self.image_height,
             **units,
         }

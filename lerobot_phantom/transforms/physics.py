@@ -427,8 +427,9 @@ def _drifting_interior_rows(
     """Mean over recordings of a recording's mean lit rows over its frames with a lit row, when each recording
     starts from a whole-stripe placement (``_interior_placements``, uniform) and its phase then advances steadily
     by ``drift`` of a period (midpoint grids over both; the direction does not matter: the placements and the
-    count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)`` rows, ``C(y)`` the lit length of
-    ``[0, y)`` under stripes of width ``w`` every ``p`` rows (``cumulative_on_time``)."""
+    count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)``
+    rows, ``C(y)`` the lit length of ``[0, y)`` under stripes of width ``w`` every ``p`` rows
+    (``cumulative_on_time``)."""
     grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
     starts, weights = [], []
     for lowest, _, length in placements:
