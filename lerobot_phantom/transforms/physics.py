@@ -295,7 +295,13 @@ def pulse_overlap_lit_time(
     if noise_s is None:
         high = torch.maximum(light[..., 1:], light[..., :-1])
         low = torch.minimum(light[..., 1:], light[..., :-1])
-        share = ((high - threshold.unsqueeze(-1)) / (high - low).clamp(min=1e-15)).clamp(0.0, 1.0)
+        above = high - threshold.unsqueeze(-1)
+        # a flat piece (a plateau: the window holds the whole pulse) is lit or not as a whole: a step in the
+        # threshold whose derivative is 0, not the 1/(high - low) of a slope of no width (seen: a Jacobian column
+        # of 5e11 that froze a fit's threshold where it equalled a pulse's on-time)
+        flat = (high - low) <= 1e-9 * period.unsqueeze(-1)
+        sloped = (above / (high - low).clamp(min=1e-15)).clamp(0.0, 1.0)
+        share = torch.where(flat, (above > 0).to(light.dtype), sloped)
         return (share * lengths).sum(-1)
     # read noise: a row is lit with probability Phi((L - threshold) / noise); along a linear piece of L the
     # integral of Phi(z) is G(z) = z Phi(z) + phi(z) over the slope
@@ -352,7 +358,8 @@ def rolling_shutter_rows_lit(
       ``frames="all"`` every frame (``rows * lit share``); ``"lit"`` frames with at least one lit row (a frame
       catches a pulse with probability ``((rows - 1) min(lit, row_time) + lit) / period``, capped at 1);
       ``"interior"`` only frames whose first and last rows are dark (cameras with dead lines: every stripe fully
-      visible; the count is the stripe width times the mean number of whole stripes that fit).
+      visible; the count is the stripe width times the mean number of whole stripes that fit). The last row starts
+      H - 1 row times after the first, and blooming reaches an edge row from inside the frame only.
     - phase drift within a recording (``drift``, per condition, a share of the laser period; ``"interior"`` only):
       a laser whose frequency is close to a multiple of the frame rate beats with it slowly, so one recording
       does not see a random phase per frame: its stripes start where they were placed whole in view and the phase
@@ -384,12 +391,16 @@ def rolling_shutter_rows_lit(
     if frames == "lit":
         return lit_frames
     p, w = period / row_time, lit_time / row_time
-    placements = _interior_placements(p, w, height)
+    # an edge row is dark when no stripe reaches it: a stripe blooms into it from inside the frame only (there is no
+    # row beyond the edge to bloom from), and the last row starts H - 1 row times after the first
+    bloom = 0.5 * spread / row_time
+    edge_span = height - 1.0 - bloom
+    placements = _interior_placements(p, w - bloom, edge_span)
     total = sum(length for _, _, length in placements)
     possible = (total > 0) & (w < p)
     if drift is not None:
         drift = torch.as_tensor(drift, dtype=torch.float64)
-        interior = _drifting_interior_rows(p, w, height, placements, drift)
+        interior = _drifting_interior_rows(p, w, height, edge_span, placements, drift)
     else:
         weighted = sum(length * stripes for _, stripes, length in placements)
         interior = w * weighted / total.clamp(min=1e-12)
@@ -400,9 +411,10 @@ def _interior_placements(
     p: torch.Tensor, w: torch.Tensor, height: torch.Tensor
 ) -> list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]]:
     """Where the stripes of a frame with dark first and last rows can lie, in rows (period ``p``, stripe width
-    ``w``): ``(lowest c', whole stripes, length)`` of each interval of ``c' = H - c``, where ``c``, the first
-    stripe's start, is uniform on (0, p - w] given row 0 dark; the last row is dark when ``c' mod p >= w``, and then
-    ``ceil(c' / p)`` stripes fit."""
+    ``w`` as the edge rows see it, the last row ``height`` rows after the first): ``(lowest c', whole stripes,
+    length)`` of each interval of ``c' = height - c``, where ``c``, the first stripe's start, is uniform on
+    (0, p - w] given row 0 dark; the last row is dark when ``c' mod p >= w``, and then ``ceil(c' / p)`` stripes
+    fit."""
     lowest = height - p + w
     first = torch.floor(lowest / p)
     out = []
@@ -421,11 +433,13 @@ def _drifting_interior_rows(
     p: torch.Tensor,
     w: torch.Tensor,
     height: torch.Tensor,
+    edge_span: torch.Tensor,
     placements: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]],
     drift: torch.Tensor,
 ) -> torch.Tensor:
     """Mean over recordings of a recording's mean lit rows over its frames with a lit row, when each recording
-    starts from a whole-stripe placement (``_interior_placements``, uniform) and its phase then advances steadily
+    starts from a whole-stripe placement (``_interior_placements`` over ``edge_span``, uniform; a placement's
+    ``c = edge_span - c'`` is where its first stripe, bloom included, starts) and its phase then advances steadily
     by ``drift`` of a period (midpoint grids over both; the direction does not matter: the placements and the
     count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)``
     rows, ``C(y)`` the lit length of ``[0, y)`` under stripes of width ``w`` every ``p`` rows
@@ -434,7 +448,7 @@ def _drifting_interior_rows(
     starts, weights = [], []
     for lowest, _, length in placements:
         c_prime = lowest.unsqueeze(-1) + length.unsqueeze(-1) * grid
-        starts.append(height - c_prime)
+        starts.append(edge_span.unsqueeze(-1) - c_prime)
         weights.append((length / DRIFT_PLACEMENTS).unsqueeze(-1).expand_as(c_prime))
     start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
     arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS

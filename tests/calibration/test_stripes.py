@@ -261,30 +261,17 @@ def calibrate_drawn_camera(
 
 
 # -- the physics kernel against the simulator ---------------------------------------------------------------------
-@pytest.mark.parametrize(
-    "frames",
-    [
-        "all",
-        "lit",
-        pytest.param(
-            "interior",
-            marks=pytest.mark.xfail(
-                strict=False,
-                reason="open (issue 12): the interior frame rule's approximation is 6% above the simulator at 5% duty, "
-                "the mid frequency and the longest exposure on some 480-row cameras (301 vs 285.5 rows, "
-                "STRIPES_SEED=594202656; 299 vs 281.5, STRIPES_SEED=281172929): 1 of 40 fresh seeds in session 27, "
-                "and the same at 1d68bfd (docs/bench/session27.md)",
-            ),
-        ),
-    ],
-)
+@pytest.mark.parametrize("frames", physics.STRIPE_FRAME_RULES)
 def test_phase_averaged_rows_match_the_simulator(frames):
     """Without the unmodelled rise time and noise, the analytic expectation equals the simulated frame mean.
 
     Until session 23 this was an expected failure on some draws: the kernel bloomed stripes narrower than a row
     time in every frame (102.8 rows against 56.8, STRIPES_SEED=2577942692), and a fixed tolerance of 8% + 4 rows
     was under the simulator's sampling error at low frequencies (406 against 370 rows, STRIPES_SEED=2677795359,
-    which 3000 frames bring to 402)."""
+    which 3000 frames bring to 402). Until session 28 the interior rule was: its edge rows were taken H rows apart
+    (not H - 1) and dark only if a stripe's bloom beyond the frame missed them, so on a frame whose gap between
+    stripes barely holds both edges no frame qualified and the kernel fell back to the lit rule (301.4 against the
+    simulator's 285.5 rows, STRIPES_SEED=594202656; 284.7 with the edges right)."""
     check = kernel_against_simulator(SEED, frames)
     miss = kernel_miss(check)
     kept = np.isfinite(miss)
