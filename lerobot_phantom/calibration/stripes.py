@@ -421,10 +421,11 @@ class StripeProblem(Problem):
             )
             fits = [self.fit_from(effects, specs, items, rule, initial) for initial in tries]
             error, params = min(fits, key=lambda fit: fit[0])
-            if below := self.threshold_regime_below(effects, params, items):
-                error, params = min(
-                    (error, params), self.fit_from(effects, specs, items, rule, below), key=lambda fit: fit[0]
-                )
+            beside = [
+                self.fit_from(effects, specs, items, rule, s)
+                for s in self.threshold_regimes_beside(effects, params, items)
+            ]
+            error, params = min([(error, params), *beside], key=lambda fit: fit[0])
             if best is None or error < best[0]:
                 best = (error, params, rule)
         assert best is not None
@@ -450,24 +451,31 @@ class StripeProblem(Problem):
             values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
             return float(torch.sum((self.predict(effects, values, items, rule) - target) ** 2)), params
 
-    def threshold_regime_below(
+    def threshold_regimes_beside(
         self, effects: frozenset[str], params: dict[str, float], items: np.ndarray
-    ) -> dict[str, float] | None:
-        """A start one threshold regime below ``params``, or None. Without read noise the error is flat in the
-        threshold between the pulses' on-times (a threshold between two of them sees the same pulses) and steps
-        where it crosses one, with no slope to lead a fit back: a fit whose threshold ended above a pulse that lit
-        rows among ``items`` (predicting none of them) is started again just under the highest such on-time.
-        Seen on a drawn table of tests/calibration/test_stripes.py once the interior rule's edges were right:
-        the threshold crossed a 1% pulse (21.4 us) while the row time was still far off, and the fit ended at 7.4
-        rows where 1.3 lay just under that step."""
+    ) -> list[dict[str, float]]:
+        """Starts in the two threshold regimes beside the one of ``params``. Without read noise the error is flat in
+        the threshold between the light the rows' pulses can give at most (``min(on-time, exposure + offset)``; a
+        threshold between two of them sees the same pulses) and steps where it crosses one, with no slope to lead a
+        fit across: a fit ends in the regime its row-time search left it in. Each start lies just beyond the
+        nearest step below and above the threshold (not past the next one). Seen on the drawn tables of
+        tests/calibration/test_stripes.py: a threshold that had crossed a 1% pulse (21.4 us) while the row time was
+        still far off ended at 7.4 rows where 1.3 lay just under that step; one that stopped under a 16.2 us pulse
+        ended at 3.3 rows where the camera's own threshold (18.8 us, the pulse seen through read noise) gives 0.8."""
         if "detection_threshold" not in effects or "detection_noise" in effects:
-            return None
-        seen = items[self.rows[items] > 0]
-        on_times = self.duty[seen] / self.frequency_hz[seen]
-        crossed = on_times[on_times <= params["threshold_s"]]
-        if not len(crossed):
-            return None
-        return {**params, "threshold_s": 0.95 * float(crossed.max())}
+            return []
+        window = self.exposure_s[items] + params.get("integration_offset_s", 0.0)
+        steps = np.unique(np.minimum(self.duty[items] / self.frequency_hz[items], window))
+        threshold = params["threshold_s"]
+        below, above = steps[steps <= threshold], steps[steps > threshold]
+        starts = []
+        if len(below):
+            nearest, next_one = below[-1], below[-2] if len(below) > 1 else 0.0
+            starts.append(max(0.95 * nearest, 0.5 * (nearest + next_one)))
+        if len(above):
+            nearest, next_one = above[0], above[1] if len(above) > 1 else np.inf
+            starts.append(min(1.05 * nearest, 0.5 * (nearest + next_one)))
+        return [{**params, "threshold_s": float(start)} for start in starts]
 
     def fit_drift(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
         """The model with ``phase_drift``: the locked model (every drift 0) fitted under the interior rule, whose
