@@ -8,19 +8,20 @@ parameter with a plain tensor or a Python number as a Python decomposition in to
 
     OMP_NUM_THREADS=1 python docs/bench/stripe_jacobian.py TABLE.csv SCRATCH_DIR --image_height 720 \\
         --exposure_unit_s 1e-4
+
+(``session28/stripe_jacobian_logitech_c1.txt`` was printed by this script's first form at 25e931b, before
+``phase_drift``, whose own fit takes finite differences in both runs; its lines are worded without the table's name.)
 """
 
 from __future__ import annotations
 
-import json
 import sys
-import time
 from pathlib import Path
 
 import torch
+from jacobian_choice import print_comparison, run
 
 from lerobot_phantom.calibration import stripes
-from lerobot_phantom.calibration.cli import main as calibrate_cli
 
 
 def main(table: str, scratch: Path, flags: list[str]) -> None:
@@ -29,26 +30,10 @@ def main(table: str, scratch: Path, flags: list[str]) -> None:
     runs = {}
     for jacobian in ("forward", "reverse"):
         stripes.STRIPE_JACOBIAN = jacobian
-        out = scratch / jacobian
-        start = time.process_time()
-        calibrate_cli(["--attack", "laser_color_strip", "--measured", table, *flags, "--out", str(out)])
-        runs[jacobian] = (time.process_time() - start, json.loads((out / "report.json").read_text()))
-    for jacobian, (cpu, report) in runs.items():
-        rmse = report["extended"]["heldout_rmse_interval"]
-        print(
-            f"{jacobian}: {cpu:.1f} s CPU; written {rmse['estimate']:.4f} [{rmse['low']:.4f}, {rmse['high']:.4f}]; "
-            f"named {report['extended']['effects']}"
+        runs[jacobian] = run(
+            Path(table).parent, scratch / jacobian, "laser_color_strip", Path(table).name, flags
         )
-    (forward_cpu, forward), (reverse_cpu, reverse) = runs.values()
-    differences = [
-        abs(reverse["extended"]["params"].get(k, float("nan")) - v) / max(abs(v), 1e-12)
-        for k, v in forward["extended"]["params"].items()
-    ]
-    print(
-        f"CPU reverse / forward {reverse_cpu / forward_cpu:.2f}; largest relative difference over "
-        f"{len(differences)} fitted parameters {max(differences):.2e}",
-        flush=True,
-    )
+    print_comparison(Path(table).name, runs)
 
 
 if __name__ == "__main__":

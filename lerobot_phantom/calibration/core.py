@@ -85,11 +85,10 @@ class Param:
 
 def physical_limits(specs: Sequence[Param]) -> dict[str, dict[str, str]]:
     """Parameter -> {bound side: what the model is there} for the bounds declared physical limits."""
-    limits = {p.name: {"low": p.low_limit, "high": p.high_limit} for p in specs}
     return {
-        name: {side: text for side, text in sides.items() if text}
-        for name, sides in limits.items()
-        if any(sides.values())
+        p.name: {side: p.limit(side) for side in ("low", "high") if p.limit(side)}
+        for p in specs
+        if p.low_limit or p.high_limit
     }
 
 
@@ -242,6 +241,10 @@ class Problem:
         """Residuals over ``items`` with the variables they may depend on (``structure.ResidualSample``), or
         None when this input offers nothing to test."""
         return None
+
+    def item_label(self, item: int) -> str:
+        """How a report names item ``item`` (structure.py's outlying-item test)."""
+        return f"item {item}"
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         """The fitted parameters of the model with ``effects`` (names and search bounds)."""
@@ -398,8 +401,8 @@ def pinned_in_most_folds(spec: Param, fits: list[Fit]) -> str | None:
 
 def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[Fit]) -> dict[str, str]:
     """The members of a scored group with an own parameter at one bound of its search range in most fold fits
-    (:func:`pinned_in_most_folds`; a bound declared a physical limit, ``Param.low_limit``/``high_limit``, excepted), with
-    why.
+    (:func:`pinned_in_most_folds`; a bound declared a physical limit, ``Param.low_limit``/``high_limit``,
+    excepted), with why.
 
     Identification's rule 3 refuses to name such an effect (identify.py): its score measures the end of the range,
     not the camera. Selection applies the same rule before taking a group, so a pinned form cannot take the step

@@ -218,7 +218,7 @@ def parameter_checks(
     reasons, notes = [], []
     for name, value in params.items():
         side = at_bound(value, *bounds[name])
-        limit = limits.get(name, {}).get(side, "") if side is not None else ""
+        limit = limits.get(name, {}).get(side, "")
         if limit:
             quantity = "an upper bound" if side == "low" else "a lower bound"
             notes.append(

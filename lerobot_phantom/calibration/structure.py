@@ -228,9 +228,8 @@ def outlying_item_tests(
     errors, squared = item_errors(problem, fit, np.asarray(items))
     outlying = errors > OUTLIER_FACTOR * reference
     share = float(squared[outlying].sum() / max(squared.sum(), 1e-300))
-    label = getattr(problem, "item_label", lambda i: f"item {i}")
     where = ", ".join(
-        f"{label(int(i))}: {e:.3g}"
+        f"{problem.item_label(int(i))}: {e:.3g}"
         for i, e in sorted(zip(items[outlying], errors[outlying], strict=True), key=lambda t: -t[1])
     )
     return [

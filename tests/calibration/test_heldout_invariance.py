@@ -130,6 +130,17 @@ def test_altering_heldout_table_rows_of_the_shared_triples_changes_no_fit(tmp_pa
     assert_fits_ignore_the_alteration(tmp_path, "light_projection", source, altered_path, seed)
 
 
+def stripe_table_with_heldout_rows_redrawn(source, folder, seed: int, rng: np.random.Generator, height: int):
+    """A copy of stripe table ``source`` (in ``folder``) whose held-out rows (split ``seed``) count rows drawn at
+    random in [0, height)."""
+    table = pd.read_csv(source)
+    _, heldout = seeded_split(len(table), 0.2, seed)
+    table.loc[heldout, "affected_rows_mean"] = rng.uniform(0, height, len(heldout))
+    altered_path = folder / "altered.csv"
+    table.to_csv(altered_path, index=False)
+    return altered_path
+
+
 @pytest.mark.slow
 def test_altering_heldout_rows_of_a_stripe_table_changes_no_fit(tmp_path):
     from test_stripes import draw_camera, write_table
@@ -138,13 +149,8 @@ def test_altering_heldout_rows_of_a_stripe_table_changes_no_fit(tmp_path):
     camera = draw_camera(rng, "lit")
     source = tmp_path / "stripes.csv"
     write_table(source, camera, rng, n_rows=40, frames=30, style="exposure_us")
-    table = pd.read_csv(source)
     seed = 3
-    _, heldout = seeded_split(len(table), 0.2, seed)
-    altered = table.copy()
-    altered.loc[heldout, "affected_rows_mean"] = rng.uniform(0, camera["height"], len(heldout))
-    altered_path = tmp_path / "altered.csv"
-    altered.to_csv(altered_path, index=False)
+    altered_path = stripe_table_with_heldout_rows_redrawn(source, tmp_path, seed, rng, camera["height"])
 
     assert_fits_ignore_the_alteration(
         tmp_path, "laser_color_strip", source, altered_path, seed, image_height=camera["height"]
@@ -161,13 +167,8 @@ def test_altering_heldout_rows_of_drifting_recordings_changes_no_drift(tmp_path)
     camera = draw_camera(rng, "interior")
     source = tmp_path / "drifting.csv"
     drifting_table(source, camera, rng, np.array([0.0, 0.5, 0.0, 0.4, 0.0]))
-    table = pd.read_csv(source)
     seed = 3
-    _, heldout = seeded_split(len(table), 0.2, seed)
-    altered = table.copy()
-    altered.loc[heldout, "affected_rows_mean"] = rng.uniform(0, camera["height"], len(heldout))
-    altered_path = tmp_path / "altered.csv"
-    altered.to_csv(altered_path, index=False)
+    altered_path = stripe_table_with_heldout_rows_redrawn(source, tmp_path, seed, rng, camera["height"])
 
     report = assert_fits_ignore_the_alteration(
         tmp_path, "laser_color_strip", source, altered_path, seed, image_height=camera["height"]

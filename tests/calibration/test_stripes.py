@@ -11,6 +11,7 @@ failure (set ``STRIPES_SEED`` to replay a run).
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 
@@ -284,14 +285,24 @@ def test_phase_averaged_rows_match_the_simulator(frames):
 
 @pytest.mark.parametrize(
     ("on_rows", "period", "frames"),
-    [(0.2, 7.3, "all"), (0.7, 7.3, "all"), (2.6, 7.3, "all"), (0.2, 500.0, "lit"), (2.6, 500.0, "lit")],
+    [
+        (0.2, 7.3, "all"),
+        (0.7, 7.3, "all"),
+        (2.6, 7.3, "all"),
+        (0.2, 500.0, "lit"),
+        (2.6, 500.0, "lit"),
+        (2.6, 7.3, "interior"),
+        (20.0, 60.0, "interior"),
+    ],
 )
 def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows, period, frames):
     """Exact expectation over the pulse phase (a fine phase grid, rows as discrete start times): a stripe narrower
     than a row time lights a row for only part of the phases, and only then blooms (session 23: the kernel added
     the spread to every stripe, 102.8 rows where the simulator counted 56.8). A pulse slower than the readout
     (period 500 rows, 200-row frames) leaves most frames dark; blooming cannot light one, so it does not change
-    which frames the ``lit`` rule counts."""
+    which frames the ``lit`` rule counts. Under the ``interior`` rule an edge row is dark unless a stripe blooms
+    into it from inside the frame (until session 29 the kernel bloomed into it from beyond the edge too: 189.0 rows
+    at 2.6 of 7.3, where frames count 186.3)."""
     rows, window, spread = 200, 0.3, 2
     starts = np.arange(rows, dtype=float)  # one row time = 1
     counts = []
@@ -299,9 +310,11 @@ def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows, period, fram
         # a row collects light when its window [t, t + window] overlaps a pulse [phase + k period, + on_rows]
         lit = np.mod(starts - phase + window, period) < on_rows + window
         padded = np.pad(lit, spread)
-        count = np.any([padded[k : k + rows] for k in range(2 * spread + 1)], axis=0).sum()
-        if frames == "all" or count > 0:
-            counts.append(count)
+        bloomed = np.any([padded[k : k + rows] for k in range(2 * spread + 1)], axis=0)
+        edges_dark = not bloomed[0] and not bloomed[-1]
+        if frames == "all" or (bloomed.any() and (frames == "lit" or edges_dark)):
+            counts.append(bloomed.sum())
+    assert counts, "no frame kept: the case does not test the rule"
     kernel = physics.rolling_shutter_rows_lit(
         torch.tensor(1.0 / period),
         torch.tensor(on_rows / period),
@@ -314,6 +327,20 @@ def test_blooming_widens_only_the_stripes_that_light_a_row(on_rows, period, fram
     # a stripe at the frame's edge loses the spread edge that falls outside the frame: under one row with 27 stripes
     # per frame, a few hundredths of a row with one stripe in a lit frame
     assert float(kernel) == pytest.approx(np.mean(counts), abs=1.0 if frames == "all" else 0.1)
+
+
+def test_a_window_that_holds_the_whole_pulse_is_lit_as_a_step_in_the_threshold():
+    """Where the window holds the whole pulse, the collected light is flat (a plateau at the on-time): just under the
+    on-time that whole plateau is lit, and the lit time's slope in the threshold is the stripe's two edges, -2. Until
+    session 29 the plateau's share divided by a clamped width of 1e-15 s: a tenth of the plateau lit and a slope of
+    -3e12 there, a Jacobian that froze a fit's threshold at a pulse's on-time."""
+    period, on, window = (torch.tensor(v, dtype=torch.float64) for v in (1e-2, 2e-3, 5e-3))
+    threshold = (on - 1e-16).requires_grad_(True)
+    lit = physics.pulse_overlap_lit_time(period, on, window, threshold)
+    (slope,) = torch.autograd.grad(lit, threshold)
+    assert float(lit) == pytest.approx(float(window - on), rel=1e-9)
+    assert float(slope) == pytest.approx(-2.0)
+    assert float(physics.pulse_overlap_lit_time(period, on, window, on + 1e-12)) == 0.0
 
 
 def test_lit_time_is_the_overlap_minus_twice_the_threshold():
@@ -404,18 +431,8 @@ def test_a_drifting_recording_matches_the_simulator(drift):
     for duty in (0.4, 0.05):
         condition = (frequency, duty, camera["exposures_us"][0] * 1e-6)
         means = simulate_drifting_recordings(camera, condition, drift, rng, recordings=60, frames=24)
-        kernel = physics.rolling_shutter_rows_lit(
-            torch.tensor([frequency]),
-            torch.tensor([duty]),
-            torch.tensor([condition[2]]),
-            camera["row_time"],
-            image_rows=camera["height"],
-            integration_offset_s=camera["offset"],
-            threshold_s=camera["threshold_grey"] / camera["gain"],
-            frames="interior",
-            drift=torch.tensor([drift]),
-        )
-        locked = physics.rolling_shutter_rows_lit(
+        interior_rows = functools.partial(
+            physics.rolling_shutter_rows_lit,
             torch.tensor([frequency]),
             torch.tensor([duty]),
             torch.tensor([condition[2]]),
@@ -425,6 +442,7 @@ def test_a_drifting_recording_matches_the_simulator(drift):
             threshold_s=camera["threshold_grey"] / camera["gain"],
             frames="interior",
         )
+        kernel, locked = interior_rows(drift=torch.tensor([drift])), interior_rows()
         error = 4.0 * means.std(ddof=1) / np.sqrt(len(means)) + 0.02 * float(kernel) + 2.0
         about = f"{camera_summary(camera)} duty {duty} drift {drift}: kernel {float(kernel):.1f} (locked "
         about += f"{float(locked):.1f}), simulated {means.mean():.1f} +- {means.std(ddof=1) / np.sqrt(len(means)):.1f}"
