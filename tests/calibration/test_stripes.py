@@ -248,17 +248,21 @@ def calibrate_drawn_camera(
     table = tmp_path / "second_camera.csv"
     write_table(table, camera, rng, n_rows=60, frames=60, style=style)
     unit = {"exposure_unit_s": 1e-6} if style == "exposure" else {}
-    report = calibrate(
-        CalibrateConfig(
-            attack="laser_color_strip",
-            measured=str(table),
-            out=str(tmp_path / "out"),
-            seed=calibration_seed,
-            image_height=camera["height"],
-            **unit,
-        )
+    return camera, calibrate_stripes(tmp_path, table, camera["height"], seed=calibration_seed, **unit)
+
+
+def calibrate_stripes(tmp_path, table, image_height: int, **options) -> dict:
+    """report.json of ``lerobot-phantom-calibrate`` on stripe table ``table``, written under ``tmp_path / "out"``
+    (held-out split seed ``SEED % 1000`` unless ``options`` give one)."""
+    options.setdefault("seed", SEED % 1000)
+    config = CalibrateConfig(
+        attack="laser_color_strip",
+        measured=str(table),
+        out=str(tmp_path / "out"),
+        image_height=image_height,
+        **options,
     )
-    return camera, report
+    return calibrate(config)
 
 
 # -- the physics kernel against the simulator ---------------------------------------------------------------------
@@ -495,16 +499,8 @@ def test_recordings_that_drift_are_named_and_locked_ones_are_not(tmp_path, drift
         drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
     table = tmp_path / "drifting.csv"
     drifting_table(table, camera, rng, drifts)
-    report = calibrate(
-        CalibrateConfig(
-            attack="laser_color_strip",
-            measured=str(table),
-            out=str(tmp_path / "out"),
-            image_height=camera["height"],
-            seed=SEED % 1000,
-            bootstrap=10,  # the suite's budget: a third of the default draws behind each parameter's interval
-        )
-    )
+    # bootstrap=10: the suite's budget, a third of the default draws behind each parameter's interval
+    report = calibrate_stripes(tmp_path, table, camera["height"], bootstrap=10)
     named = {f["effect"] for f in report["findings"]}
     about = f"{camera_summary(camera)} drifts {drifts}\nnamed {sorted(named)}\n{report['selection']['steps']}"
     assert "exposure_overlap" in named, about
@@ -607,15 +603,7 @@ def test_fixed_band_keeps_the_base(tmp_path):
     rng = np.random.default_rng([SEED, 3])
     camera = draw_camera(rng, "lit")
     table = fixed_band_table(tmp_path / "band.csv", rng, camera)
-    report = calibrate(
-        CalibrateConfig(
-            attack="laser_color_strip",
-            measured=str(table),
-            out=str(tmp_path / "out"),
-            image_height=camera["height"],
-            seed=SEED % 1000,
-        )
-    )
+    report = calibrate_stripes(tmp_path, table, camera["height"])
     assert report["extended"]["effects"] == [], camera_summary(camera)
     assert report["base"]["params"]["band_rows"] == pytest.approx(camera["height"] / 3, abs=2.0)
     assert not report["unexplained_structure"]["structure_remains"], report["unexplained_structure"][
@@ -668,15 +656,7 @@ def test_residual_structure_of_a_stripe_table(tmp_path, flicker):
 def test_an_unnamed_stripe_effect_is_reported_as_structure_not_as_a_cause(tmp_path):
     rng = np.random.default_rng([SEED, 5])
     band_table(tmp_path / "beat.csv", rng, 600, flicker=0.4)
-    report = calibrate(
-        CalibrateConfig(
-            attack="laser_color_strip",
-            measured=str(tmp_path / "beat.csv"),
-            out=str(tmp_path / "out"),
-            image_height=600,
-            seed=SEED % 1000,
-        )
-    )
+    report = calibrate_stripes(tmp_path, tmp_path / "beat.csv", 600)
     about = (
         f"STRIPES_SEED={SEED} {report['unexplained_structure']['summary']} {report['extended']['effects']}"
     )
