@@ -22,7 +22,6 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
-from scipy.optimize import differential_evolution
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, binned_rmse, fit_least_squares
 from lerobot_phantom.calibration.structure import ResidualSample
@@ -87,11 +86,6 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
-# differential evolution's start (StripeProblem.evolved_start): population per parameter, generations, seed; set once
-# before the screen that measured the start (session 30), not tuned on it
-EVOLUTION_POPULATION = 10
-EVOLUTION_GENERATIONS = 60
-EVOLUTION_SEED = 0
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:
@@ -424,7 +418,6 @@ class StripeProblem(Problem):
                 [first]
                 + ([{p.name: p.init for p in specs}] if refit else [])
                 + [{k: float(v[i]) for k, v in grid.items()} for i in self.regime_starts(grid, order, n_grid)]
-                + [self.evolved_start(effects, specs, items, rule)]
             )
             fits = [self.fit_from(effects, specs, items, rule, initial) for initial in tries]
             error, params = min(fits, key=lambda fit: fit[0])
@@ -457,45 +450,6 @@ class StripeProblem(Problem):
         with torch.no_grad():
             values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
             return float(torch.sum((self.predict(effects, values, items, rule) - target) ** 2)), params
-
-    def evolved_start(
-        self, effects: frozenset[str], specs: list[Param], items: np.ndarray, rule: str
-    ) -> dict[str, float]:
-        """A start found by differential evolution over the whole search range (row time on a log scale), each
-        generation one batched evaluation of the model. The grid's starts rank stripe-count regimes by one coarse
-        point each (row times 1.5x apart), and a regime's offset/threshold minima are narrower than its grid cells:
-        on the first-fit test's drawn tables (seeds 1-80, both frame rules) the grid's starts alone stopped short
-        of the minimum the camera's own parameters reach on 15 of 160, with this start 1 of 160 (session 30).
-        The population is seeded, so a fit is a function of its rows."""
-        target = torch.as_tensor(self.rows[items])
-        names = [p.name for p in specs]
-        on_log_scale = [p.name == "row_time_s" for p in specs]
-        bounds = [
-            (np.log(p.low), np.log(p.high)) if log else (p.low, p.high)
-            for p, log in zip(specs, on_log_scale, strict=True)
-        ]
-
-        def values(z: np.ndarray) -> dict[str, np.ndarray]:
-            return {n: np.exp(v) if log else v for n, v, log in zip(names, z, on_log_scale, strict=True)}
-
-        def squared_error(population: np.ndarray) -> np.ndarray:
-            batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in values(population).items()}
-            with torch.no_grad():
-                sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
-            return torch.nan_to_num(sse, nan=float("inf")).numpy()
-
-        result = differential_evolution(
-            squared_error,
-            bounds,
-            popsize=EVOLUTION_POPULATION,
-            maxiter=EVOLUTION_GENERATIONS,
-            tol=0.0,
-            vectorized=True,
-            updating="deferred",
-            polish=False,
-            rng=np.random.default_rng(EVOLUTION_SEED),
-        )
-        return {k: float(v) for k, v in values(result.x).items()}
 
     def threshold_regimes_beside(
         self, effects: frozenset[str], params: dict[str, float], items: np.ndarray
