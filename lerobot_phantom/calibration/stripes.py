@@ -413,15 +413,15 @@ class StripeProblem(Problem):
         ):
             return None
         specs = {p.name: p for p in self.param_specs(fit.effects)}
-        thresholds = np.linspace(specs["threshold_s"].low, specs["threshold_s"].high, RIDGE_SCAN_POINTS)
+        fitted = fit.params["threshold_s"]
+        scan = np.linspace(specs["threshold_s"].low, specs["threshold_s"].high, RIDGE_SCAN_POINTS)
+        thresholds = np.unique(np.append(scan, fitted))  # the fit's own threshold is a point of the range
         offsets = self.ridge_offsets(fit, thresholds)
         offset_spec = specs["integration_offset_s"]
         inside = (offsets >= offset_spec.low) & (offsets <= offset_spec.high)
         change = np.abs(self.ridge_predictions(fit, items, thresholds) - self.predict_fit(fit, items)).max(1)
         same = inside & (change <= RIDGE_TOLERANCE_ROWS)
-        at_fit = int(np.argmin(np.abs(thresholds - fit.params["threshold_s"])))
-        if not same[at_fit]:
-            return None
+        at_fit = int(np.searchsorted(thresholds, fitted))
         low, high = at_fit, at_fit
         while low > 0 and same[low - 1]:
             low -= 1
