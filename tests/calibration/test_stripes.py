@@ -23,7 +23,7 @@ from scipy.signal import lfilter
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
-from lerobot_phantom.calibration.core import Fit, fit_least_squares, seeded_split
+from lerobot_phantom.calibration.core import Fit, at_bound, fit_least_squares, seeded_split
 from lerobot_phantom.calibration.stripes import StripeProblem, read_stripe_table
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
@@ -452,6 +452,24 @@ def test_a_threshold_the_fit_rows_leave_open_predicts_by_its_average(tmp_path):
     assert (predicted > along.min(0)[varies] + 1.0).all() and (
         predicted < along.max(0)[varies] - 1.0
     ).all(), f"{predicted} outside ({along.min(0)[varies]}, {along.max(0)[varies]})"
+
+
+def test_rows_that_fix_no_row_time_do_not_leave_it_at_a_bound(tmp_path):
+    """Drawn camera 1095341462 (lit frames, the second-camera test's table and split): with read noise in the model
+    the fit rows fix no row time (fits from every start match to 1e-6), and the fit kept the one a start had left
+    at 0.37 us, within 0.1% of the range's low bound. Identification then rejected exposure_overlap for it and the
+    base model was written (178 rows held-out, against 3.0). Among equal fits none at a bound is kept."""
+    seed, frames = 1095341462, "lit"
+    rng = np.random.default_rng([seed, 2, len(frames)])
+    camera = draw_camera(rng, frames)
+    table = tmp_path / "table.csv"
+    write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
+    fit_items, _ = seeded_split(problem.n_items, 0.2, seed % 1000)
+    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold", "detection_noise"})
+    fit = problem.fit(effects, fit_items)
+    at_bounds = [p.name for p in problem.param_specs(effects) if at_bound(fit.params[p.name], p.low, p.high)]
+    assert not at_bounds, f"{camera_summary(camera)}\n{fit.params} {fit.extra}: {at_bounds} at a bound"
 
 
 @pytest.mark.parametrize("drift", [0.1, 0.4])
