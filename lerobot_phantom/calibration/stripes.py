@@ -94,13 +94,8 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
-# the offset-threshold ridge (StripeProblem.threshold_ridge): thresholds scanned over the search range, the largest
-# change of a fit row's prediction that still counts as none, and thresholds averaged over when predicting
 # fits whose squared errors agree within this share are equal (preferred_fit)
 TIE_SHARE = 1e-6
-RIDGE_SCAN_POINTS = 801
-RIDGE_TOLERANCE_ROWS = 1e-6
-RIDGE_AVERAGE_POINTS = 64
 
 
 def preferred_fit(specs: list[Param], fits: list[tuple]) -> tuple:
@@ -108,8 +103,9 @@ def preferred_fit(specs: list[Param], fits: list[tuple]) -> tuple:
     within ``TIE_SHARE``, one with the fewest parameters at a bound of their search range. Where the rows do not
     tell two fits apart, a parameter at its bound is where a start left it, not what the rows ask for, and
     identification would reject the effect for it (session 30: a drawn lit-rule table whose rows fix no row time;
-    fits from every start matched to 1e-6, and the one kept at a 0.37 us row time made selection withdraw
-    exposure_overlap and write the base model, 178 rows held-out against 3.0)."""
+    fits from every start matched to 1e-6; on the selection paths of two changes tried that session, the one kept
+    at a 0.37 us row time made selection withdraw exposure_overlap and write the base model, 178 rows held-out
+    against 3.0)."""
     lowest = min(fit[0] for fit in fits)
     tied = [fit for fit in fits if fit[0] <= lowest * (1.0 + TIE_SHARE)]
     return min(
@@ -285,11 +281,6 @@ class StripeProblem(Problem):
     # by the fold that validates it, whatever the model: its error (hundreds of rows) would decide every squared-
     # error comparison, while the rows each model can predict would not count.
     selection_score = "mean_item_error"
-    heldout_definition = (
-        "RMSE of the model fitted on the fit items, predicting the held-out items from their inputs alone; where "
-        "the fit rows leave the detection threshold open (a range along which the integration offset makes up for "
-        "it and no fit row's prediction changes), an item is predicted by the average over that range"
-    )
     selection_score_reason = (
         "each table row's absolute error, averaged: a condition alone in its regime, which no fold that validates "
         "it can predict, must not decide every comparison"
@@ -415,59 +406,8 @@ class StripeProblem(Problem):
         readout alike; refits from the estimate alone gave a row time of 47.8-48.9 us, refits that search
         48.0-191 us). A model with ``phase_drift`` is fitted by ``fit_drift``."""
         if "phase_drift" in effects:
-            fit = self.fit_drift(effects, items, start)
-        else:
-            fit = self.fit_rules(effects, items, start, self.frame_rules)
-        ridge = self.threshold_ridge(fit, items)
-        if ridge is not None:
-            fit.extra["threshold_ridge_s"] = ridge
-        return fit
-
-    def threshold_ridge(self, fit: Fit, items: np.ndarray) -> tuple[float, float] | None:
-        """The range of detection thresholds the rows ``items`` leave open, or None: a stripe covers
-        ``on + window - 2 threshold`` of start time (``rolling_shutter_rows_lit``), so a threshold moved with an
-        integration offset moved twice as far lights the same rows, until the threshold crosses the light some
-        row's pulse gives at most (``min(on-time, exposure + offset)``). Between two such steps no fitted row says
-        where the threshold is, while a held-out row whose pulse lies between them is lit on one side and dark on
-        the other (session 30: drawn camera 2932763216, a 1% pulse of 18.6 us measured 169 rows lit, predicted 0
-        from a fitted threshold of 31 us where the camera's is 14 us; the fit rows' error is the same at both).
-        Read noise makes the threshold soft and the ridge no longer flat: None then."""
-        if (
-            not {"detection_threshold", "integration_offset"} <= fit.effects
-            or "detection_noise" in fit.effects
-        ):
-            return None
-        specs = {p.name: p for p in self.param_specs(fit.effects)}
-        fitted = fit.params["threshold_s"]
-        scan = np.linspace(specs["threshold_s"].low, specs["threshold_s"].high, RIDGE_SCAN_POINTS)
-        thresholds = np.unique(np.append(scan, fitted))  # the fit's own threshold is a point of the range
-        offsets = self.ridge_offsets(fit, thresholds)
-        offset_spec = specs["integration_offset_s"]
-        inside = (offsets >= offset_spec.low) & (offsets <= offset_spec.high)
-        change = np.abs(self.ridge_predictions(fit, items, thresholds) - self.predict_fit(fit, items)).max(1)
-        same = inside & (change <= RIDGE_TOLERANCE_ROWS)
-        at_fit = int(np.searchsorted(thresholds, fitted))
-        low, high = at_fit, at_fit
-        while low > 0 and same[low - 1]:
-            low -= 1
-        while high < len(thresholds) - 1 and same[high + 1]:
-            high += 1
-        return (float(thresholds[low]), float(thresholds[high])) if high > low else None
-
-    def ridge_offsets(self, fit: Fit, thresholds: np.ndarray) -> np.ndarray:
-        """The integration offsets that keep ``on + window - 2 threshold`` at the fit's along ``thresholds``."""
-        return fit.params["integration_offset_s"] + 2.0 * (thresholds - fit.params["threshold_s"])
-
-    def ridge_predictions(self, fit: Fit, items: np.ndarray, thresholds: np.ndarray) -> np.ndarray:
-        """Predicted rows of ``items`` (one row of the result per threshold) along the offset-threshold ridge."""
-        moved = {
-            "threshold_s": torch.as_tensor(thresholds).reshape(-1, 1),
-            "integration_offset_s": torch.as_tensor(self.ridge_offsets(fit, thresholds)).reshape(-1, 1),
-        }
-        with torch.no_grad():
-            return self.predict(
-                fit.effects, fit.params | moved, items, fit.extra.get("frames", "lit")
-            ).numpy()
+            return self.fit_drift(effects, items, start)
+        return self.fit_rules(effects, items, start, self.frame_rules)
 
     def fit_rules(
         self, effects: frozenset[str], items: np.ndarray, start: Fit | None, rules: tuple[str, ...]
@@ -641,13 +581,7 @@ class StripeProblem(Problem):
         return self.residual(fit, items) ** 2, np.ones(len(items))
 
     def predict_fit(self, fit: Fit, items: np.ndarray) -> np.ndarray:
-        """The fitted model's rows; where the fit rows leave the threshold open (``threshold_ridge``), the average
-        over that range (the fit rows' own predictions are the same anywhere in it)."""
-        if "threshold_ridge_s" in fit.extra:
-            low, high = fit.extra["threshold_ridge_s"]
-            return self.ridge_predictions(fit, items, np.linspace(low, high, RIDGE_AVERAGE_POINTS)).mean(0)
-        with torch.no_grad():
-            return self.predict(fit.effects, fit.params, items, fit.extra.get("frames", "lit")).numpy()
+        return self.predict(fit.effects, fit.params, items, fit.extra.get("frames", "lit")).numpy()
 
     def residual(self, fit: Fit, items: np.ndarray) -> np.ndarray:
         return self.predict_fit(fit, items) - self.rows[items]
@@ -753,11 +687,6 @@ class StripeProblem(Problem):
             "threshold_us": fit.params.get("threshold_s", 0.0) * 1e6,
             "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
             "frames_averaged": fit.extra.get("frames", "lit"),
-            "threshold_open_us": (
-                [v * 1e6 for v in fit.extra["threshold_ridge_s"]]
-                if "threshold_ridge_s" in fit.extra
-                else None
-            ),
             "phase_drift_offered": f"{'yes' if self.drift_offered else 'no'}: {self.drift_offer_reason}",
             "image_height": self.image_height,
             **units,
