@@ -28,9 +28,9 @@ from lerobot_phantom.calibration.core import (
     Fit,
     Param,
     Problem,
-    at_bound,
     binned_rmse,
     fit_least_squares,
+    preferred_fit,
 )
 from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutter_rows_lit
@@ -94,24 +94,6 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
-# fits whose squared errors agree within this share are equal (preferred_fit)
-TIE_SHARE = 1e-6
-
-
-def preferred_fit(specs: list[Param], fits: list[tuple]) -> tuple:
-    """The fit (a tuple: squared error, parameters, ...) with the lowest error; among fits whose errors agree
-    within ``TIE_SHARE``, one with the fewest parameters at a bound of their search range. Where the rows do not
-    tell two fits apart, a parameter at its bound is where a start left it, not what the rows ask for, and
-    identification would reject the effect for it (session 30: a drawn lit-rule table whose rows fix no row time;
-    fits from every start matched to 1e-6; on the selection paths of two changes tried that session, the one kept
-    at a 0.37 us row time made selection withdraw exposure_overlap and write the base model, 178 rows held-out
-    against 3.0)."""
-    lowest = min(fit[0] for fit in fits)
-    tied = [fit for fit in fits if fit[0] <= lowest * (1.0 + TIE_SHARE)]
-    return min(
-        tied,
-        key=lambda fit: (sum(at_bound(fit[1][p.name], p.low, p.high) is not None for p in specs), fit[0]),
-    )
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:

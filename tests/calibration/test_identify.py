@@ -11,6 +11,7 @@ import pytest
 import torch
 
 from lerobot_phantom.calibration.core import (
+    TIE_SHARE,
     Effect,
     Fit,
     Param,
@@ -18,6 +19,7 @@ from lerobot_phantom.calibration.core import (
     Step,
     physical_limits,
     pinned_in_most_folds,
+    preferred_fit,
 )
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
@@ -92,6 +94,18 @@ def test_at_bound():
     assert at_bound(8.0, 0.2, 8.0) == "high"
     assert at_bound(0.2001, 0.2, 8.0) == "low"
     assert at_bound(3.0, 0.2, 8.0) is None
+
+
+def test_of_equal_fits_one_off_its_bounds_is_kept():
+    """Fits whose errors agree within TIE_SHARE are equal: of those, one with no parameter at a bound is kept; a fit
+    at a bound that is lower by more than that is kept all the same (the data ask for the bound)."""
+    specs = [Param("row_time", 1.0, 0.0, 10.0), Param("offset", 0.0, -1.0, 1.0)]
+    at_low = (1.0, {"row_time": 0.001, "offset": 0.2})
+    inside_equal = (1.0 + 0.5 * TIE_SHARE, {"row_time": 4.0, "offset": 0.2})
+    inside_worse = (1.0 + 10 * TIE_SHARE, {"row_time": 4.0, "offset": 0.2})
+    assert preferred_fit(specs, [at_low, inside_equal]) is inside_equal
+    assert preferred_fit(specs, [at_low, inside_worse]) is at_low
+    assert preferred_fit(specs, [inside_worse, inside_equal]) is inside_equal  # no bound: the lowest error
 
 
 def identified(**overrides):
