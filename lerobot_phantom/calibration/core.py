@@ -601,9 +601,14 @@ def scored_groups(
 def joint_group_taken(
     problem: Problem, eligible: dict[frozenset[str], float], current: float, margin: float
 ) -> frozenset[str] | None:
-    """The group of two or more new effects a step takes, or None: the one furthest under what it needs, if it
-    is under it. It needs ``margin`` under the best smaller eligible group and, over the ``current`` score, the
-    margin once per member that stands on its own (one that builds on another member only carries it)."""
+    """The group of two or more new effects a step takes, or None: of the groups under what they need, the one
+    with the lowest score. A group needs ``margin`` under the best smaller eligible group and, over the ``current``
+    score, the margin once per member that stands on its own (one that builds on another member only carries it).
+
+    Lowest score, not furthest under its need: a pair far under its need can be the first step of a worse model
+    (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
+    pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
+    larger group under its need has already beaten every smaller one by the margin."""
     requires = requirements(problem)
     needed = {}
     for group in eligible:
@@ -612,8 +617,7 @@ def joint_group_taken(
         smaller = min((v for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
         standing = max(1, sum(1 for e in group if not requires[e] & group))
         needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
-    joint = min(needed, key=lambda g: eligible[g] / needed[g], default=None)
-    return joint if joint is not None and eligible[joint] <= needed[joint] else None
+    return min((g for g in needed if eligible[g] <= needed[g]), key=eligible.get, default=None)
 
 
 def steps_inside(joint: frozenset[str], scores: dict[frozenset[str], float]) -> list[frozenset[str]]:
