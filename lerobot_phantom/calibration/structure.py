@@ -2,7 +2,8 @@
 
 Run on the held-out residual of the model that is written (base + identified effects). Two kinds of test:
 
-- **dependence on a variable** (position in the frame, intensity, brightness, channel, the table's settings): the
+- **dependence on a variable** (position in the frame, intensity, brightness, channel, the table's settings, the
+  local detail of a recorded attack pattern: ``frame_models.common.pattern_detail``): the
   share of the residual's variance explained by its mean per bin of the variable (eta squared): up to 8 quantile
   bins, or one bin per level for a variable of few distinct values (``core.bin_index``: a table's settings).
   Structure remains when the lower end of the 90% item-bootstrap interval of eta squared exceeds both

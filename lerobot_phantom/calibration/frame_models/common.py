@@ -16,6 +16,7 @@ import numpy as np
 import pandas as pd
 import torch
 from PIL import Image
+from scipy import ndimage
 from scipy.special import logsumexp
 
 from lerobot_phantom.calibration.core import (
@@ -131,9 +132,14 @@ class FrameProblem(Problem):
 
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         """Held-out residuals (grey levels) on a seeded sample of values per pair, against row and column
-        position, the clean pixel's level, the channel and the pair's intensity; neighbours ``LAG`` pixels apart
-        along rows and columns of the channel-mean residual."""
-        sample = ResidualSample([], {k: [] for k in ("row", "column", "clean_level", "channel", "intensity")})
+        position, the clean pixel's level, the channel, the pair's intensity and, when the pairs record the attack's
+        pattern, the pattern's local detail (:func:`pattern_detail`); neighbours ``LAG`` pixels apart along rows and
+        columns of the channel-mean residual."""
+        variables = ("row", "column", "clean_level", "channel", "intensity")
+        with_pattern = all(p.pattern is not None for p in self.pairs)
+        sample = ResidualSample(
+            [], {k: [] for k in variables + (("pattern_detail",) if with_pattern else ())}
+        )
         sample.neighbours = {"neighbours_along_rows": [], "neighbours_along_columns": []}
         for i in items:
             pair = self.pairs[int(i)]
@@ -150,6 +156,8 @@ class FrameProblem(Problem):
             sample.covariates["clean_level"].append(255.0 * pair.clean.numpy()[c, y, x])
             sample.covariates["channel"].append(c.astype(np.float64))
             sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
+            if with_pattern:
+                sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
             mean = residual.mean(0)
             for name, (a, b) in {
                 "neighbours_along_rows": (mean[:, :-LAG], mean[:, LAG:]),
@@ -304,6 +312,23 @@ class PixelProblem(FrameProblem):
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return None if start is None else start.params
+
+
+# the neighbourhood a pattern value is compared with: wider than demosaicing's and compression's one or two pixels,
+# as narrow as the blur of a projector slightly out of focus or of a lens's point spread
+DETAIL_SIGMA_PX = 1.5
+
+
+def pattern_detail(pattern: torch.Tensor) -> np.ndarray:
+    """The pattern (3, H, W) in grey levels minus its Gaussian-weighted neighbourhood mean, per channel: positive on
+    the bright side of an edge, negative on the dark side, 0 where the pattern is flat. Light that spreads across the
+    pattern's edges on its way to the sensor (optics blur, a projector's defocus), which no model term spreads,
+    leaves a residual that follows this variable (camsim's optics blur of an emitted projector frame:
+    docs/bench/session31.md)."""
+    values = 255.0 * pattern.double().numpy()
+    return values - ndimage.gaussian_filter(
+        values, sigma=(0, DETAIL_SIGMA_PX, DETAIL_SIGMA_PX), mode="nearest"
+    )
 
 
 def flat_pixels(image: torch.Tensor, pixels: torch.Tensor | None) -> torch.Tensor:
