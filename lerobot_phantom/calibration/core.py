@@ -609,7 +609,15 @@ def joint_group_taken(
     (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
     larger group under its need has already beaten every smaller one by the margin."""
-    requires = requirements(problem)
+    needed = group_needs(requirements(problem), eligible, current, margin)
+    return min((g for g in needed if eligible[g] <= needed[g]), key=eligible.get, default=None)
+
+
+def group_needs(
+    requires: dict[str, set[str]], eligible: dict[frozenset[str], float], current: float, margin: float
+) -> dict[frozenset[str], float]:
+    """The score each eligible group of two or more new effects must reach to earn a step
+    (:func:`joint_group_taken`)."""
     needed = {}
     for group in eligible:
         if len(group) < 2:
@@ -617,7 +625,7 @@ def joint_group_taken(
         smaller = min((v for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
         standing = max(1, sum(1 for e in group if not requires[e] & group))
         needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
-    return min((g for g in needed if eligible[g] <= needed[g]), key=eligible.get, default=None)
+    return needed
 
 
 def steps_inside(joint: frozenset[str], scores: dict[frozenset[str], float]) -> list[frozenset[str]]:

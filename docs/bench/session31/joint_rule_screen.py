@@ -9,11 +9,11 @@ Usage: ``PYTHONPATH=. python docs/bench/session31/joint_rule_screen.py REPORT_JS
 from __future__ import annotations
 
 import json
-import math
 import sys
 from pathlib import Path
 
 from lerobot_phantom.calibration import captures, projection, stripes
+from lerobot_phantom.calibration.core import group_needs
 from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS
 
 TABLE_EFFECTS = {
@@ -25,13 +25,7 @@ TABLE_EFFECTS = {
 
 def group_taken(tried: dict, set_aside: dict, current: float, requires: dict, margin: float, rule: str):
     eligible = {frozenset(k.split("+")): v for k, v in tried.items() if k not in set_aside}
-    needed = {}
-    for group in eligible:
-        if len(group) < 2:
-            continue
-        smaller = min((v for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
-        standing = max(1, sum(1 for e in group if not requires[e] & group))
-        needed[group] = min((1 - margin) * smaller, (1 - standing * margin) * current)
+    needed = group_needs(requires, eligible, current, margin)
     earned = [g for g in needed if eligible[g] <= needed[g]]
     if earned:
         key = (lambda g: eligible[g] / needed[g]) if rule == "furthest under need" else eligible.get
