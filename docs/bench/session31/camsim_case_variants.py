@@ -22,8 +22,6 @@ import os
 import sys
 import time
 
-import torch
-
 from lerobot_phantom.calibration import projection
 from lerobot_phantom.calibration.core import Effect, Param
 from lerobot_phantom.calibration.frame_models import light_projection
@@ -51,22 +49,15 @@ def offer_projector_gamma() -> None:
     def predict(surface, projected, strength, effects, params):
         if "projector_gamma" not in effects:
             return library_predict(surface, projected, strength, effects, params)
-        decode, encode = projection.tone_curve(effects, params)
-        surface_lin = decode(surface)
-        light = projected.clamp(min=1e-12) ** params["projector_gamma"]
-        if "channel_crosstalk" in effects:
-            names = projection.CROSSTALK_NAMES
-            matrix = torch.stack([torch.as_tensor(params[n], dtype=surface.dtype) for n in names]).reshape(
-                3, 3
-            )
-            light = light @ matrix.T
-        light = strength * light * (1.0 if "channel_crosstalk" in effects else params["strength"])
-        if "albedo_modulation" in effects:
-            light = light * (surface_lin + params["reflectance_floor"]).clamp(min=0.0)
-        total = surface_lin + light
-        if "clipping" in effects:
-            total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
-        return encode(total).clamp(0.0, 1.0)
+        # the library decodes the pattern through the camera's curve: hand it the projector's light encoded by it
+        _, encode = projection.tone_curve(effects, params)
+        return library_predict(
+            surface,
+            encode(projected.clamp(min=1e-12) ** params["projector_gamma"]),
+            strength,
+            effects,
+            params,
+        )
 
     light_projection.ProjectionFrames.candidates = (*projection.EFFECTS, PROJECTOR_GAMMA)
     projection.projection_specs = specs
