@@ -85,6 +85,21 @@ EFFECTS = (
     ),
 )
 
+# frame pairs only: a colour-triple table has no neighbouring pixels for light to spread to
+LIGHT_SPREAD = Effect(
+    "light_spread",
+    "the projected light reaches the sensor spread over neighbouring pixels (a projector out of focus on the "
+    "surface, the camera lens's point spread, demosaicing): a pattern recorded as the frame the projector was sent "
+    "has sharper edges than the light the camera sees. Modelled as a Gaussian spread of the projected light before "
+    "it meets the surface (physics.gaussian_spread); the camera's spread of the scene's own light is already in "
+    "the clean frame",
+    requires=("additive_light",),
+)
+FRAME_EFFECTS = (*EFFECTS, LIGHT_SPREAD)
+# the widest spread a fit considers, standard deviation in pixels at the 256-pixel reference (3% of the frame's
+# longer side): wider than defocus and lens blur that leave a pattern recognisable, and the fit's kernel grows with it
+SPREAD_HIGH_REF_PX = 8.0
+
 CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
 
 
@@ -114,6 +129,8 @@ def projection_specs(effects: frozenset[str]) -> list[Param]:
         specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
     if "tone_shoulder" in effects:
         specs += list(SHOULDER_PARAMS)
+    if "light_spread" in effects:
+        specs.append(Param("spread_ref_px", 2.0, 0.0, SPREAD_HIGH_REF_PX, scale=1.0))
     return specs
 
 
@@ -127,6 +144,8 @@ def projection_nulls(effect: str) -> dict[str, float]:
         return {"gamma": 1.0}
     if effect == "tone_shoulder":  # a knee at infinite light: the power law (or identity) without it
         return {"shoulder": 0.0}
+    if effect == "light_spread":
+        return {"spread_ref_px": 0.0}
     return {}
 
 
@@ -142,11 +161,20 @@ def tone_curve(effects, params: dict):
 
 
 def projection_predict(
-    surface: torch.Tensor, projected: torch.Tensor, strength: torch.Tensor, effects, params: dict[str, float]
+    surface: torch.Tensor,
+    projected: torch.Tensor,
+    strength: torch.Tensor,
+    effects,
+    params: dict[str, float],
+    *,
+    projected_light: torch.Tensor | None = None,
 ) -> torch.Tensor:
-    """Captured colour (N, 3) in [0, 1] from surface colour, projected colour (N, 3) and strength (N, 1)."""
+    """Captured colour (N, 3) in [0, 1] from surface colour, projected colour (N, 3) and strength (N, 1).
+    ``projected_light``: the projected colour already decoded to linear light (and spread over its neighbours, which
+    the caller sees and this function does not), in place of decoding ``projected``."""
     decode, encode = tone_curve(effects, params)
-    surface_lin, light = decode(surface), decode(projected)
+    surface_lin = decode(surface)
+    light = decode(projected) if projected_light is None else projected_light
     if "channel_crosstalk" in effects:
         matrix = torch.stack(
             [torch.as_tensor(params[n], dtype=surface.dtype) for n in CROSSTALK_NAMES]
@@ -208,6 +236,8 @@ def projection_kwargs(fit: Fit) -> dict:
         kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
+    if "light_spread" in effects:
+        kwargs["spread"] = p["spread_ref_px"]
     return kwargs
 
 

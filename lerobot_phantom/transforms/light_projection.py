@@ -167,15 +167,22 @@ class LightProjection(CameraAttack):
         crosstalk: Sequence[Sequence[float]] | None = None,
         white: float = 1.0,
         gamma: float | None = 1.0,
+        spread: float = 0.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "light projection transparency", upper=1.0)
         # model="additive"/"blend" (lerobot-phantom-calibrate): projector light at strength x intensity through
-        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve)
+        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve, spread over ``spread`` pixels
+        # at the 256-pixel reference, scaled by max(H, W) / 256)
         if model not in ("paper", "additive", "blend"):
             raise ValueError(f"unknown light projection model {model!r}; valid: 'paper', 'additive', 'blend'")
+        if spread < 0.0 or (spread > 0.0 and model == "paper"):
+            raise ValueError(
+                f"spread={spread!r}: the projected light's spread is >= 0 reference pixels and only spreads light "
+                "in the physical models (model='additive' or 'blend'); the paper's watermark has sharp edges"
+            )
         matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float32)
         if matrix is not None and matrix.shape != (3, 3):
             raise ValueError(f"crosstalk must be a 3x3 matrix, got shape {tuple(matrix.shape)}")
@@ -187,6 +194,7 @@ class LightProjection(CameraAttack):
             "crosstalk": matrix,
             "white": float(white),
             "gamma": None if gamma is None else float(gamma),
+            "spread": float(spread),
         }
         if size is None or size == "native":
             size = None
@@ -277,6 +285,7 @@ class LightProjection(CameraAttack):
                 crosstalk=p["crosstalk"],
                 white=p["white"],
                 gamma=p["gamma"],
+                spread_px=p["spread"] * max(height, width) / REFERENCE_SIZE,
                 blend=self.model == "blend",
             )
         return composite(x, rgba, params["transparency"], top, left)

@@ -16,6 +16,7 @@ from __future__ import annotations
 import math
 
 import torch
+import torch.nn.functional as F
 
 # ---------------------------------------------------------------------------------------------------------------
 # tone curves
@@ -152,6 +153,29 @@ def saturation_radius(
     return 0.5 * (lo + hi)
 
 
+def gaussian_spread(
+    x: torch.Tensor, sigma_px: float | torch.Tensor, *, radius: int | None = None
+) -> torch.Tensor:
+    """Light spread over neighbouring pixels by a Gaussian point spread of standard deviation ``sigma_px`` pixels
+    (one value, or ``(B,)`` per image) on ``(B, C, H, W)`` linear light; pixels beyond the border repeat the edge.
+
+    ``radius`` is the kernel's half width (default 3 sigma): a fit passes the widest its bound allows, so the kernel's
+    shape never depends on the value being fitted. Not torchvision's ``gaussian_blur``: calibration fits sigma by
+    autograd, and torchvision takes it as a Python float. A spread of 0 is the identity."""
+    batch, channels, height, width = x.shape
+    sigma = _as(sigma_px, x).reshape(-1).expand(batch)
+    if radius is None:
+        radius = max(1, math.ceil(3.0 * float(sigma.max())))
+    taps = torch.arange(-radius, radius + 1, dtype=x.dtype, device=x.device)
+    # the narrowest kernel is a single tap: a spread of 0 divides by nothing
+    kernel = torch.exp(-0.5 * (taps / sigma.clamp(min=1e-3)[:, None]) ** 2)
+    kernel = (kernel / kernel.sum(dim=1, keepdim=True)).repeat_interleave(channels, dim=0)
+    planes = F.pad(x.reshape(1, batch * channels, height, width), (radius,) * 4, mode="replicate")
+    planes = F.conv2d(planes, kernel[:, None, None, :], groups=batch * channels)
+    planes = F.conv2d(planes, kernel[:, None, :, None], groups=batch * channels)
+    return planes.reshape(batch, channels, height, width)
+
+
 def project_light(
     x: torch.Tensor,
     pattern: torch.Tensor,
@@ -162,18 +186,23 @@ def project_light(
     crosstalk: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
     gamma: float | torch.Tensor | None = 1.0,
+    spread_px: float | torch.Tensor = 0.0,
     blend: bool = False,
 ) -> torch.Tensor:
     """Projector light on a surface seen by a camera: light adds, it never blends (``blend=True`` keeps the
     paper's blend, ``(1 - strength) * scene + strength * light``, with the other terms).
 
     The projected colour ``pattern`` (encoded, like an image; black = no light) reaches the camera as
-    ``crosstalk @ rgb`` (3x3: the projector's primaries seen through the camera's filters), scaled by ``strength``
-    and, with ``albedo``, by the surface's reflectance estimated from its colour (``scene + reflectance_floor``).
-    The sum clips at ``white`` and is re-encoded; ``gamma`` as in ``decode`` (1 = compose the encoded values).
+    ``crosstalk @ rgb`` (3x3: the projector's primaries seen through the camera's filters), spread over
+    ``spread_px`` pixels (``gaussian_spread``: a projector out of focus on the surface, the lens's point spread),
+    scaled by ``strength`` and, with ``albedo``, by the surface's reflectance estimated from its colour
+    (``scene + reflectance_floor``). The sum clips at ``white`` and is re-encoded; ``gamma`` as in ``decode``
+    (1 = compose the encoded values).
     """
     scene = decode(x, gamma)
     light = decode(pattern, gamma)
+    if isinstance(spread_px, torch.Tensor) or spread_px > 0.0:
+        light = gaussian_spread(light, spread_px)
     if crosstalk is not None:
         light = torch.einsum(
             "ij,bjhw->bihw", torch.as_tensor(crosstalk, dtype=light.dtype, device=light.device), light

@@ -359,3 +359,28 @@ RENDERERS = {
     "ultrasound_blur": render_ultrasound_blur,
     "em_color_strip": render_em_color_strip,
 }
+
+
+def projection_pairs_with_spread_light(spread_px: float, seed: int = 0) -> list:
+    """Light projection pairs whose projected light reaches the sensor blurred by ``spread_px`` (a Gaussian), where
+    the recorded pattern is the sharp frame the projector was sent; encoded values add (no tone curve), so
+    additive light at the true strength leaves only the spread light and a little noise. The blur is scipy's, not
+    the package's."""
+    import torch
+
+    from lerobot_phantom.calibration.frame_models.common import Pair
+
+    rng = np.random.default_rng(seed)
+    pairs = []
+    for index in range(6):
+        clean = ndimage.gaussian_filter(rng.uniform(0.1, 0.5, (3, 40, 50)), sigma=(0, 4, 4))
+        pattern = np.zeros((3, 40, 50))
+        for _ in range(3):
+            top, left = rng.integers(0, 30), rng.integers(0, 40)
+            pattern[rng.integers(3), top : top + 10, left : left + 10] = 1.0
+        light = ndimage.gaussian_filter(pattern, sigma=(0, spread_px, spread_px)) if spread_px else pattern
+        attacked = clean + 0.4 * light + rng.normal(0.0, 0.004, clean.shape)
+        pairs.append(
+            Pair(f"p{index}", *(torch.from_numpy(a) for a in (clean, attacked.clip(0, 1), pattern)), 1.0)
+        )
+    return pairs

@@ -34,6 +34,10 @@ NOISE = frozenset({"shot_noise"})
 LINEAR_LIGHT = frozenset({"shot_noise", "sensor_gamma"})
 # a filmic camera's tone curve has a highlight shoulder: where light adds in linear irradiance, naming it is true
 SHOULDERED_TONES = frozenset({"filmic"})
+# a pattern recorded as the frame the projector was sent is sharp, while camsim's optics (its PSF) and demosaicing
+# spread the projector's light in the attacked frame: naming that spread is true (a board capture went through the
+# same optics, so there the light is recorded spread and naming it is not)
+EMITTED_PATTERN = LINEAR_LIGHT | {"light_spread"}
 
 
 @dataclass(frozen=True)
@@ -139,7 +143,7 @@ CASES = [
             pattern_record="emitted",
         ),
         planted=frozenset({"additive_light", "albedo_modulation", "channel_crosstalk"}),
-        tolerated=LINEAR_LIGHT,
+        tolerated=EMITTED_PATTERN,
     ),
     Case(
         "projection_clipping",
@@ -153,7 +157,7 @@ CASES = [
             rng, cam, N_PAIRS, power=rng.uniform(6.0, 12.0), pattern_record="emitted"
         ),
         planted=frozenset({"additive_light", "albedo_modulation", "clipping"}),
-        tolerated=LINEAR_LIGHT,
+        tolerated=EMITTED_PATTERN,
         # the full well fills 75-92% of the ADC's range (camsim.Camera.well_share_of_adc), so a saturated pixel is
         # written at 225-246 under sRGB. Saturation at the file's maximum (share 1) is in every model: nothing to
         # find. The camera is sRGB because a filmic shoulder writes that headroom within 2 grey levels of the

@@ -4,10 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-import torch
+from calibration_testkit import projection_pairs_with_spread_light
 
 from lerobot_phantom.calibration.core import Fit, binned_rmse
-from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.structure import ResidualSample, residual_structure
 
@@ -180,28 +179,6 @@ def test_a_few_held_out_items_outside_the_fit_errors_are_reported_by_name(seed):
     result = residual_structure(clean, None, heldout, base_mse=191.0**2, rng=rng, fit_items=fit_items)
     assert not result["structure_remains"], result["summary"]
     assert next(t for t in result["tests"] if t["variable"] == "items")["outlying_items"] == []
-
-
-def projection_pairs_with_spread_light(spread_px: float, seed: int = 0) -> list:
-    """Light projection pairs whose projected light reaches the sensor blurred by ``spread_px`` (a Gaussian), where
-    the recorded pattern is the sharp frame the projector was sent; encoded values add (no tone curve), so
-    additive light at the true strength leaves only the spread light and a little noise."""
-    from scipy import ndimage
-
-    rng = np.random.default_rng(seed)
-    pairs = []
-    for index in range(6):
-        clean = ndimage.gaussian_filter(rng.uniform(0.1, 0.5, (3, 40, 50)), sigma=(0, 4, 4))
-        pattern = np.zeros((3, 40, 50))
-        for _ in range(3):
-            top, left = rng.integers(0, 30), rng.integers(0, 40)
-            pattern[rng.integers(3), top : top + 10, left : left + 10] = 1.0
-        light = ndimage.gaussian_filter(pattern, sigma=(0, spread_px, spread_px)) if spread_px else pattern
-        attacked = clean + 0.4 * light + rng.normal(0.0, 0.004, clean.shape)
-        pairs.append(
-            Pair(f"p{index}", *(torch.from_numpy(a) for a in (clean, attacked.clip(0, 1), pattern)), 1.0)
-        )
-    return pairs
 
 
 @pytest.mark.parametrize("spread_px", [0.0, 1.0, 2.0])

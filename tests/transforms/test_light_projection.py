@@ -176,6 +176,28 @@ def test_bad_arguments_raise():
         light_projection(torch.zeros(3, 4, 4), torch.zeros(3, 2, 2), 0.5)
 
 
+def test_spread_of_the_projected_light_is_in_reference_pixels():
+    image = torch.full((1, 3, 128, 128), 0.2)
+    options = {"model": "additive", "pattern": "disk", "size": 0.5, "strength": 0.5}  # no pixel reaches white
+    sharp = LightProjection("strong", **options)(image)
+    soft = LightProjection("strong", **options, spread=6.0)(image)
+    assert not torch.equal(sharp, soft)
+
+    # the disk's edge along the middle row: the spread light's 10-90% rise is 2.56 sigma wide, with sigma
+    # 6 reference pixels = 3 pixels at 128, so 7.7 pixels; the sharp edge is one step
+    def rise(out: torch.Tensor) -> int:
+        row = out[0, 1, 64, :64]
+        low, high = float(row.min()), float(row.max())
+        level = (row - low) / (high - low)
+        return int(((level > 0.1) & (level < 0.9)).sum())
+
+    assert rise(sharp) <= 1 and 7 <= rise(soft) <= 9
+    with pytest.raises(ValueError, match="'additive' or 'blend'"):
+        LightProjection(spread=2.0)
+    with pytest.raises(ValueError, match=">= 0"):
+        LightProjection(model="additive", spread=-1.0)
+
+
 def test_watermark_fully_outside_is_identity():
     img = _random_uint8((3, 16, 16), seed=3)
     out = LightProjection("strong", x_offset=10_000)(img)

@@ -86,6 +86,43 @@ def test_projected_light_on_black_surface_vanishes_with_albedo():
     )  # red light seen in the green channel
 
 
+@pytest.mark.parametrize("sigma", [0.6, 1.3, 2.5])
+def test_gaussian_spread_is_scipys_gaussian_filter_with_edges_repeated(sigma):
+    from scipy import ndimage
+
+    light = torch.rand(2, 3, 17, 23, generator=torch.Generator().manual_seed(7), dtype=torch.float64)
+    spread = physics.gaussian_spread(light, sigma)
+    expected = ndimage.gaussian_filter(
+        light.numpy(), sigma=(0, 0, sigma, sigma), mode="nearest", truncate=3.0
+    )
+    # scipy truncates at int(3 sigma + 0.5) pixels, the kernel here at ceil(3 sigma): the tails differ by < 0.3%
+    assert torch.allclose(spread, torch.from_numpy(expected), atol=3e-3)
+    assert torch.allclose(physics.gaussian_spread(light, 0.0, radius=4), light)  # no spread: the identity
+
+
+def test_gaussian_spread_per_image_and_its_derivative_in_sigma():
+    spot = torch.zeros(2, 1, 9, 9, dtype=torch.float64)
+    spot[:, :, 4, 4] = 1.0
+    spread = physics.gaussian_spread(spot, torch.tensor([0.0, 1.0], dtype=torch.float64), radius=4)
+    assert float(spread[0, 0, 4, 4]) == 1.0 and float(spread[1, 0, 4, 4]) < 0.2
+    assert torch.allclose(spread.sum(dim=(2, 3)), torch.ones(2, 1, dtype=torch.float64))  # light is conserved
+    # the peak of a 2-D Gaussian is 1 / (2 pi sigma^2): d/dsigma = -1 / (pi sigma^3)
+    peak = torch.func.jacfwd(lambda s: physics.gaussian_spread(spot[:1], s, radius=4)[0, 0, 4, 4])
+    assert float(peak(torch.tensor(1.0, dtype=torch.float64))) == pytest.approx(-1.0 / math.pi, rel=0.01)
+
+
+def test_projected_light_spreads_before_it_meets_the_surface():
+    surface = torch.full((1, 3, 16, 16), 0.2)
+    pattern = torch.zeros(1, 3, 16, 16)
+    pattern[..., 8:] = 1.0  # a sharp vertical edge
+    sharp = physics.project_light(surface, pattern, 0.5)
+    soft = physics.project_light(surface, pattern, 0.5, spread_px=1.5)
+    assert torch.equal(physics.project_light(surface, pattern, 0.5, spread_px=0.0), sharp)
+    # light crosses the edge: the dark side brightens, the lit side dims, far from it nothing changes
+    assert float(soft[0, 0, 8, 7]) > 0.3 and float(soft[0, 0, 8, 8]) < 0.6
+    assert torch.allclose(soft[..., :3], sharp[..., :3]) and torch.allclose(soft[..., 13:], sharp[..., 13:])
+
+
 def test_rolling_shutter_rows_match_overlap_formula():
     f, duty, exposure, row_time = torch.tensor([30.0]), torch.tensor([0.1]), torch.tensor([0.002]), 5e-5
     # whole stripes only ("interior" frames, one stripe per frame): (on time + exposure) / row time

@@ -2,15 +2,26 @@
 
 from __future__ import annotations
 
+import math
+
 import torch
 
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair, PixelProblem, flat_pixels
-from lerobot_phantom.calibration.projection import ProjectionTerms, projection_predict, projection_warm
+from lerobot_phantom.calibration.projection import (
+    FRAME_EFFECTS,
+    SPREAD_HIGH_REF_PX,
+    ProjectionTerms,
+    projection_predict,
+    projection_warm,
+    tone_curve,
+)
+from lerobot_phantom.transforms.physics import gaussian_spread
 
 
 class ProjectionFrames(ProjectionTerms, PixelProblem):
     base_model = "alpha blend of the scene and the projected image (the paper's light projection)"
+    candidates = FRAME_EFFECTS
     # a filmic camera's shoulder and the surface's reflectance pay only together: without the reflectance term the
     # shoulder's fit runs its knee to a hard clip (exponent at its bound), and without the shoulder the reflectance
     # term's floor runs to its end (camsim master seed 458072150: additive light alone 3.87 grey levels, + shoulder
@@ -23,6 +34,8 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
                 "light_projection frame pairs need a 'pattern' column: the image the attacker projected"
             )
         super().__init__(pairs, seed)
+        # one kernel for every value a fit tries: as wide as the widest spread at the smallest working scale
+        self.spread_radius = max(math.ceil(3.0 * SPREAD_HIGH_REF_PX / p.to_reference) for p in pairs)
 
     def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
         pair = self.pairs[index]
@@ -31,10 +44,40 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
             "surface": surface,
             "projected": flat_pixels(pair.pattern, pixels),
             "strength": torch.full((len(surface), 1), pair.intensity, dtype=torch.float64),
+            # light_spread needs each pixel's neighbours: the pair's whole pattern, and which pixels the rows are
+            "pair": torch.tensor([index]),
+            "pixel": torch.arange(pair.height * pair.width)
+            if pixels is None
+            else torch.as_tensor(pixels).long(),
+            "pixel_count": torch.tensor([len(surface)]),
         }
 
+    def spread_light(self, effects, params, feats) -> torch.Tensor:
+        """Each row's projected light in linear light, spread over its neighbours (``light_spread``)."""
+        decode, _ = tone_curve(effects, params)
+        pairs = feats["pair"].tolist()
+        rows = torch.split(feats["pixel"], feats["pixel_count"].tolist())
+        light = [None] * len(pairs)
+        # pairs of one size spread together (one convolution), pairs resized to other sizes apart
+        for shape in {self.pairs[i].pattern.shape for i in pairs}:
+            members = [k for k, i in enumerate(pairs) if self.pairs[i].pattern.shape == shape]
+            patterns = torch.stack([self.pairs[pairs[k]].pattern for k in members])
+            scales = torch.tensor([self.pairs[pairs[k]].to_reference for k in members], dtype=torch.float64)
+            sigma = params["spread_ref_px"] / scales
+            spread = gaussian_spread(decode(patterns), sigma, radius=self.spread_radius).flatten(2)
+            for j, k in enumerate(members):
+                light[k] = spread[j][:, rows[k]].T
+        return torch.cat(light)
+
     def predict_features(self, effects, params, feats):
-        return projection_predict(feats["surface"], feats["projected"], feats["strength"], effects, params)
+        return projection_predict(
+            feats["surface"],
+            feats["projected"],
+            feats["strength"],
+            effects,
+            params,
+            projected_light=self.spread_light(effects, params, feats) if "light_spread" in effects else None,
+        )
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
