@@ -8,6 +8,13 @@ Every model's output is clipped to the file's range (no camera writes more than 
 sensor that saturates *below* the file's maximum (a white level < 1, e.g. video range or white-balance gains
 applied after the raw clip), so saturation exactly at the file's maximum is part of every model and is never
 named as a cause.
+
+Frame pairs can show one effect a table cannot: the projected light spread over neighbouring pixels
+(``light_spread``). A projector is seldom in focus on every surface it lights, and the camera's lens and
+demosaicing spread light further, so a pattern recorded as the frame the projector was sent has sharper edges than
+the light in the attacked frame. Light spread across a bright edge is signed (too much predicted on its bright side,
+too little on its dark side), so no per-pixel term absorbs it; camsim's optics blur of an emitted pattern hid
+clipping under it (docs/bench/session31.md, session32.md).
 """
 
 from __future__ import annotations

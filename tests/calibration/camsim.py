@@ -406,6 +406,7 @@ def light_projection_pairs(
     digital_alpha: float | None = None,
     falloff: float = 0.0,
     pattern_record: str = "board",
+    reflectance_modulated: bool = True,
 ) -> list[FramePair]:
     """Light projection pairs; the pattern is the projector's frame captured on a white board in the dark
     (``pattern_record="board"``) or the frame the projector was sent (``"emitted"``, what SLAP's tables record as
@@ -418,7 +419,9 @@ def light_projection_pairs(
     reflectance * irradiance, so bright projector light on a bright surface saturates. ``digital_alpha``: the paper's
     overlay with transparency t = digital_alpha * intensity in output space (null). ``falloff``: the projected light
     loses this share at the frame corner (projector lens vignetting), which the recorded pattern does not show (the
-    board was captured with a different lens-to-board geometry): an effect the library has no name for."""
+    board was captured with a different lens-to-board geometry): an effect the library has no name for.
+    ``reflectance_modulated=False`` is a counterfactual for measuring what the reflectance term changes (benches
+    only): every surface returns the projector's light as the scene's mean reflectance would."""
     mix = np.eye(3) + crosstalk * rng.uniform(0.5, 1.5, (3, 3)) * (1 - np.eye(3))
     board = 0.85
     session = Session(cam)
@@ -440,7 +443,8 @@ def light_projection_pairs(
             blend = (1 - t) * quantised(attacked) + t * pattern_u8 / 255.0
             attacked_u8 = encode(blend, cam)
         else:
-            irradiance = refl * (light + intensity * power * projector)
+            returned = refl if reflectance_modulated else refl.mean()
+            irradiance = refl * light + returned * intensity * power * projector
             attacked, _ = capture(irradiance, cam, rng, exposure=exposure)
             attacked_u8 = encode(attacked, cam)
         pairs.append(FramePair(encode(clean, cam), attacked_u8, float(intensity), pattern_u8))

@@ -451,6 +451,9 @@ def test_case(name, root):
     "(projection_crosstalk 3 times, projection_additive twice; docs/bench/session30.md). Session 31: the additive "
     "misses fixed (a step takes the lowest-scoring group that earns it); 34 of 42 on four fresh seeds, failing on "
     "three (projection_crosstalk on filmic cameras, projection_clipping, blinding_halo; docs/bench/session31.md). "
+    "Session 32: light projection frames offered light_spread (the projected light spread over neighbouring pixels, "
+    "which hid the clip under camsim's optics blur); 43 of 44 on four fresh seeds, passing on all four; the miss: "
+    "projection_crosstalk on a filmic camera, reflectance not named (docs/bench/session32.md). "
     "History and measurements: the README, 'Tested against an independent camera simulator', and "
     "docs/bench/camsim_session*.md",
     strict=False,
