@@ -32,7 +32,10 @@ def main() -> None:
     for name in cases:
         for master, _sim, _case, _seed, _rng, camera in case_draws(name, seeds):
             gamma = f" {camera.tone_gamma:.2f}" if camera.tone == "power" else ""
-            print(f"master {master} {name}: tone {camera.tone}{gamma}, full well {camera.full_well_e:.0f} e")
+            print(
+                f"master {master} {name}: tone {camera.tone}{gamma}, full well {camera.full_well_e:.0f} e, "
+                f"PSF core sigma {camera.psf_sigma_px:.2f} px"
+            )
 
 
 if __name__ == "__main__":

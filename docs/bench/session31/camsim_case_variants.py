@@ -1,5 +1,5 @@
 """One camsim core case, rendered and calibrated as ``tests/calibration/test_independent_sim.py`` does for a master
-seed, as tested or in one of two variants (session 31's diagnosis; neither variant is in the package or the test):
+seed, as tested or in one of three variants (sessions 31 and 32; no variant is in the package or the test):
 
 - ``as_tested``: the case itself;
 - ``no_psf``: the camera's optics blur switched off (core sigma 0.05 px, no wide part) after the camera's draws, so
@@ -7,6 +7,13 @@ seed, as tested or in one of two variants (session 31's diagnosis; neither varia
 - ``projector_gamma``: light projection is also offered a projector transfer term (a prototype): the pattern is
   the frame the projector was sent, its light that frame through the projector's own display gamma
   (``projector_gamma``, 1-3.5) instead of through the camera's tone curve.
+- ``library_curve`` (session 32): camsim's filmic curve (ACES on a 4x pre-gain, then sRGB) replaced by the library's
+  own shoulder form at its closest fit to it (shoulder 38.8, knee exponent 1.19, no display gamma: 0.48 grey levels
+  RMS, ``camsim_session15/filmic_shoulder_fit.txt``): is reflectance named when the camera's curve is in the
+  library's family?
+- ``pattern_gamma`` (session 32): models that compose linear light (``sensor_gamma`` or ``tone_shoulder``) take an
+  emitted pattern's light as the frame through camsim's projector gamma (``frame ** 2.2``) instead of decoding it
+  through the fitted camera curve.
 
 Usage: ``PYTHONPATH=. CAMSIM_SEED=0 python docs/bench/session31/camsim_case_variants.py CASE MASTER_SEED ROOT MODE``
 from the repository root (``CAMSIM_SEED`` only has to exist for the import; MASTER_SEED replaces it). Prints the
@@ -22,13 +29,20 @@ import os
 import sys
 import time
 
+import numpy as np
+import torch
+
 from lerobot_phantom.calibration import projection
 from lerobot_phantom.calibration.core import Effect, Param
 from lerobot_phantom.calibration.frame_models import light_projection
+from lerobot_phantom.calibration.tone import shoulder_encode
 
 sys.path.insert(0, "tests/calibration")
 
-MODES = ("as_tested", "no_psf", "projector_gamma")
+MODES = ("as_tested", "no_psf", "projector_gamma", "library_curve", "pattern_gamma")
+CAMSIM_PROJECTOR_GAMMA = 2.2
+LINEAR_LIGHT_FORMS = frozenset({"sensor_gamma", "tone_shoulder"})
+CLOSEST_SHOULDER = {"shoulder": 38.8, "shoulder_exponent": 1.19}
 PROJECTOR_GAMMA = Effect(
     "projector_gamma",
     "the pattern is the frame the projector was sent: its light is that frame through the projector's own display "
@@ -65,12 +79,56 @@ def offer_projector_gamma() -> None:
     light_projection.projection_predict = predict
 
 
+def use_library_curve() -> None:
+    camsim = importlib.import_module("camsim")
+    camsim_curve = camsim.tone_curve
+
+    def library_family(linear, cam):
+        if cam.tone != "filmic":
+            return camsim_curve(linear, cam)
+        linear = torch.from_numpy(np.clip(linear, 0.0, 1.0).astype(np.float64))
+        return shoulder_encode(linear, CLOSEST_SHOULDER).numpy()
+
+    camsim.tone_curve = library_family
+
+
+def decode_pattern_by_projector_gamma() -> None:
+    frames = light_projection.ProjectionFrames
+    library_curve, library_predict = projection.tone_curve, frames.predict_features
+
+    def projector_light(pattern):
+        return pattern.clamp(min=0.0) ** CAMSIM_PROJECTOR_GAMMA
+
+    def pattern_curve(effects, params):  # what the spread path decodes the whole pattern with
+        decode, encode = library_curve(effects, params)
+        return (projector_light if LINEAR_LIGHT_FORMS & effects else decode), encode
+
+    def predict(self, effects, params, feats):
+        if "light_spread" in effects or not LINEAR_LIGHT_FORMS & effects:
+            return library_predict(self, effects, params, feats)
+        return projection.projection_predict(
+            feats["surface"],
+            feats["projected"],
+            feats["strength"],
+            effects,
+            params,
+            projected_light=projector_light(feats["projected"]),
+        )
+
+    light_projection.tone_curve = pattern_curve
+    frames.predict_features = predict
+
+
 def main(name: str, seed: str, root: str, mode: str) -> None:
     if mode not in MODES:
         raise SystemExit(f"mode {mode!r}: valid modes are {', '.join(MODES)}")
     os.environ["CAMSIM_SEED"] = seed
     if mode == "projector_gamma":
         offer_projector_gamma()
+    if mode == "library_curve":
+        use_library_curve()
+    if mode == "pattern_gamma":
+        decode_pattern_by_projector_gamma()
     sim = importlib.import_module("test_independent_sim")
     if mode == "no_psf":
         drawn_camera = sim.random_camera
