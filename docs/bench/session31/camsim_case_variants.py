@@ -1,5 +1,5 @@
 """One camsim core case, rendered and calibrated as ``tests/calibration/test_independent_sim.py`` does for a master
-seed, as tested or in one of five variants (sessions 31 and 32; no variant is in the package or the test):
+seed, as tested or in one of six variants (sessions 31 and 32; no variant is in the package or the test):
 
 - ``as_tested``: the case itself;
 - ``no_psf``: the camera's optics blur switched off (core sigma 0.05 px, no wide part) after the camera's draws, so
@@ -16,6 +16,7 @@ seed, as tested or in one of five variants (sessions 31 and 32; no variant is in
   through the fitted camera curve.
 - ``pattern_gamma_4`` (session 32): ``pattern_gamma`` with light projection selection scoring groups of up to four
   new effects (``joint_effects = 4``), so additive light + shoulder + cross-talk + reflectance can be scored at once.
+- ``groups_4`` (session 32): the case as tested, but light projection selection scores groups of up to four.
 
 Usage: ``PYTHONPATH=. CAMSIM_SEED=0 python docs/bench/session31/camsim_case_variants.py CASE MASTER_SEED ROOT MODE``
 from the repository root (``CAMSIM_SEED`` only has to exist for the import; MASTER_SEED replaces it). Prints the
@@ -41,7 +42,15 @@ from lerobot_phantom.calibration.tone import shoulder_encode
 
 sys.path.insert(0, "tests/calibration")
 
-MODES = ("as_tested", "no_psf", "projector_gamma", "library_curve", "pattern_gamma", "pattern_gamma_4")
+MODES = (
+    "as_tested",
+    "no_psf",
+    "projector_gamma",
+    "library_curve",
+    "pattern_gamma",
+    "pattern_gamma_4",
+    "groups_4",
+)
 CAMSIM_PROJECTOR_GAMMA = 2.2
 LINEAR_LIGHT_FORMS = frozenset({"sensor_gamma", "tone_shoulder"})
 CLOSEST_SHOULDER = {"shoulder": 38.8, "shoulder_exponent": 1.19}
@@ -131,7 +140,7 @@ def main(name: str, seed: str, root: str, mode: str) -> None:
         use_library_curve()
     if mode in ("pattern_gamma", "pattern_gamma_4"):
         decode_pattern_by_projector_gamma()
-    if mode == "pattern_gamma_4":
+    if mode in ("pattern_gamma_4", "groups_4"):
         light_projection.ProjectionFrames.joint_effects = 4
     sim = importlib.import_module("test_independent_sim")
     if mode == "no_psf":
