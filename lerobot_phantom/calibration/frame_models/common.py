@@ -16,7 +16,6 @@ import numpy as np
 import pandas as pd
 import torch
 from PIL import Image
-from scipy import ndimage
 from scipy.special import logsumexp
 
 from lerobot_phantom.calibration.core import (
@@ -29,6 +28,7 @@ from lerobot_phantom.calibration.core import (
     further_starts,
 )
 from lerobot_phantom.calibration.structure import LAG, ResidualSample
+from lerobot_phantom.transforms.physics import gaussian_spread
 
 REFERENCE_SIZE = 256
 
@@ -325,10 +325,8 @@ def pattern_detail(pattern: torch.Tensor) -> np.ndarray:
     pattern's edges on its way to the sensor (optics blur, a projector's defocus), which no model term spreads,
     leaves a residual that follows this variable (camsim's optics blur of an emitted projector frame:
     docs/bench/session31.md)."""
-    values = 255.0 * pattern.double().numpy()
-    return values - ndimage.gaussian_filter(
-        values, sigma=(0, DETAIL_SIGMA_PX, DETAIL_SIGMA_PX), mode="nearest"
-    )
+    values = 255.0 * pattern.double()
+    return (values - gaussian_spread(values[None], DETAIL_SIGMA_PX)[0]).numpy()
 
 
 def flat_pixels(image: torch.Tensor, pixels: torch.Tensor | None) -> torch.Tensor:
