@@ -4,7 +4,10 @@ Base (the paper): a fixed band of rows whatever the laser and exposure settings 
 H/3). Extensions follow the rolling shutter term by term (``physics.rolling_shutter_rows_lit`` documents each):
 row readout time, the pulse/exposure overlap, the sensor's extra integration time, the detection threshold that
 drops partly lit rows, blooming at stripe edges, and the phase drift of a recording whose laser beats slowly with
-the frame rate (``phase_drift``: one drift per recording, the rows of one laser frequency and exposure setting).
+the frame rate (``phase_drift``: one drift per recording, the rows of one laser frequency and exposure setting;
+``drift_from_entry``: each video of it begins as its stripes come whole into view). "Recording" here is that duty-
+cycle sweep: the measured tables ("They See Me Rollin'", ``rsa/profile.py``) hold one video per row, and the model
+assumes the videos of one sweep share the beat of the laser and frame clocks.
 Every prediction is an expectation over the pulse phase (the phase of one frame cannot be known in advance: uniform,
 or a whole-stripe placement and the recording's drift from it), so no held-out row informs its own prediction; a
 recording's drift is fitted on its fit rows only.
@@ -84,7 +87,15 @@ EFFECTS = (
         "each recording (the rows of one laser frequency and exposure setting)",
         requires=("exposure_overlap",),
     ),
+    Effect(
+        "drift_from_entry",
+        "a drifting recording begins at the first frame that shows its stripes whole, as they come into view (a "
+        "recording started once the stripe is in view), not at any whole placement: its stripes cross the frame's "
+        "whole free span before an edge cuts them, so a small drift cuts only stripes that nearly fill the frame",
+        requires=("phase_drift",),
+    ),
 )
+DRIFT_EFFECTS = ("phase_drift", "drift_from_entry")
 # a recording's drift, as a share of the laser period, is searched on this grid before the joint fit: at 0 the
 # error is flat in it (a small drift cuts no stripe), so a fit started there never leaves
 DRIFT_GRID = np.concatenate([[0.0], np.geomspace(0.01, 1.0, 24)])
@@ -289,8 +300,8 @@ class StripeProblem(Problem):
         self.exposure_setting = meta["exposure_setting"]
         self.rows = meta["rows"]
         self.spread = meta["spread"]
-        # a recording: the rows of one laser frequency and exposure setting (a duty-cycle sweep), which share the
-        # phase relation of the laser and frame clocks
+        # a recording: the rows of one laser frequency and exposure setting (a duty-cycle sweep, one video per row
+        # in the measured tables), assumed to share the beat of the laser and frame clocks
         keys = np.c_[self.frequency_hz, self.exposure_s]
         _, first, self.recording = np.unique(keys, axis=0, return_index=True, return_inverse=True)
         self.recording = self.recording.ravel()
@@ -300,7 +311,7 @@ class StripeProblem(Problem):
         self.rows_per_recording = self.n_items / len(self.drift_names)
         self.drift_offered, self.drift_offer_reason = self.drift_offer()
         if not self.drift_offered:
-            self.candidates = tuple(e for e in EFFECTS if e.name != "phase_drift")
+            self.candidates = tuple(e for e in EFFECTS if e.name not in DRIFT_EFFECTS)
 
     @property
     def n_items(self) -> int:
@@ -374,6 +385,7 @@ class StripeProblem(Problem):
             noise_s=params.get("noise_s"),
             frames=frames,
             drift=drift,
+            drift_start="entry" if "drift_from_entry" in effects else "placement",
         )
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
@@ -489,7 +501,7 @@ class StripeProblem(Problem):
         these items by the selection step it extends); then each recording's drift from ``DRIFT_GRID``
         (recordings share no drift, so one batched evaluation scores every recording at every grid value); then
         all parameters jointly from there."""
-        locked = effects - {"phase_drift"}
+        locked = effects - set(DRIFT_EFFECTS)
         if start is not None and start.effects == locked and start.extra.get("frames") == "interior":
             base = start  # the locked model on these very items (the selection step's fit it extends)
         else:
@@ -633,6 +645,8 @@ class StripeProblem(Problem):
             "detection_noise": np.minimum(on, self.exposure_s[items]),
             # drift cuts wide stripes: the locked model errs on them
             "phase_drift": on + self.exposure_s[items],
+            # from the entry, drift cuts only the stripes that nearly fill the frame
+            "drift_from_entry": on + self.exposure_s[items],
         }
         driver = drivers[effect]
         corr = float(np.corrcoef(driver, res)[0, 1]) if np.std(driver) > 0 and np.std(res) > 0 else 0.0
@@ -642,7 +656,7 @@ class StripeProblem(Problem):
         )
 
     def drift_offer(self) -> tuple[bool, str]:
-        """Whether selection is offered ``phase_drift``, and why (or why not)."""
+        """Whether selection is offered ``phase_drift`` (and ``drift_from_entry`` on it), and why (or why not)."""
         rows = f"{self.rows_per_recording:.3g} rows per recording ({len(self.drift_names)} recordings)"
         if "interior" not in self.frame_rules:
             return (

@@ -362,6 +362,7 @@ def rolling_shutter_rows_lit(
     noise_s: float | torch.Tensor | None = None,
     frames: str = "lit",
     drift: float | torch.Tensor | None = None,
+    drift_start: str = "placement",
 ) -> torch.Tensor:
     """Mean number of rows a pulsed laser lights per counted frame, over a uniformly random pulse phase.
 
@@ -396,6 +397,10 @@ def rolling_shutter_rows_lit(
       stripes are then cut by the frame's edges in part of the frames. ``drift=0`` is the interior rule above
       (a locked phase), ``drift=1`` the ``"lit"`` rule (the phase covers the period); with ``drift`` given, the
       average over the placement and the arc is taken on a grid (``_drifting_interior_rows``), also at 0.
+      ``drift_start`` says where a drifting recording starts: ``"placement"`` at any whole-stripe placement
+      (uniform), ``"entry"`` at the first frame of a run of whole-stripe frames as the stripes move (a recording
+      started once its stripes came whole into view): the stripes then cross the frame's whole free span before an
+      edge cuts them, so a drift shorter than that span cuts nothing.
     """
     if frames not in STRIPE_FRAME_RULES:
         raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
@@ -429,7 +434,9 @@ def rolling_shutter_rows_lit(
     possible = (total > 0) & (w < p)
     if drift is not None:
         drift = torch.as_tensor(drift, dtype=torch.float64)
-        interior = _drifting_interior_rows(p, w, height, edge_span, placements, drift)
+        interior = _drifting_interior_rows(
+            p, w, height, edge_span, placements, drift, drift_start=drift_start
+        )
     else:
         weighted = sum(length * stripes for _, stripes, length in placements)
         interior = w * weighted / total.clamp(min=1e-12)
@@ -456,6 +463,7 @@ def _interior_placements(
 
 DRIFT_PLACEMENTS = 16  # grid points per interval of whole-stripe placements
 DRIFT_STEPS = 64  # grid points along the drift arc
+DRIFT_STARTS = ("placement", "entry")
 
 
 def _drifting_interior_rows(
@@ -465,6 +473,7 @@ def _drifting_interior_rows(
     edge_span: torch.Tensor,
     placements: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]],
     drift: torch.Tensor,
+    drift_start: str = "placement",
 ) -> torch.Tensor:
     """Mean over recordings of a recording's mean lit rows over its frames with a lit row, when each recording
     starts from a whole-stripe placement (``_interior_placements`` over ``edge_span``, uniform; a placement's
@@ -472,13 +481,19 @@ def _drifting_interior_rows(
     by ``drift`` of a period (midpoint grids over both; the direction does not matter: the placements and the
     count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)``
     rows, ``C(y)`` the lit length of ``[0, y)`` under stripes of width ``w`` every ``p`` rows
-    (``cumulative_on_time``)."""
+    (``cumulative_on_time``). With ``drift_start="entry"`` each interval of placements contributes only its end the
+    stripes move away from (the frame's stripes just whole; ``s`` grows, so the stripes move down), weighted by
+    the interval's length as before."""
+    if drift_start not in DRIFT_STARTS:
+        raise ValueError(f"unknown drift start {drift_start!r}; valid: {', '.join(DRIFT_STARTS)}")
     grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
+    if drift_start == "entry":
+        grid = torch.ones(1, dtype=p.dtype)
     starts, weights = [], []
     for lowest, _, length in placements:
         c_prime = lowest.unsqueeze(-1) + length.unsqueeze(-1) * grid
         starts.append(edge_span.unsqueeze(-1) - c_prime)
-        weights.append((length / DRIFT_PLACEMENTS).unsqueeze(-1).expand_as(c_prime))
+        weights.append((length / len(grid)).unsqueeze(-1).expand_as(c_prime))
     start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
     arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
     p3, w3 = p.unsqueeze(-1).unsqueeze(-1), w.unsqueeze(-1).unsqueeze(-1)

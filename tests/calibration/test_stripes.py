@@ -24,7 +24,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.core import Fit, at_bound, fit_least_squares, seeded_split
-from lerobot_phantom.calibration.stripes import StripeProblem, read_stripe_table
+from lerobot_phantom.calibration.stripes import DRIFT_EFFECTS, StripeProblem, read_stripe_table
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
 
@@ -87,23 +87,39 @@ def frame_lit_rows(
 
 
 def simulate_drifting_recordings(
-    camera: dict, condition, drift: float, rng: np.random.Generator, recordings: int, frames: int
+    camera: dict,
+    condition,
+    drift: float,
+    rng: np.random.Generator,
+    recordings: int,
+    frames: int,
+    start_at: str = "placement",
 ) -> np.ndarray:
     """Each recording's mean lit-row count over its frames with a lit row, for one (frequency Hz, duty, exposure
     s): a recording starts at a phase where the frame shows whole stripes (its first and last rows dark, a row
     lit; found by drawing phases until one does), then the laser and frame clocks beat, and the phase advances by
-    ``drift`` of a laser period over the recording's ``frames``."""
+    ``drift`` of a laser period over the recording's ``frames``. With ``start_at="entry"`` the recording starts
+    instead at the earliest phase of that run of whole frames (walked back from the drawn phase a row time at a
+    time): the first frame to show its stripes whole as they move."""
     frequency, duty, exposure = condition
     period = 1.0 / frequency
+
+    def whole(phase: float) -> bool:
+        lit = frame_lit_rows(camera, frequency, duty, exposure, phase, rng)
+        return bool(lit.any() and not lit[0] and not lit[-1])
+
     means = []
     for _ in range(recordings):
         for _ in range(1000):
             start = rng.uniform(0.0, period)
-            lit = frame_lit_rows(camera, frequency, duty, exposure, start, rng)
-            if lit.any() and not lit[0] and not lit[-1]:
+            if whole(start):
                 break
         else:
             raise AssertionError(f"no phase shows whole stripes at {condition}")
+        if start_at == "entry":
+            for step in (8.0 * camera["row_time"], camera["row_time"]):
+                while whole(start - step):
+                    start -= step
         counts = [
             int(
                 frame_lit_rows(
@@ -441,18 +457,29 @@ def test_rows_that_fix_no_row_time_do_not_leave_it_at_a_bound(tmp_path):
     assert not at_bounds, f"{camera_summary(camera)}\n{fit.params} {fit.extra}: {at_bounds} at a bound"
 
 
+@pytest.mark.parametrize("start_at", ["placement", "entry"])
 @pytest.mark.parametrize("drift", [0.1, 0.4])
-def test_a_drifting_recording_matches_the_simulator(drift):
-    """A laser at the frame rate (phase locked, placed with whole stripes in view) whose clock beats with the
-    camera's by ``drift`` of a period per recording: the kernel's expectation over placements equals the simulated
-    recordings' mean, for a stripe that fills most of the frame (cut at the edges) and a narrow one."""
+def test_a_drifting_recording_matches_the_simulator(drift, start_at):
+    """A laser at the frame rate (phase locked, placed with whole stripes in view: anywhere, or where they just came
+    whole into view) whose clock beats with the camera's by ``drift`` of a period per recording: the kernel's
+    expectation over placements equals the simulated recordings' mean, for a stripe that fills most of the frame
+    (cut at the edges) and a narrow one. From the entry, the narrow stripe is not cut by the larger drift, which
+    crosses less than the frame's free span; from anywhere it is."""
     rng = np.random.default_rng([SEED, 6])
     camera = draw_camera(rng, "interior") | {"rise": 1e-9, "read_noise": 0.0, "spread": 0, "dt": 4e-6}
     readout = camera["height"] * camera["row_time"]
     frequency = 1.0 / (2.0 * readout)  # one stripe per frame, a period of two readouts
     for duty in (0.4, 0.05):
         condition = (frequency, duty, camera["exposures_us"][0] * 1e-6)
-        means = simulate_drifting_recordings(camera, condition, drift, rng, recordings=60, frames=24)
+        means = simulate_drifting_recordings(
+            camera,
+            condition,
+            drift,
+            rng,
+            recordings=60 if start_at == "placement" else 6,
+            frames=24,
+            start_at=start_at,
+        )
         interior_rows = functools.partial(
             physics.rolling_shutter_rows_lit,
             torch.tensor([frequency]),
@@ -464,18 +491,27 @@ def test_a_drifting_recording_matches_the_simulator(drift):
             threshold_s=camera["threshold_grey"] / camera["gain"],
             frames="interior",
         )
-        kernel, locked = interior_rows(drift=torch.tensor([drift])), interior_rows()
+        kernel, locked = interior_rows(drift=torch.tensor([drift]), drift_start=start_at), interior_rows()
         error = 4.0 * means.std(ddof=1) / np.sqrt(len(means)) + 0.02 * float(kernel) + 2.0
-        about = f"{camera_summary(camera)} duty {duty} drift {drift}: kernel {float(kernel):.1f} (locked "
-        about += f"{float(locked):.1f}), simulated {means.mean():.1f} +- {means.std(ddof=1) / np.sqrt(len(means)):.1f}"
+        about = (
+            f"{camera_summary(camera)} duty {duty} drift {drift} from {start_at}: kernel {float(kernel):.1f} "
+        )
+        about += f"(locked {float(locked):.1f}), simulated {means.mean():.1f} +- "
+        about += f"{means.std(ddof=1) / np.sqrt(len(means)):.1f}"
         assert abs(float(kernel) - means.mean()) <= error, about
         if (
             duty == 0.4 and drift == 0.4
         ):  # a wide stripe cut this much: the simulation tells drift from a lock
             assert float(locked) - means.mean() > error, about
+        if duty == 0.05 and drift == 0.4:
+            cut = float(locked) - means.mean()
+            standard_error = means.std(ddof=1) / np.sqrt(len(means))
+            assert (cut < 1.0) if start_at == "entry" else (cut > 4.0 * standard_error + 1.0), about
 
 
-def drifting_table(path, camera: dict, rng: np.random.Generator, drifts: np.ndarray) -> None:
+def drifting_table(
+    path, camera: dict, rng: np.random.Generator, drifts: np.ndarray, start_at: str = "placement"
+) -> None:
     """A duty sweep per exposure setting at a laser near the frame rate (one stripe per frame, a period of two
     readouts): each row is one recording of 24 frames, whose phase drifts by ``drifts[k]`` of a period at the k-th
     exposure (0: locked)."""
@@ -484,18 +520,21 @@ def drifting_table(path, camera: dict, rng: np.random.Generator, drifts: np.ndar
     for exposure, drift in zip(camera["exposures_us"], drifts, strict=True):
         for duty in (2, 5, 10, 15, 20, 25, 30, 35):
             condition = (frequency, duty / 100.0, exposure * 1e-6)
-            mean = simulate_drifting_recordings(camera, condition, drift, rng, recordings=1, frames=24)[0]
+            mean = simulate_drifting_recordings(
+                camera, condition, drift, rng, recordings=1, frames=24, start_at=start_at
+            )[0]
             lines.append(f"{frequency:g}Hz,{exposure:g},{duty},{mean:.3f}")
     path.write_text("\n".join(lines) + "\n")
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize(
-    "drifting",
+    "start_at",
     [
-        pytest.param(True, id="two recordings drift"),
+        pytest.param("placement", id="two recordings drift"),
+        pytest.param("entry", id="two recordings drift from the entry"),
         pytest.param(
-            False,
+            None,
             id="null: locked",
             marks=pytest.mark.xfail(
                 strict=False,
@@ -506,32 +545,35 @@ def drifting_table(path, camera: dict, rng: np.random.Generator, drifts: np.ndar
         ),
     ],
 )
-def test_recordings_that_drift_are_named_and_locked_ones_are_not(tmp_path, drifting):
+def test_recordings_that_drift_are_named_and_locked_ones_are_not(tmp_path, start_at):
     """Two of five recordings drift by a third to two thirds of a period (the rest are locked): phase_drift is
     named, a drifting recording's interval excludes 0 and the held-out rows are predicted better than by the locked
-    model; with every recording locked, phase_drift is not named."""
+    model; drift_from_entry is named where the simulated recordings start as their stripes come whole into view,
+    and not where they start at any whole placement; with every recording locked, phase_drift is not named."""
     rng = np.random.default_rng([SEED, 7])
     camera = draw_camera(rng, "interior")
     drifts = np.zeros(5)
-    if drifting:
+    if start_at is not None:
         drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
     table = tmp_path / "drifting.csv"
-    drifting_table(table, camera, rng, drifts)
+    drifting_table(table, camera, rng, drifts, start_at=start_at or "placement")
     # bootstrap=10: the suite's budget, a third of the default draws behind each parameter's interval
     report = calibrate_stripes(tmp_path, table, camera["height"], bootstrap=10)
     named = {f["effect"] for f in report["findings"]}
-    about = f"{camera_summary(camera)} drifts {drifts}\nnamed {sorted(named)}\n{report['selection']['steps']}"
+    about = f"{camera_summary(camera)} drifts {drifts} from {start_at}\nnamed {sorted(named)}\n"
+    about += f"{report['selection']['steps']}"
     assert "exposure_overlap" in named, about
-    if not drifting:
+    if start_at is None:
         assert "phase_drift" not in named, about
         return
     assert "phase_drift" in named, about
+    assert ("drift_from_entry" in named) == (start_at == "entry"), about
     intervals = report["extended"]["param_intervals"]
     drifted = [k for k in intervals if k.startswith("drift_") and intervals[k]["low"] > 0.05]
     assert drifted, about
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
     fit_items, heldout = seeded_split(problem.n_items, 0.2, SEED % 1000)
-    locked = problem.fit(frozenset(report["extended"]["effects"]) - {"phase_drift"}, fit_items)
+    locked = problem.fit(frozenset(report["extended"]["effects"]) - set(DRIFT_EFFECTS), fit_items)
     assert report["extended"]["heldout_rmse"] < problem.rmse(locked, heldout), about
 
 

@@ -206,3 +206,58 @@ def test_drift_cuts_wide_stripes_first():
     )
     assert (wide[1:] < wide[:-1]).all() and (narrow[1:] <= narrow[:-1]).all(), (wide, narrow)
     assert float(wide[-1] / wide[0]) < float(narrow[-1] / narrow[0]) - 0.1, (wide, narrow)
+
+
+def test_a_recording_that_starts_as_its_stripes_come_into_view_is_cut_only_after_crossing_the_frame():
+    """``drift_start="entry"``: a locked recording counts what the interior rule counts; a drifting one keeps its
+    stripe whole until the stripe has crossed the frame's free span (the frame minus the stripe), then loses it row
+    by row at the far edge: for one stripe per frame the mean over lit frames has a closed form, checked against
+    the kernel; a drift that does not reach the far edge cuts nothing, where a start at any placement cuts."""
+    f = torch.tensor([25.0, 25.0, 750.0, 300.0])
+    duty = torch.tensor([0.3, 0.1, 0.2, 0.05])
+    exposure = torch.tensor([5e-5, 1e-3, 3.2e-5, 2e-3])
+    kwargs = {"image_rows": 720, "integration_offset_s": 3e-4, "frames": "interior"}
+    interior = physics.rolling_shutter_rows_lit(f, duty, exposure, 2e-5, **kwargs)
+    locked = physics.rolling_shutter_rows_lit(
+        f, duty, exposure, 2e-5, drift=torch.zeros(4), drift_start="entry", **kwargs
+    )
+    torch.testing.assert_close(locked, interior, rtol=1e-9, atol=1e-9)
+
+    row_time, height = 2e-5, 720
+    period_rows = 1.0 / (25.0 * row_time)  # 2000 rows: one stripe per frame
+    width = (0.25 / 25.0 + 5e-5 + 3e-4) / row_time  # 517.5 rows
+    free = (height - 1) - width
+    drifts = torch.tensor([0.5 * free, 0.9 * free, free + 0.5 * width, free + width], dtype=torch.float64)
+    drifts = drifts / period_rows
+    n = len(drifts)
+    cut = physics.rolling_shutter_rows_lit(
+        torch.full((n,), 25.0),
+        torch.full((n,), 0.25),
+        torch.full((n,), 5e-5),
+        row_time,
+        image_rows=height,
+        integration_offset_s=3e-4,
+        frames="interior",
+        drift=drifts,
+        drift_start="entry",
+    )
+    travel = drifts * period_rows
+    beyond = (travel - free).clamp(min=0.0)
+    expected = (travel.clamp(max=free) * width + beyond * (width - beyond / 2)) / travel
+    torch.testing.assert_close(cut, expected, rtol=0.01, atol=1.0)
+    assert float(cut[1]) == pytest.approx(width, abs=1e-6) and float(cut[-1]) < 0.8 * width, cut
+    anywhere = physics.rolling_shutter_rows_lit(
+        torch.full((n,), 25.0),
+        torch.full((n,), 0.25),
+        torch.full((n,), 5e-5),
+        row_time,
+        image_rows=height,
+        integration_offset_s=3e-4,
+        frames="interior",
+        drift=drifts,
+    )
+    assert float(anywhere[1]) < width - 20.0, anywhere
+    with pytest.raises(ValueError, match="placement, entry"):
+        physics.rolling_shutter_rows_lit(
+            f, duty, exposure, 2e-5, drift=torch.zeros(4), drift_start="x", **kwargs
+        )
