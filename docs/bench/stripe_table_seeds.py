@@ -70,6 +70,8 @@ def main() -> None:
         "written_heldout_rmse_median": float(np.median(written)),
         "written_heldout_rmse_max": float(written.max()),
         "named_phase_drift": sum("phase_drift" in r["named_causes"] for r in runs.values()),
+        "named_drift_from_entry": sum("drift_from_entry" in r["named_causes"] for r in runs.values()),
+        "splits_at_most_30_rows": int((written <= 30.0).sum()),
     }
     print(json.dumps(summary))
     args.out.write_text(

@@ -482,18 +482,25 @@ def _drifting_interior_rows(
     count are symmetric under flipping the frame). A frame whose stripes start at ``s`` lights ``C(H - s) - C(-s)``
     rows, ``C(y)`` the lit length of ``[0, y)`` under stripes of width ``w`` every ``p`` rows
     (``cumulative_on_time``). With ``drift_start="entry"`` each interval of placements contributes only its end the
-    stripes move away from (the frame's stripes just whole; ``s`` grows, so the stripes move down), weighted by
-    the interval's length as before."""
+    stripes move away from (the frame's stripes just whole, a row inside; ``s`` grows, so the stripes move
+    down), weighted by the interval's length as before."""
     if drift_start not in DRIFT_STARTS:
         raise ValueError(f"unknown drift start {drift_start!r}; valid: {', '.join(DRIFT_STARTS)}")
     grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
-    if drift_start == "entry":
-        grid = torch.ones(1, dtype=p.dtype)
     starts, weights = [], []
     for lowest, _, length in placements:
-        c_prime = lowest.unsqueeze(-1) + length.unsqueeze(-1) * grid
+        if drift_start == "entry":
+            # a row inside the run: the placements end where the last row starts (H - 1 rows after the first) but a
+            # frame counts H rows, so at the run's very end a neighbouring stripe still lights a row (seen on the
+            # Logitech table, several stripes per period: any drift > 0 then moved every prediction a row)
+            inside = torch.minimum(0.5 * length, torch.ones_like(length))
+            c_prime = (lowest + length - inside).unsqueeze(-1)
+            weight = length.unsqueeze(-1)
+        else:
+            c_prime = lowest.unsqueeze(-1) + length.unsqueeze(-1) * grid
+            weight = (length / DRIFT_PLACEMENTS).unsqueeze(-1).expand_as(c_prime)
         starts.append(edge_span.unsqueeze(-1) - c_prime)
-        weights.append((length / len(grid)).unsqueeze(-1).expand_as(c_prime))
+        weights.append(weight)
     start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
     arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
     p3, w3 = p.unsqueeze(-1).unsqueeze(-1), w.unsqueeze(-1).unsqueeze(-1)

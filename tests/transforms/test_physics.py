@@ -257,6 +257,28 @@ def test_a_recording_that_starts_as_its_stripes_come_into_view_is_cut_only_after
         drift=drifts,
     )
     assert float(anywhere[1]) < width - 20.0, anywhere
+    # a laser period shorter than the frame (the Logitech table: 30.1 Hz, 48.9 us rows, 679 rows a period): the run
+    # of whole frames ends where a neighbouring stripe reaches an edge row, and a small drift from its start still
+    # cuts nothing (it once moved every count a row, the start sitting on that edge)
+    several = {
+        "image_rows": 720,
+        "integration_offset_s": 3.5e-4,
+        "frames": "interior",
+        "drift_start": "entry",
+    }
+    counts = [
+        physics.rolling_shutter_rows_lit(
+            torch.full((3,), 30.1),
+            torch.tensor([0.05, 0.15, 0.3]),
+            1.5e-3,
+            4.89e-5,
+            drift=torch.full((3,), d),
+            **several,
+        )
+        for d in (0.0, 0.02, 0.1)
+    ]
+    torch.testing.assert_close(counts[1], counts[0], rtol=0.0, atol=1e-6)
+    torch.testing.assert_close(counts[2], counts[0], rtol=0.0, atol=1e-6)
     with pytest.raises(ValueError, match="placement, entry"):
         physics.rolling_shutter_rows_lit(
             f, duty, exposure, 2e-5, drift=torch.zeros(4), drift_start="x", **kwargs
