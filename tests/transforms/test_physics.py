@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 
 import pytest
@@ -230,7 +231,8 @@ def test_a_recording_that_starts_as_its_stripes_come_into_view_is_cut_only_after
     drifts = torch.tensor([0.5 * free, 0.9 * free, free + 0.5 * width, free + width], dtype=torch.float64)
     drifts = drifts / period_rows
     n = len(drifts)
-    cut = physics.rolling_shutter_rows_lit(
+    drifting = functools.partial(
+        physics.rolling_shutter_rows_lit,
         torch.full((n,), 25.0),
         torch.full((n,), 0.25),
         torch.full((n,), 5e-5),
@@ -239,23 +241,14 @@ def test_a_recording_that_starts_as_its_stripes_come_into_view_is_cut_only_after
         integration_offset_s=3e-4,
         frames="interior",
         drift=drifts,
-        drift_start="entry",
     )
+    cut = drifting(drift_start="entry")
     travel = drifts * period_rows
     beyond = (travel - free).clamp(min=0.0)
     expected = (travel.clamp(max=free) * width + beyond * (width - beyond / 2)) / travel
     torch.testing.assert_close(cut, expected, rtol=0.01, atol=1.0)
     assert float(cut[1]) == pytest.approx(width, abs=1e-6) and float(cut[-1]) < 0.8 * width, cut
-    anywhere = physics.rolling_shutter_rows_lit(
-        torch.full((n,), 25.0),
-        torch.full((n,), 0.25),
-        torch.full((n,), 5e-5),
-        row_time,
-        image_rows=height,
-        integration_offset_s=3e-4,
-        frames="interior",
-        drift=drifts,
-    )
+    anywhere = drifting(drift_start="placement")
     assert float(anywhere[1]) < width - 20.0, anywhere
     # a laser period shorter than the frame (the Logitech table: 30.1 Hz, 48.9 us rows, 679 rows a period): the run
     # of whole frames ends where a neighbouring stripe reaches an edge row, and a small drift from its start still
