@@ -404,6 +404,8 @@ def rolling_shutter_rows_lit(
     """
     if frames not in STRIPE_FRAME_RULES:
         raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
+    if drift_start not in DRIFT_STARTS:
+        raise ValueError(f"unknown drift start {drift_start!r}; valid: {', '.join(DRIFT_STARTS)}")
     frequency_hz = torch.as_tensor(frequency_hz, dtype=torch.float64)
     period = 1.0 / frequency_hz
     on = torch.as_tensor(duty, dtype=torch.float64).clamp(0.0, 1.0) * period
@@ -484,8 +486,6 @@ def _drifting_interior_rows(
     (``cumulative_on_time``). With ``drift_start="entry"`` each interval of placements contributes only its end the
     stripes move away from (the frame's stripes just whole, a row inside; ``s`` grows, so the stripes move
     down), weighted by the interval's length as before."""
-    if drift_start not in DRIFT_STARTS:
-        raise ValueError(f"unknown drift start {drift_start!r}; valid: {', '.join(DRIFT_STARTS)}")
     grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
     starts, weights = [], []
     for lowest, _, length in placements:
