@@ -281,6 +281,33 @@ def calibrate_stripes(tmp_path, table, image_height: int, **options) -> dict:
     return calibrate(config)
 
 
+def test_the_drift_and_its_entry_start_are_offered_only_with_enough_rows_per_recording_and_the_interior_rule(
+    tmp_path,
+):
+    """phase_drift is one parameter per recording (a frequency and exposure setting): offered with at least 4 rows per
+    recording on average and frames that allow the interior rule; drift_from_entry builds on it and goes with it."""
+    table = tmp_path / "sweeps.csv"
+    lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean"]
+    for exposure in (50, 100):
+        lines += [f"25Hz,{exposure},{duty},{10.0 * duty}" for duty in (1, 5, 10, 20)]
+    table.write_text("\n".join(lines) + "\n")
+    drift = {"phase_drift", "drift_from_entry"}
+
+    def offered(path, frames="auto"):
+        problem = StripeProblem(path, image_height=720, exposure_unit_s=None, frames=frames)
+        return {e.name for e in problem.candidates} & drift, problem.drift_offer_reason
+
+    assert offered(table) == (drift, "4 rows per recording (2 recordings)")
+    names, reason = offered(table, frames="lit")
+    assert names == set() and "interior" in reason, reason
+    sparse = tmp_path / "sparse.csv"
+    sparse.write_text(
+        "\n".join(lines[:1] + [line for line in lines[1:] if ",5," not in line and ",20," not in line]) + "\n"
+    )
+    names, reason = offered(sparse)
+    assert names == set() and "2 rows per recording" in reason, reason
+
+
 # -- the physics kernel against the simulator ---------------------------------------------------------------------
 @pytest.mark.parametrize("frames", physics.STRIPE_FRAME_RULES)
 def test_phase_averaged_rows_match_the_simulator(frames):
