@@ -10,7 +10,9 @@ cycle sweep: the measured tables ("They See Me Rollin'", ``rsa/profile.py``) hol
 assumes the videos of one sweep share the beat of the laser and frame clocks.
 Every prediction is an expectation over the pulse phase (the phase of one frame cannot be known in advance: uniform,
 or a whole-stripe placement and the recording's drift from it), so no held-out row informs its own prediction; a
-recording's drift is fitted on its fit rows only.
+recording's drift is fitted on its fit rows only, and kept only where they call for it beyond their measurement
+error (``StripeProblem.drifts_without_evidence``; the standard error of each mean comes from an
+``affected_rows_95ci``/``affected_rows_99ci`` column when the table has one).
 
 Units and geometry come from the table when it says them (``exposure_us``/``exposure_ms``/``exposure_s`` columns
 or values such as ``32us``; an ``image_height``/``image_rows`` column); otherwise ``--exposure-unit-s`` and
@@ -42,6 +44,9 @@ STRIPE_COLUMNS = ("frequency", "exposure", "duty_cycle", "affected_rows_mean")
 EXPOSURE_COLUMN_UNITS = {"exposure_s": 1.0, "exposure_ms": 1e-3, "exposure_us": 1e-6}
 HEIGHT_COLUMNS = ("image_height", "image_rows")
 SPREAD_COLUMN = "affected_rows_std"
+# a row's confidence half-width of its mean over frames, and the normal quantile it was taken at ("They See Me
+# Rollin'" tables give both): the standard error of each measured mean
+CONFIDENCE_COLUMNS = {"affected_rows_95ci": 1.959964, "affected_rows_99ci": 2.575829}
 # unit suffixes a value may carry (case-insensitive); "u" and the micro sign both mean microseconds
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6, "µs": 1e-6, "μs": 1e-6, "ns": 1e-9}
 FREQUENCY_UNITS = {"hz": 1.0, "khz": 1e3, "mhz": 1e6}
@@ -105,6 +110,10 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
+# a recording keeps its drift when its fit rows' variance-weighted squared error drops by at least this much against a
+# lock: the 5% critical value of the likelihood ratio for one parameter at its bound (a 50:50 mixture of 0 and
+# chi-square with one degree of freedom; Self & Liang 1987)
+DRIFT_EVIDENCE = 2.706
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:
@@ -183,8 +192,19 @@ def read_stripe_table(
         )
     # the frames' spread of each row's count, when the table gives it: a diagnosis of rows whose frames disagree
     spread = table[SPREAD_COLUMN].to_numpy(dtype=np.float64) if SPREAD_COLUMN in table.columns else None
+    standard_error = np.zeros(len(rows))
+    for column, quantile in CONFIDENCE_COLUMNS.items():
+        if column in table.columns:
+            standard_error = table[column].to_numpy(dtype=np.float64) / quantile
+            sources["standard_error"] = f"column {column} / {quantile:.4g}"
+            break
+    else:
+        sources["standard_error"] = "none in the table: model error only"
+    if not np.isfinite(standard_error).all() or (standard_error < 0).any():
+        raise ValueError(f"{path}: confidence half-widths must be finite and non-negative")
     meta = {
         "spread": spread,
+        "standard_error": standard_error,
         "frequency_hz": frequency_hz,
         "duty": duty,
         "exposure_s": exposure * data_unit,
@@ -300,6 +320,7 @@ class StripeProblem(Problem):
         self.exposure_setting = meta["exposure_setting"]
         self.rows = meta["rows"]
         self.spread = meta["spread"]
+        self.standard_error = meta["standard_error"]
         # a recording: the rows of one laser frequency and exposure setting (a duty-cycle sweep, one video per row
         # in the measured tables), assumed to share the beat of the laser and frame clocks
         keys = np.c_[self.frequency_hz, self.exposure_s]
@@ -500,7 +521,8 @@ class StripeProblem(Problem):
         placements the drift starts from, by ``fit``'s search (or ``start`` itself when it is that model, fitted on
         these items by the selection step it extends); then each recording's drift from ``DRIFT_GRID``
         (recordings share no drift, so one batched evaluation scores every recording at every grid value); then
-        all parameters jointly from there."""
+        all parameters jointly from there; then the drifts their recordings' fit rows do not call for
+        (``drifts_without_evidence``) are locked and the rest refitted once (listed in the fit's extra)."""
         locked = effects - set(DRIFT_EFFECTS)
         if start is not None and start.effects == locked and start.extra.get("frames") == "interior":
             base = start  # the locked model on these very items (the selection step's fit it extends)
@@ -521,13 +543,60 @@ class StripeProblem(Problem):
         for index, name in enumerate(self.drift_names):
             mine = recordings == index
             warm[name] = float(DRIFT_GRID[np.argmin(squared[:, mine].sum(1))]) if mine.any() else 0.0
+        specs = self.param_specs(effects)
         params = fit_least_squares(
-            self.param_specs(effects),
+            specs,
             lambda p: self.predict(effects, p, items, "interior") - target,
             warm=warm,
             jacobian=DRIFT_JACOBIAN,
         )
-        return Fit(effects, params, {"frames": "interior"})
+        unsupported = self.drifts_without_evidence(effects, params, items)
+        if unsupported:
+            # the drifts the recordings' own fit rows do not call for are locked, the rest refitted with them
+            pinned = dict.fromkeys(unsupported, 0.0)
+            free = [spec for spec in specs if spec.name not in pinned]
+            refitted = pinned | fit_least_squares(
+                free,
+                lambda p: self.predict(effects, p | pinned, items, "interior") - target,
+                warm={k: v for k, v in params.items() if k not in pinned},
+                jacobian=DRIFT_JACOBIAN,
+            )
+            params = {spec.name: refitted[spec.name] for spec in specs}
+        return Fit(effects, params, {"frames": "interior", "drifts_locked_for_want_of_evidence": unsupported})
+
+    def drifts_without_evidence(self, effects: frozenset[str], params: dict, items: np.ndarray) -> list[str]:
+        """The recordings' drifts that their own fit rows do not call for: a drift is a parameter per recording,
+        and a recording whose one cut video sits within its measurement error, or whose fit stripes are all narrow
+        enough that the drift cuts none, must not carry it to its other videos (on the Axis table one wide video of
+        a sweep, short of a whole stripe by under two standard errors of its mean, set a drift that cut the sweep's
+        locked 30% video by 104 rows). Per recording, the likelihood ratio of its fitted drift against a lock: the drop in its fit rows'
+        squared error, each row weighted by its variance (the row's standard error of the mean from the table,
+        plus the model's error beyond measurement, estimated from every fit row's residual). A drift is kept when
+        the drop reaches ``DRIFT_EVIDENCE`` (the 5% critical value of a likelihood ratio for a parameter at its
+        bound)."""
+        drifting = [n for n in self.drift_names if params[n] > 0.0]
+        if not drifting:
+            return []
+        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+        with torch.no_grad():
+            fitted = self.predict(effects, values, items, "interior").numpy()
+            locked = self.predict(
+                effects,
+                values | {n: torch.tensor(0.0, dtype=torch.float64) for n in drifting},
+                items,
+                "interior",
+            ).numpy()
+        measured_variance = self.standard_error[items] ** 2
+        model_variance = max(float(np.mean((fitted - self.rows[items]) ** 2 - measured_variance)), 1e-9)
+        drop = ((locked - self.rows[items]) ** 2 - (fitted - self.rows[items]) ** 2) / (
+            model_variance + measured_variance
+        )
+        recordings = self.recording[items]
+        return [
+            name
+            for name in drifting
+            if drop[recordings == self.drift_names.index(name)].sum() < DRIFT_EVIDENCE
+        ]
 
     @staticmethod
     def regime_starts(
@@ -684,6 +753,18 @@ class StripeProblem(Problem):
             "noise_us": fit.params.get("noise_s", 0.0) * 1e6,
             "frames_averaged": fit.extra.get("frames", "lit"),
             "phase_drift_offered": f"{'yes' if self.drift_offered else 'no'}: {self.drift_offer_reason}",
+            **(
+                {
+                    "drifts_locked_for_want_of_evidence": fit.extra["drifts_locked_for_want_of_evidence"],
+                    "drift_evidence_rule": (
+                        f"a recording keeps its drift when its fit rows' squared error, weighted by each row's "
+                        f"variance (standard error of its mean + the model's error beyond it), drops by >= "
+                        f"{DRIFT_EVIDENCE} against a lock"
+                    ),
+                }
+                if "drifts_locked_for_want_of_evidence" in fit.extra
+                else {}
+            ),
             "image_height": self.image_height,
             **units,
         }

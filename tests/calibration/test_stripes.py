@@ -813,3 +813,69 @@ def test_a_table_of_two_cameras_is_refused(tmp_path):
                 stripe_frames="most",
             )
         )
+
+
+def two_sweeps_table(path, b_confidence: float) -> dict[str, float]:
+    """Two duty sweeps at 25 Hz from the kernel itself (a 720-row camera, 20 us rows, 100 us extra integration):
+    exposure 50 drifts 0.3 of a period from the entry, and its wide stripes are cut; exposure 200 is locked, but
+    its widest video reads 30 rows short with a 95% half-width of ``b_confidence`` rows (the rest 1 row)."""
+    sweeps = {50: (0.3, (1, 5, 10, 20, 25, 30)), 200: (0.0, (1, 5, 10, 15, 20))}
+    lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean,affected_rows_95ci"]
+    for exposure, (drift, duties) in sweeps.items():
+        rows = physics.rolling_shutter_rows_lit(
+            torch.full((len(duties),), 25.0),
+            torch.tensor(duties, dtype=torch.float64) / 100.0,
+            torch.full((len(duties),), exposure * 1e-6),
+            20e-6,
+            image_rows=720,
+            integration_offset_s=100e-6,
+            frames="interior",
+            drift=torch.full((len(duties),), drift),
+            drift_start="entry",
+        ).tolist()
+        for duty, mean in zip(duties, rows, strict=True):
+            short, confidence = (30.0, b_confidence) if (exposure, duty) == (200, 20) else (0.0, 1.0)
+            lines.append(f"25Hz,{exposure},{duty},{mean - short:.3f},{confidence}")
+    path.write_text("\n".join(lines) + "\n")
+    return {"cut": sweeps[50][0]}
+
+
+@pytest.mark.parametrize("b_confidence", [60.0, 1.0], ids=["within its error", "beyond its error"])
+def test_a_drift_that_one_video_within_its_error_calls_for_is_locked(tmp_path, b_confidence):
+    """A recording's drift is kept only when its own fit rows call for it beyond their measurement error: one video
+    30 rows short with a 95% half-width of 60 rows leaves its sweep locked (a drift there would cut the sweep's
+    wider videos, which this table does not hold); the same shortfall measured within 1 row keeps the drift, and a
+    drift that cuts none of its recording's stripes is locked either way. The truly drifting sweep keeps its drift.
+
+    The fit starts from the camera's own locked values: from the locked model's fit the drift search does not find
+    the exposure-200 sweep's drift at all (its grid starts from a row time 25% off), which would leave the rule
+    untested."""
+    table = tmp_path / "sweeps.csv"
+    truth = two_sweeps_table(table, b_confidence)
+    problem = StripeProblem(table, image_height=720, exposure_unit_s=None)
+    assert problem.sources["standard_error"] == "column affected_rows_95ci / 1.96"
+    assert problem.standard_error[0] == pytest.approx(1.0 / 1.959964)
+    effects = frozenset({"exposure_overlap", "integration_offset", "phase_drift", "drift_from_entry"})
+    items = np.arange(problem.n_items)
+    camera = {"row_time_s": 20e-6, "integration_offset_s": 100e-6}
+    flat = problem.drifts_without_evidence(
+        effects, camera | {"drift_25Hz_exposure50": 0.3, "drift_25Hz_exposure200": 0.05}, items
+    )
+    assert flat == ["drift_25Hz_exposure200"], flat
+    start = Fit(effects - set(DRIFT_EFFECTS), camera, {"frames": "interior"})
+    fit = problem.fit(effects, items, start)
+    drifts = {name: round(fit.params[name], 3) for name in problem.drift_names}
+    locked = fit.extra["drifts_locked_for_want_of_evidence"]
+    about = f"drifts {drifts}, locked for want of evidence {locked}"
+    assert drifts["drift_25Hz_exposure50"] == pytest.approx(truth["cut"], abs=0.03), about
+    if b_confidence > 30.0:
+        assert locked == ["drift_25Hz_exposure200"] and drifts["drift_25Hz_exposure200"] == 0.0, about
+    else:
+        assert locked == [] and drifts["drift_25Hz_exposure200"] > 0.1, about
+
+
+def test_confidence_half_widths_must_be_non_negative(tmp_path):
+    table = tmp_path / "sweeps.csv"
+    two_sweeps_table(table, -1.0)
+    with pytest.raises(ValueError, match="confidence half-widths must be finite and non-negative"):
+        read_stripe_table(table, image_height=720, exposure_unit_s=None)
