@@ -207,6 +207,20 @@ def identify(
     return Identification(effect, not reasons, tuple(reasons), tuple(notes))
 
 
+def excludes_null(interval: Interval, null: float, low: float, high: float) -> bool:
+    """Whether ``interval`` excludes the ``null`` value of a parameter bounded by [low, high]. A null on a bound
+    (a drift of 0, a threshold of 0) is not excluded by an interval end that sits at that same bound: the optimiser
+    keeps values a hair inside their bounds (``fit_least_squares`` starts 1e-9 of the range inside), and a draw
+    stopped there is a draw at the null, not one beside it (before session 34 a drift interval of 1e-9 to 0.31 on
+    the Axis table excluded the null 0 and named ``phase_drift``)."""
+    if not interval.excludes(null):
+        return False
+    side = at_bound(null, low, high)
+    if side is None:
+        return True
+    return at_bound(interval.low if side == "low" else interval.high, low, high) != side
+
+
 def parameter_checks(
     params: Mapping[str, float],
     bounds: Mapping[str, tuple[float, float]],
@@ -230,7 +244,11 @@ def parameter_checks(
                 f"{name} = {value:.4g} sits at its {side} bound {bounds[name][side == 'high']:.4g}"
             )
     if nulls:
-        excluded = [n for n, null in nulls.items() if n in intervals and intervals[n].excludes(null)]
+        excluded = [
+            n
+            for n, null in nulls.items()
+            if n in intervals and excludes_null(intervals[n], null, *bounds.get(n, (-np.inf, np.inf)))
+        ]
         if not excluded:
             reasons.append(
                 "the interval of "

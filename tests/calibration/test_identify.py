@@ -30,6 +30,7 @@ from lerobot_phantom.calibration.identify import (
     bootstrap,
     dependants,
     error_ratio,
+    excludes_null,
     identify,
     identify_selection,
     own_params,
@@ -182,6 +183,23 @@ def test_a_high_bound_declared_a_physical_limit_is_a_note_and_never_pins():
     assert pinned_in_most_folds(spec, high) is None
     low = [Fit(frozenset({"x"}), {"drift": 0.0}) for _ in range(3)]
     assert pinned_in_most_folds(spec, low) == "drift at its low bound 0 in 3 of 3 folds"
+
+
+def test_an_interval_that_stops_a_hair_inside_the_bound_of_its_null_includes_the_null():
+    """A drift's null 0 is its low bound; draws that stopped 1e-9 inside it (where the optimiser starts a parameter
+    at its bound) are draws at the null: the interval 1e-9-0.31 includes it, and the effect is not identified. An
+    interval that clears the bound by more than the bound tolerance excludes it; a null inside the range is
+    compared exactly."""
+    bounds = {"drift": (0.0, 1.0)}
+    hair = {"drift": Interval(0.3, 1e-9, 0.31)}
+    reasons, _ = parameter_checks({"drift": 0.3}, bounds, hair, {"drift": 0.0}, {})
+    assert len(reasons) == 1 and "includes the null value drift = 0" in reasons[0], reasons
+    clear = {"drift": Interval(0.3, 0.05, 0.31)}
+    assert parameter_checks({"drift": 0.3}, bounds, clear, {"drift": 0.0}, {}) == ([], [])
+    inside = {"gamma": Interval(1.2, 1.0 + 1e-9, 1.4)}
+    assert parameter_checks({"gamma": 1.2}, {"gamma": (0.2, 4.0)}, inside, {"gamma": 1.0}, {}) == ([], [])
+    assert excludes_null(Interval(-0.3, -0.31, -1e-9), 0.0, -1.0, 0.0) is False
+    assert excludes_null(Interval(-0.3, -0.31, -0.05), 0.0, -1.0, 0.0) is True
 
 
 def test_a_change_of_functional_form_needs_no_null_value():
