@@ -567,7 +567,9 @@ def drifting_table(
                 strict=False,
                 reason="open (issue 12): failed once in session 29's review on a seed whose output was cut "
                 "(phase_drift named on locked recordings, or the overlap not named: the message was lost); 0 of 20 "
-                "seeds 101-120 fail at 582cfc5 and at ecaf039 (docs/bench/session29/drift_null_seeds_*)",
+                "seeds 101-120 fail at 582cfc5 and at ecaf039 (docs/bench/session29/drift_null_seeds_*); seed 12 "
+                "fails at fab577e and 4765c93: a misfit at the shortest exposure taken for a drift "
+                "(docs/bench/session34.md)",
             ),
         ),
     ],
