@@ -567,13 +567,13 @@ class StripeProblem(Problem):
     def drifts_without_evidence(self, effects: frozenset[str], params: dict, items: np.ndarray) -> list[str]:
         """The recordings' drifts that their own fit rows do not call for: a drift is a parameter per recording,
         and a recording whose one cut video sits within its measurement error, or whose fit stripes are all narrow
-        enough that the drift cuts none, must not carry it to its other videos (on the Axis table one wide video of
-        a sweep, short of a whole stripe by under two standard errors of its mean, set a drift that cut the sweep's
-        locked 30% video by 104 rows). Per recording, the likelihood ratio of its fitted drift against a lock: the drop in its fit rows'
-        squared error, each row weighted by its variance (the row's standard error of the mean from the table,
-        plus the model's error beyond measurement, estimated from every fit row's residual). A drift is kept when
-        the drop reaches ``DRIFT_EVIDENCE`` (the 5% critical value of a likelihood ratio for a parameter at its
-        bound)."""
+        enough that the drift cuts none, must not carry it to its other videos (in a selection fold of the Axis
+        table a drift that moved one fit video of a sweep, lowering the weighted error below by 1.95, cut the
+        sweep's locked 30% video by over 100 rows). Per recording, the likelihood ratio of its fitted drift against
+        a lock: the drop in its fit rows' squared error, each row weighted by its variance (the row's standard
+        error of the mean from the table, plus the model's error beyond measurement, estimated from every fit row's
+        residual). A drift is kept when the drop reaches ``DRIFT_EVIDENCE`` (the 5% critical value of a likelihood
+        ratio for a parameter at its bound)."""
         drifting = [n for n in self.drift_names if params[n] > 0.0]
         if not drifting:
             return []
