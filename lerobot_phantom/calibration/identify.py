@@ -65,6 +65,10 @@ from lerobot_phantom.calibration.core import (
 )
 
 LEVEL = 0.9  # two-sided coverage of every reported interval
+# share of a parameter's range within which an interval end counts as reaching a null on that bound: a thousand
+# times the optimiser's start inset (1e-9), far below any estimate; not core.BOUND_TOLERANCE (1e-3), which on a wide
+# range swallowed a real end (a read noise of 0.21 us on a 0-1365 us range, session 34)
+NULL_AT_BOUND_TOLERANCE = 1e-6
 
 
 @dataclass(frozen=True)
@@ -212,13 +216,14 @@ def excludes_null(interval: Interval, null: float, low: float, high: float) -> b
     (a drift of 0, a threshold of 0) is not excluded by an interval end that sits at that same bound: the optimiser
     keeps values a hair inside their bounds (``fit_least_squares`` starts 1e-9 of the range inside), and a draw
     stopped there is a draw at the null, not one beside it (before session 34 a drift interval of 1e-9 to 0.31 on
-    the Axis table excluded the null 0 and named ``phase_drift``)."""
+    the Axis table excluded the null 0 and named ``phase_drift``). "At" is within ``NULL_AT_BOUND_TOLERANCE``."""
     if not interval.excludes(null):
         return False
-    side = at_bound(null, low, high)
+    side = at_bound(null, low, high, NULL_AT_BOUND_TOLERANCE)
     if side is None:
         return True
-    return at_bound(interval.low if side == "low" else interval.high, low, high) != side
+    end = interval.low if side == "low" else interval.high
+    return at_bound(end, low, high, NULL_AT_BOUND_TOLERANCE) != side
 
 
 def parameter_checks(

@@ -188,8 +188,8 @@ def test_a_high_bound_declared_a_physical_limit_is_a_note_and_never_pins():
 def test_an_interval_that_stops_a_hair_inside_the_bound_of_its_null_includes_the_null():
     """A drift's null 0 is its low bound; draws that stopped 1e-9 inside it (where the optimiser starts a parameter
     at its bound) are draws at the null: the interval 1e-9-0.31 includes it, and the effect is not identified. An
-    interval that clears the bound by more than the bound tolerance excludes it; a null inside the range is
-    compared exactly."""
+    interval that clears the bound by more than a millionth of the range excludes it, also when that is a small
+    share of a wide range; a null inside the range is compared exactly."""
     bounds = {"drift": (0.0, 1.0)}
     hair = {"drift": Interval(0.3, 1e-9, 0.31)}
     reasons, _ = parameter_checks({"drift": 0.3}, bounds, hair, {"drift": 0.0}, {})
@@ -200,6 +200,9 @@ def test_an_interval_that_stops_a_hair_inside_the_bound_of_its_null_includes_the
     assert parameter_checks({"gamma": 1.2}, {"gamma": (0.2, 4.0)}, inside, {"gamma": 1.0}, {}) == ([], [])
     assert excludes_null(Interval(-0.3, -0.31, -1e-9), 0.0, -1.0, 0.0) is False
     assert excludes_null(Interval(-0.3, -0.31, -0.05), 0.0, -1.0, 0.0) is True
+    # a real end close to the bound of a wide range is not the optimiser's hair: session 34's read noise of
+    # 0.21-4.5 us, on a range up to the longest exposure (1365 us), excludes a noise of 0
+    assert excludes_null(Interval(3.9e-6, 2.07e-7, 4.46e-6), 0.0, 0.0, 1.365e-3) is True
 
 
 def test_a_change_of_functional_form_needs_no_null_value():
