@@ -568,8 +568,10 @@ def drifting_table(
                 reason="open (issue 12): failed once in session 29's review on a seed whose output was cut "
                 "(phase_drift named on locked recordings, or the overlap not named: the message was lost); 0 of 20 "
                 "seeds 101-120 fail at 582cfc5 and at ecaf039 (docs/bench/session29/drift_null_seeds_*); seed 12 "
-                "fails at fab577e and 4765c93: a misfit at the shortest exposure taken for a drift "
-                "(docs/bench/session34.md)",
+                "fails at fab577e, 4765c93 and 921312e: at its shortest exposure a fully lit row reads 11 grey "
+                "against a threshold of 10 with a read noise of 1, so rows inside the stripe drop out and "
+                "blooming refills all but runs of three; the kernel's soft threshold has no refill, and a drift "
+                "takes the misfit (docs/bench/session34.md, section 9)",
             ),
         ),
     ],

@@ -3,9 +3,12 @@
 and per fit row its residual with the fitted drifts and with every drift locked, and the drop in squared error over
 the model's error (the drift rule's weight; the simulated table has no standard errors).
 
-Usage (from the checkout): ``PYTHONPATH=. python docs/bench/session34/locked_table_drift.py SEED EFFECT [EFFECT ...]``
+Usage (from the checkout): ``PYTHONPATH=. python docs/bench/session34/locked_table_drift.py SEED EFFECT [EFFECT ...]
+[--camera KEY=VALUE ...]``; ``--camera`` overrides a drawn camera property (``read_noise=0``, ``spread=0``,
+``rise=1e-9``) after the draw, so the table is rendered from the same random stream with one term removed.
 """
 
+import argparse
 import os
 import sys
 import tempfile
@@ -15,7 +18,7 @@ import numpy as np
 import torch
 
 
-def main(seed: int, effects: frozenset[str]) -> None:
+def main(seed: int, effects: frozenset[str], overrides: dict[str, float], keep_table: Path | None) -> None:
     os.environ["STRIPES_SEED"] = str(seed)  # the test module reads its seed at import
     sys.path.insert(0, str(Path("tests/calibration").resolve()))
     import test_stripes
@@ -25,8 +28,16 @@ def main(seed: int, effects: frozenset[str]) -> None:
 
     rng = np.random.default_rng([seed, 7])
     camera = test_stripes.draw_camera(rng, "interior")
+    unknown = set(overrides) - set(camera)
+    if unknown:
+        raise SystemExit(f"unknown camera properties {sorted(unknown)}; valid: {', '.join(sorted(camera))}")
+    camera |= {k: type(camera[k])(v) for k, v in overrides.items()}
     table = Path(tempfile.mkdtemp()) / "locked.csv"
     test_stripes.drifting_table(table, camera, rng, np.zeros(5))
+    if keep_table is not None:
+        if keep_table.exists():
+            raise SystemExit(f"{keep_table} exists; give a new path")
+        keep_table.write_text(table.read_text())
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
     print(test_stripes.camera_summary(camera))
     items, _ = seeded_split(problem.n_items, 0.2, seed % 1000)
@@ -53,4 +64,11 @@ def main(seed: int, effects: frozenset[str]) -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]), frozenset(sys.argv[2:]))
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("seed", type=int)
+    parser.add_argument("effects", nargs="+")
+    parser.add_argument("--camera", nargs="*", default=[], metavar="KEY=VALUE")
+    parser.add_argument("--keep-table", type=Path, help="also write the rendered table here (a new file)")
+    args = parser.parse_args()
+    overrides = {k: float(v) for k, v in (o.split("=", 1) for o in args.camera)}
+    main(args.seed, frozenset(args.effects), overrides, args.keep_table)
