@@ -10,6 +10,7 @@ Usage (from the checkout): ``PYTHONPATH=. python docs/bench/session34/locked_tab
 
 import argparse
 import os
+import shutil
 import sys
 import tempfile
 from pathlib import Path
@@ -37,7 +38,7 @@ def main(seed: int, effects: frozenset[str], overrides: dict[str, float], keep_t
     if keep_table is not None:
         if keep_table.exists():
             raise SystemExit(f"{keep_table} exists; give a new path")
-        keep_table.write_text(table.read_text())
+        shutil.copyfile(table, keep_table)
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
     print(test_stripes.camera_summary(camera))
     items, _ = seeded_split(problem.n_items, 0.2, seed % 1000)
@@ -70,5 +71,8 @@ if __name__ == "__main__":
     parser.add_argument("--camera", nargs="*", default=[], metavar="KEY=VALUE")
     parser.add_argument("--keep-table", type=Path, help="also write the rendered table here (a new file)")
     args = parser.parse_args()
+    malformed = [o for o in args.camera if "=" not in o]
+    if malformed:
+        parser.error(f"--camera takes KEY=VALUE (e.g. read_noise=0), not {malformed}")
     overrides = {k: float(v) for k, v in (o.split("=", 1) for o in args.camera)}
     main(args.seed, frozenset(args.effects), overrides, args.keep_table)
