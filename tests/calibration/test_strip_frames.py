@@ -64,3 +64,49 @@ def test_the_stripes_tone_curves_invert(tone):
     assert torch.allclose(encode(linear), encoded, atol=1e-9)
     # the light saturates at the sensor's full well: white stays white however much is added
     assert torch.allclose(encode(linear + 5.0), torch.ones_like(encoded))
+
+
+def full_frame_prediction(
+    problem: StripFrames, params: dict, index: int, phases: torch.Tensor
+) -> torch.Tensor:
+    """The stripe's prediction written out over every row of the frame (lit or not), one per phase: (P, 3, H, W)."""
+    pair = problem.pairs[index]
+    light = problem.row_light(params, pair.height, phases)
+    gains = pair.intensity * problem.stripe_gains(params).reshape(1, 3, 1, 1)
+    decode, encode = problem.tone(params)
+    return encode(decode(pair.clean).unsqueeze(0) + gains * light[:, None, :, None])
+
+
+@pytest.mark.parametrize(
+    "tone",
+    [
+        {},
+        {"gamma": 2.2},
+        {"shoulder": 4.0, "shoulder_exponent": 1.5},
+        {"shoulder": 4.0, "shoulder_exponent": 1.5, "gamma": 1.8},
+    ],
+    ids=["none", "gamma", "shoulder", "shoulder+gamma"],
+)
+def test_registered_costs_over_the_lit_rows_equal_the_whole_frame(tone):
+    """Registered costs computed over the rows a pulse reaches (each other row costs its unlit error at every
+    phase) equal the whole-frame formula at every phase, for one stripe or a periodic train and each tone curve,
+    and the prediction at a phase is that phase's whole frame."""
+    pairs = stripe_pairs(5, 0.47, n=3)
+    for pair in pairs:
+        # black pixels: the one level a tone curve's round trip does not return (clipped to its darkest light)
+        pair.clean[:, ::7, ::5] = 0.0
+    problem = StripFrames(pairs, seed=0)
+    with torch.no_grad():
+        for period in ({}, {"period_share": 0.47}):
+            for curve in ({}, tone, {k: 1.3 * v for k, v in tone.items()}):
+                params = {
+                    k: torch.tensor(v, dtype=torch.float64) for k, v in {**STRIPE, **period, **curve}.items()
+                }
+                for index in range(len(pairs)):
+                    phases, costs = problem.phase_costs(params, index)
+                    whole = full_frame_prediction(problem, params, index, phases)
+                    expected = ((whole - pairs[index].attacked) ** 2).sum(dim=(1, 2, 3)).numpy()
+                    np.testing.assert_allclose(costs, expected, rtol=1e-12)
+                    for k in (0, len(phases) // 2, len(phases) - 1):
+                        predicted = problem.predict_stripe(params, index, float(phases[k]))
+                        torch.testing.assert_close(predicted, whole[k], rtol=1e-13, atol=1e-15)

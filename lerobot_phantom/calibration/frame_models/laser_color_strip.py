@@ -182,10 +182,16 @@ class StripFrames(LatentFrameProblem):
         phases = torch.arange(span[0], span[1], PHASE_STEP_ROWS, dtype=torch.float64)
         with torch.no_grad():
             light = self.row_light(params, height, phases)  # (P, H)
-            gains = pair.intensity * self.stripe_gains(params).reshape(1, 3, 1, 1)
             decode, encode = self.tone(params)
-            predicted = encode(decode(pair.clean).unsqueeze(0) + gains * light[:, None, :, None])
-            cost = ((predicted - pair.attacked.unsqueeze(0)) ** 2).sum(dim=(1, 2, 3))
+            linear = decode(pair.clean)
+            # a row no pulse reaches costs the same at every phase: the tone curve runs only over the lit rows of
+            # each phase (a stripe covers a share of the frame), the rest is each row's unlit cost
+            unlit = ((encode(linear) - pair.attacked) ** 2).sum(dim=(0, 2))  # (H,)
+            phase_of, row_of = torch.nonzero(light, as_tuple=True)
+            gains = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1)
+            predicted = encode(linear[:, row_of] + gains * light[phase_of, row_of].reshape(1, -1, 1))
+            lit = ((predicted - pair.attacked[:, row_of]) ** 2).sum(dim=(0, 2)) - unlit[row_of]
+            cost = unlit.sum() + torch.zeros(len(phases), dtype=lit.dtype).index_add_(0, phase_of, lit)
         return phases, cost.numpy()
 
     def best_phase(self, params, index: int) -> float:
