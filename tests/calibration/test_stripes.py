@@ -14,6 +14,8 @@ from __future__ import annotations
 import functools
 import json
 import os
+from collections.abc import Callable
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -554,19 +556,27 @@ def drifting_table(
     path.write_text("\n".join(lines) + "\n")
 
 
+def drifting_draw(seed: int, drifting: bool) -> tuple[np.random.Generator, dict, np.ndarray]:
+    """The drift-naming tests' draw for ``seed``: (its generator, which draws the table next; the camera; each
+    recording's drift), two of five recordings drifting a third to two thirds of a period (none unless
+    ``drifting``). Every start draws the same camera and drifts."""
+    rng = np.random.default_rng([seed, 7])
+    camera = draw_camera(rng, "interior")
+    drifts = np.zeros(5)
+    if drifting:
+        drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
+    return rng, camera, drifts
+
+
 @pytest.fixture(scope="module")
-def drift_reports(tmp_path_factory) -> dict:
-    """report.json of the calibration on the drifting table of each start (``None``: every recording locked), one
-    camera and one set of drifts for all of them, computed once per module (two tests read them)."""
+def drift_reports(tmp_path_factory) -> Callable[[str | None], tuple[dict, str, dict, Path]]:
+    """(report.json, failure message, camera, table) of the calibration on the drifting table of a start
+    (``None``: every recording locked), computed once per module (two tests read them)."""
     reports: dict = {}
 
-    def report_for(start_at: str | None) -> tuple[dict, str, dict, object]:
+    def report_for(start_at: str | None) -> tuple[dict, str, dict, Path]:
         if start_at not in reports:
-            rng = np.random.default_rng([SEED, 7])
-            camera = draw_camera(rng, "interior")
-            drifts = np.zeros(5)
-            if start_at is not None:
-                drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
+            rng, camera, drifts = drifting_draw(SEED, drifting=start_at is not None)
             out = tmp_path_factory.mktemp(f"drift_{start_at}")
             table = out / "drifting.csv"
             drifting_table(table, camera, rng, drifts, start_at=start_at or "placement")

@@ -13,8 +13,6 @@ import sys
 import tempfile
 from pathlib import Path
 
-import numpy as np
-
 
 def main(seeds: list[int]) -> None:
     os.environ.setdefault("STRIPES_SEED", str(seeds[0]))  # the test module reads one at import
@@ -25,10 +23,7 @@ def main(seeds: list[int]) -> None:
         test_stripes.SEED = seed  # calibrate_stripes' held-out split seed is SEED % 1000
         line = [str(seed)]
         for start_at in ("placement", "entry"):
-            rng = np.random.default_rng([seed, 7])
-            camera = test_stripes.draw_camera(rng, "interior")
-            drifts = np.zeros(5)
-            drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
+            rng, camera, drifts = test_stripes.drifting_draw(seed, drifting=True)
             scratch = Path(tempfile.mkdtemp())
             test_stripes.drifting_table(scratch / "d.csv", camera, rng, drifts, start_at=start_at)
             report = test_stripes.calibrate_stripes(

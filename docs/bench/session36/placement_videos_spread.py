@@ -30,14 +30,11 @@ def main(seed: int, overrides: dict[str, float]) -> None:
 
     from lerobot_phantom.transforms import physics
 
-    rng = np.random.default_rng([seed, 7])
-    camera = test_stripes.draw_camera(rng, "interior")
+    rng, camera, drifts = test_stripes.drifting_draw(seed, drifting=True)
     unknown = set(overrides) - set(camera)
     if unknown:
         raise SystemExit(f"unknown camera keys {sorted(unknown)}; valid: {', '.join(sorted(camera))}")
     camera |= overrides
-    drifts = np.zeros(5)
-    drifts[rng.choice(5, 2, replace=False)] = rng.uniform(0.33, 0.67, 2)
     frequency = round(1.0 / (2.0 * camera["height"] * camera["row_time"]), 1)
     print(test_stripes.camera_summary(camera), f"laser {frequency} Hz, drifts {np.round(drifts, 3).tolist()}")
     gaps = []  # (40-video mean - placement kernel) / its standard error, every drifting recording and duty
