@@ -95,6 +95,10 @@ BLINDING_EFFECTS = (
 )
 
 
+# the laser gain's top: a spot of ten thousand full wells over a beam-profile capture's unsaturated core
+MAX_LOG10_GAIN = 4.0
+
+
 def laser_gain(params: dict):
     """The laser's power in the frames over its power in the recorded pattern (fitted as ``log10_gain``)."""
     return 10.0 ** params["log10_gain"]
@@ -377,12 +381,14 @@ class BlindingFrames(PixelProblem):
     def param_specs(self, effects):
         specs = []
         if "linear_light_saturation" in effects:
-            # laser power in the frames over the power the pattern was recorded at: tens for a capture at a few
-            # percent of the attack's power (to keep its core unsaturated), about 1 for one at the attack's power.
-            # It spans decades, so it is searched on its logarithm: on a linear 0-200 range a gain of 0.18 sat
-            # within 0.1% of the range of 0 and was reported as pinned at its bound (camsim auto-exposure case,
-            # docs/bench/camsim_session16.md)
-            specs.append(Param("log10_gain", 0.0, -3.0, float(np.log10(200.0)), scale=0.5))
+            # laser power in the frames over the power the pattern was recorded at: about 1 for a capture at the
+            # attack's power, tens to thousands for a beam-profile capture (its core kept unsaturated) of an attack
+            # that floods the sensor with many full wells. It spans decades, so it is searched on its logarithm: on
+            # a linear 0-200 range a gain of 0.18 sat within 0.1% of the range of 0 and was reported as pinned at
+            # its bound (camsim auto-exposure case, docs/bench/camsim_session16.md). The top was 200 until session
+            # 37: camsim's halo case draws true gains up to 197, the fits ran into that bound, and a tone shoulder
+            # and auto-exposure that camera lacked stretched the light's scale for them (docs/bench/session37.md)
+            specs.append(Param("log10_gain", 0.0, -3.0, MAX_LOG10_GAIN, scale=0.5))
             # beam width behind the capture's saturated core (module docstring), reference pixels: from a
             # fraction of a pixel to far wider than the frame (a flat core, held at the full well)
             specs.append(Param("core_sigma_ref_px", 20.0, 0.5, 2000.0, scale=10.0))
