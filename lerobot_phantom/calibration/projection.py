@@ -174,13 +174,15 @@ def projection_predict(
     effects,
     params: dict[str, float],
     *,
+    surface_light: torch.Tensor | None = None,
     projected_light: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Captured colour (N, 3) in [0, 1] from surface colour, projected colour (N, 3) and strength (N, 1).
     ``projected_light``: the projected colour already decoded to linear light (and spread over its neighbours, which
-    the caller sees and this function does not), in place of decoding ``projected``."""
+    the caller sees and this function does not), in place of decoding ``projected``; ``surface_light`` likewise the
+    surface colour decoded under this model's tone curve."""
     decode, encode = tone_curve(effects, params)
-    surface_lin = decode(surface)
+    surface_lin = decode(surface) if surface_light is None else surface_light
     light = decode(projected) if projected_light is None else projected_light
     if "channel_crosstalk" in effects:
         matrix = torch.stack(

@@ -5,9 +5,14 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import torch
 from calibration_testkit import projection_pairs_with_spread_light
 
-from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
+from lerobot_phantom.calibration.frame_models.light_projection import (
+    LIGHT_MEMO_SIZE,
+    SPREAD_PARAMS,
+    ProjectionFrames,
+)
 from lerobot_phantom.calibration.identify import select_and_identify
 from lerobot_phantom.calibration.projection import TripleProblem
 from lerobot_phantom.transforms.light_projection import LightProjection
@@ -38,3 +43,37 @@ def test_colour_triple_tables_are_not_offered_light_spread():
     # a table row has no neighbouring pixels for light to spread to
     assert "light_spread" not in {e.name for e in TripleProblem.candidates}
     assert "light_spread" in {e.name for e in ProjectionFrames.candidates}
+
+
+def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
+    """The decoded and spread light a fit reuses between the columns of a finite-difference Jacobian
+    (``ProjectionFrames.memoised_light``) must equal the light computed afresh for every parameter step, including
+    steps of the tone curve and of the spread, which change it."""
+    pairs = projection_pairs_with_spread_light(1.0, seed=5)
+    effects = frozenset(
+        {"additive_light", "channel_crosstalk", "tone_shoulder", "sensor_gamma", "light_spread"}
+    )
+    kept, fresh = ProjectionFrames(pairs, seed=5), ProjectionFrames(pairs, seed=5)
+    # the features of all pairs stacked, as a fit stacks them
+    per_pair = [kept.features(i, kept.samples[i]) for i in range(len(pairs))]
+    feats = {k: torch.cat([f[k] for f in per_pair]) for k in per_pair[0]}
+    point = {spec.name: spec.init for spec in kept.param_specs(effects)}
+    steps = [point] + [{**point, name: value * 1.01 + 1e-3} for name, value in point.items()] + [point]
+    spreads = []
+    spread_light = kept.spread_light
+    kept.spread_light = lambda *args: spreads.append(args) or spread_light(*args)
+    with torch.no_grad():
+        for params in steps:
+            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+            fresh.light_memo.clear()
+            torch.testing.assert_close(
+                kept.predict_features(effects, values, feats),
+                fresh.predict_features(effects, values, feats),
+                rtol=0,
+                atol=0,
+            )
+    # the light was spread anew only for the steps that move the tone curve or the spread (and the first point),
+    # and the memo stays bounded while the steps run through every parameter
+    moving = sum(name in SPREAD_PARAMS for name in point)
+    assert len(spreads) == 1 + moving < len(steps)
+    assert len(kept.light_memo) <= LIGHT_MEMO_SIZE
