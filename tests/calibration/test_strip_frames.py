@@ -90,7 +90,8 @@ def full_frame_prediction(
 def test_registered_costs_over_the_lit_rows_equal_the_whole_frame(tone):
     """Registered costs computed over the rows a pulse reaches (each other row costs its unlit error at every
     phase) equal the whole-frame formula at every phase, for one stripe or a periodic train and each tone curve,
-    and the prediction at a phase is that phase's whole frame."""
+    and the prediction at a phase is that phase's whole frame (the unlit frame a curve keeps, ``tone_memo``, must
+    not be reused under the next curve)."""
     pairs = stripe_pairs(5, 0.47, n=3)
     for pair in pairs:
         # black pixels: the one level a tone curve's round trip does not return (clipped to its darkest light)

@@ -9,6 +9,8 @@ frame model lives in its own module of this package.
 from __future__ import annotations
 
 import math
+from collections import OrderedDict
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,6 +33,48 @@ from lerobot_phantom.calibration.structure import LAG, ResidualSample
 from lerobot_phantom.transforms.physics import gaussian_spread
 
 REFERENCE_SIZE = 256
+
+
+class ParameterMemo:
+    """Values of a pure function of a few fit parameters, kept for the last ``size`` keys.
+
+    A finite-difference Jacobian moves one parameter at a time, so every column that moves another parameter
+    repeats the value at the point it is taken at: a frame decoded under the fitted tone curve, light spread over
+    the frame. ``key`` holds what the value depends on (the parameters' values as floats); ``anchor`` is the
+    tensor the value was computed from, kept with it, so that its id in a key cannot be reused by another tensor
+    while the entry lives. Never under autograd: a Jacobian taken by torch differentiates through the value, which
+    a kept one would cut."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.entries: OrderedDict = OrderedDict()
+
+    def __len__(self) -> int:
+        return len(self.entries)
+
+    def clear(self) -> None:
+        self.entries.clear()
+
+    def get(self, anchor: torch.Tensor, key: tuple, compute: Callable[[], torch.Tensor]) -> torch.Tensor:
+        if torch.is_grad_enabled():
+            return compute()
+        key = (id(anchor), *key)
+        kept = self.entries.get(key)
+        if kept is not None and kept[0] is anchor:
+            self.entries.move_to_end(key)
+            return kept[1]
+        value = compute()
+        self.entries[key] = (anchor, value)
+        if len(self.entries) > self.size:
+            self.entries.popitem(last=False)
+        return value
+
+
+def parameter_values(params: dict, names) -> tuple[tuple[str, float], ...]:
+    """(name, value) of those of ``names`` that ``params`` holds, in ``names``' order: a memo key (with the names,
+    since which of them a model has can change the value as much as what they are)."""
+    return tuple((n, float(params[n])) for n in names if n in params)
+
 
 SENSOR_GAMMA = Effect(
     "sensor_gamma",

@@ -9,7 +9,13 @@ import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
-from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, LatentFrameProblem, Pair
+from lerobot_phantom.calibration.frame_models.common import (
+    SENSOR_GAMMA,
+    LatentFrameProblem,
+    Pair,
+    ParameterMemo,
+    parameter_values,
+)
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     decode_encode,
@@ -55,6 +61,9 @@ PERIOD_STARTS = 3
 STRIPE_SHARES_OF_PERIOD = (0.3, 0.5, 0.7)
 TONE_EFFECTS = frozenset({"sensor_gamma", "tone_shoulder"})
 TONE_PARAMS = frozenset({"gamma"} | {p.name for p in SHOULDER_PARAMS})
+# a clean frame decoded and re-encoded under the tone curve, kept for each pair at the fitted point and at a step of
+# each tone parameter (finite-difference Jacobian columns that move another parameter repeat it)
+TONE_MEMO_PER_PAIR = 2 * (1 + len(TONE_PARAMS))
 ON_SHARES_OF_STRIPE = (0.2, 0.5, 0.8)  # single-stripe starts: the pulse's share of the stripe's rows
 
 
@@ -126,6 +135,7 @@ class StripFrames(LatentFrameProblem):
             full[start:end] = strip_profile(pair.height, pair.width).double() / 255.0
             self.profiles.append(full)
         self._period_starts: dict[frozenset[str], list[dict[str, float]]] = {}
+        self.tone_memo = ParameterMemo(TONE_MEMO_PER_PAIR * len(pairs))
 
     # -- the paper's band
     def predict_band(self, params, index: int) -> torch.Tensor:
@@ -163,12 +173,34 @@ class StripFrames(LatentFrameProblem):
             params, "shoulder" in params, None if "shoulder" in params else params.get("gamma", 1.0)
         )
 
+    def unlit_frame(self, params, index: int) -> tuple[torch.Tensor, torch.Tensor]:
+        """Pair ``index``'s clean frame decoded under the model's tone curve, and re-encoded: what every row no
+        pulse reaches is predicted to hold."""
+        pair = self.pairs[index]
+
+        def decoded_and_encoded():
+            decode, encode = self.tone(params)
+            linear = decode(pair.clean)
+            return torch.stack([linear, encode(linear)])
+
+        frames = self.tone_memo.get(
+            pair.clean, parameter_values(params, sorted(TONE_PARAMS)), decoded_and_encoded
+        )
+        return frames[0], frames[1]
+
     def predict_stripe(self, params, index: int, phase_rows) -> torch.Tensor:
         pair = self.pairs[index]
         light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
         decode, encode = self.tone(params)
-        return encode(decode(pair.clean) + added)
+        if torch.is_grad_enabled():
+            return encode(decode(pair.clean) + added)
+        # a stripe lights a share of the rows: the tone curve runs over those, the others hold the unlit frame
+        linear, unlit = self.unlit_frame(params, index)
+        rows = torch.nonzero(light).flatten()
+        predicted = unlit.clone()
+        predicted[:, rows] = encode(linear[:, rows] + added[:, rows])
+        return predicted
 
     def phase_costs(self, params, index: int) -> tuple[torch.Tensor, np.ndarray]:
         """(pulse phases in rows, SSE of pair ``index`` for each): every stripe position, a row apart."""
@@ -182,11 +214,11 @@ class StripFrames(LatentFrameProblem):
         phases = torch.arange(span[0], span[1], PHASE_STEP_ROWS, dtype=torch.float64)
         with torch.no_grad():
             light = self.row_light(params, height, phases)  # (P, H)
-            decode, encode = self.tone(params)
-            linear = decode(pair.clean)
+            _, encode = self.tone(params)
+            linear, unlit_frame = self.unlit_frame(params, index)
             # a row no pulse reaches costs the same at every phase: the tone curve runs only over the lit rows of
             # each phase (a stripe covers a share of the frame), the rest is each row's unlit cost
-            unlit = ((encode(linear) - pair.attacked) ** 2).sum(dim=(0, 2))  # (H,)
+            unlit = ((unlit_frame - pair.attacked) ** 2).sum(dim=(0, 2))  # (H,)
             phase_of, row_of = torch.nonzero(light, as_tuple=True)
             gains = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1)
             predicted = encode(linear[:, row_of] + gains * light[phase_of, row_of].reshape(1, -1, 1))

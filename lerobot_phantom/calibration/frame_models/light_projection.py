@@ -3,14 +3,19 @@
 from __future__ import annotations
 
 import math
-from collections import OrderedDict
 from collections.abc import Callable
 from functools import partial
 
 import torch
 
 from lerobot_phantom.calibration.core import Fit
-from lerobot_phantom.calibration.frame_models.common import Pair, PixelProblem, flat_pixels
+from lerobot_phantom.calibration.frame_models.common import (
+    Pair,
+    ParameterMemo,
+    PixelProblem,
+    flat_pixels,
+    parameter_values,
+)
 from lerobot_phantom.calibration.projection import (
     FRAME_EFFECTS,
     SPREAD_HIGH_REF_PX,
@@ -48,33 +53,14 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         super().__init__(pairs, seed)
         # one kernel for every value a fit tries: as wide as the widest spread at the smallest working scale
         self.spread_radius = max(math.ceil(3.0 * SPREAD_HIGH_REF_PX / p.to_reference) for p in pairs)
-        self.light_memo: OrderedDict = OrderedDict()
+        self.light_memo = ParameterMemo(LIGHT_MEMO_SIZE)
 
     def memoised_light(
         self, kind: str, feats: dict, effects, params: dict, names: tuple, compute: Callable[[], torch.Tensor]
     ) -> torch.Tensor:
-        """``compute()``, reused while the pixels (``feats``), the effects and the parameters ``names`` (those of
-        them the model has) repeat. Never under autograd: a Jacobian taken by torch differentiates through the
-        value, which a kept one would cut."""
-        if torch.is_grad_enabled():
-            return compute()
-        anchor = feats["pixel"]
-        key = (
-            kind,
-            id(anchor),
-            frozenset(effects),
-            tuple(float(params[n]) for n in names if n in params),
-        )
-        kept = self.light_memo.get(key)
-        # the anchor is kept with the value, so its id cannot be reused by other pixels while the entry lives
-        if kept is not None and kept[0] is anchor:
-            self.light_memo.move_to_end(key)
-            return kept[1]
-        value = compute()
-        self.light_memo[key] = (anchor, value)
-        if len(self.light_memo) > LIGHT_MEMO_SIZE:
-            self.light_memo.popitem(last=False)
-        return value
+        """``compute()``, reused while the pixels (``feats``), the effects and the parameters ``names`` repeat."""
+        key = (kind, frozenset(effects), parameter_values(params, names))
+        return self.light_memo.get(feats["pixel"], key, compute)
 
     def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
         pair = self.pairs[index]
