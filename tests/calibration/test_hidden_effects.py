@@ -19,19 +19,9 @@ SLOW = pytest.mark.slow  # > 10 s each on 2 cores
 CASES = [
     pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SLOW),
     pytest.param("laser_blinding", {"auto_exposure"}, 12, marks=SLOW),
-    pytest.param(
-        "light_projection",
-        {"additive_light", "channel_crosstalk"},
-        21,
-        marks=[
-            SLOW,
-            pytest.mark.xfail(
-                strict=False,
-                reason="open (issue 12): with identification on, additive_light is not named next to "
-                "channel_crosstalk on this seed (named: channel_crosstalk only)",
-            ),
-        ],
-    ),
+    # an expected failure until session 37 (additive_light not named next to channel_crosstalk); it passed in every
+    # recorded suite run from session 30 on (docs/bench/session3*/suite_*.log)
+    pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SLOW),
     pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
     pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
     pytest.param("em_truncation", {"free_band_position"}, 51),
