@@ -42,6 +42,8 @@ SHOULDER_PARAMS = (
     Param("shoulder", 1.0, 0.0, 500.0, scale=3.0),
     Param("shoulder_exponent", 1.0, 0.25, 4.0, scale=0.5),
 )
+# every parameter a fitted tone curve may have: ``sensor_gamma``'s power and the shoulder's two
+TONE_PARAMS = ("gamma", *(p.name for p in SHOULDER_PARAMS))
 
 
 def _parts(params: dict, gamma) -> tuple:

@@ -77,3 +77,33 @@ def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
     moving = sum(name in SPREAD_PARAMS for name in point)
     assert len(spreads) == 1 + moving < len(steps)
     assert len(kept.light_memo) <= LIGHT_MEMO_SIZE
+
+
+def test_a_jacobian_taken_by_torch_passes_the_kept_light_by():
+    """Under a torch Jacobian (``fit_least_squares(jacobian="reverse")``) the kept light is neither read nor keyed:
+    the derivative in a tone parameter and in the spread matches a central difference."""
+    pairs = projection_pairs_with_spread_light(1.0, seed=5)
+    effects = frozenset({"additive_light", "sensor_gamma", "light_spread"})
+    problem = ProjectionFrames(pairs, seed=5)
+    feats = problem.features(0, problem.samples[0])
+    names = ("gamma", "spread_ref_px")
+    point = {spec.name: spec.init for spec in problem.param_specs(effects)}
+
+    def predicted(values: torch.Tensor) -> torch.Tensor:
+        params = {k: torch.tensor(v, dtype=torch.float64) for k, v in point.items()}
+        params.update(dict(zip(names, values, strict=True)))
+        return problem.predict_features(effects, params, feats).sum()
+
+    at = torch.tensor([point[n] for n in names], dtype=torch.float64)
+    with torch.no_grad():  # a value computed without autograd is kept at this very point first
+        predicted(at)
+    jacobian = torch.func.jacrev(predicted)(at)
+    step = 1e-6
+    with torch.no_grad():
+        central = torch.stack(
+            [
+                (predicted(at + step * e) - predicted(at - step * e)) / (2 * step)
+                for e in torch.eye(2, dtype=at.dtype)
+            ]
+        )
+    torch.testing.assert_close(jacobian, central, rtol=1e-4, atol=1e-6)

@@ -40,10 +40,10 @@ class ParameterMemo:
 
     A finite-difference Jacobian moves one parameter at a time, so every column that moves another parameter
     repeats the value at the point it is taken at: a frame decoded under the fitted tone curve, light spread over
-    the frame. ``key`` holds what the value depends on (the parameters' values as floats); ``anchor`` is the
+    the frame. ``key()`` gives what the value depends on (the parameters' values as floats); ``anchor`` is the
     tensor the value was computed from, kept with it, so that its id in a key cannot be reused by another tensor
     while the entry lives. Never under autograd: a Jacobian taken by torch differentiates through the value, which
-    a kept one would cut."""
+    a kept one would cut, and its parameters have no float values to key on."""
 
     def __init__(self, size: int) -> None:
         self.size = size
@@ -55,10 +55,12 @@ class ParameterMemo:
     def clear(self) -> None:
         self.entries.clear()
 
-    def get(self, anchor: torch.Tensor, key: tuple, compute: Callable[[], torch.Tensor]) -> torch.Tensor:
+    def get(
+        self, anchor: torch.Tensor, key: Callable[[], tuple], compute: Callable[[], torch.Tensor]
+    ) -> torch.Tensor:
         if torch.is_grad_enabled():
             return compute()
-        key = (id(anchor), *key)
+        key = (id(anchor), *key())
         kept = self.entries.get(key)
         if kept is not None and kept[0] is anchor:
             self.entries.move_to_end(key)

@@ -18,6 +18,7 @@ from lerobot_phantom.calibration.frame_models.common import (
 )
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
+    TONE_PARAMS,
     decode_encode,
     equivalent_power_gamma,
     implied_gamma_statistic,
@@ -60,7 +61,6 @@ PERIOD_SCAN_STEPS = 48
 PERIOD_STARTS = 3
 STRIPE_SHARES_OF_PERIOD = (0.3, 0.5, 0.7)
 TONE_EFFECTS = frozenset({"sensor_gamma", "tone_shoulder"})
-TONE_PARAMS = frozenset({"gamma"} | {p.name for p in SHOULDER_PARAMS})
 # a clean frame decoded and re-encoded under the tone curve, kept for each pair at the fitted point and at a step of
 # each tone parameter (finite-difference Jacobian columns that move another parameter repeat it)
 TONE_MEMO_PER_PAIR = 2 * (1 + len(TONE_PARAMS))
@@ -184,7 +184,7 @@ class StripFrames(LatentFrameProblem):
             return torch.stack([linear, encode(linear)])
 
         frames = self.tone_memo.get(
-            pair.clean, parameter_values(params, sorted(TONE_PARAMS)), decoded_and_encoded
+            pair.clean, lambda: parameter_values(params, TONE_PARAMS), decoded_and_encoded
         )
         return frames[0], frames[1]
 
@@ -192,9 +192,7 @@ class StripFrames(LatentFrameProblem):
         pair = self.pairs[index]
         light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
-        decode, encode = self.tone(params)
-        if torch.is_grad_enabled():
-            return encode(decode(pair.clean) + added)
+        _, encode = self.tone(params)
         # a stripe lights a share of the rows: the tone curve runs over those, the others hold the unlit frame
         linear, unlit = self.unlit_frame(params, index)
         rows = torch.nonzero(light).flatten()

@@ -24,10 +24,10 @@ from lerobot_phantom.calibration.projection import (
     projection_warm,
     tone_curve,
 )
+from lerobot_phantom.calibration.tone import TONE_PARAMS
 from lerobot_phantom.transforms.physics import gaussian_spread
 
-# the parameters decoding to linear light depends on, and spreading the projected light besides
-TONE_PARAMS = ("gamma", "shoulder", "shoulder_exponent")
+# the parameters spreading the projected light depends on (decoding it depends on TONE_PARAMS)
 SPREAD_PARAMS = (*TONE_PARAMS, "spread_ref_px")
 # a finite-difference Jacobian moves one parameter at a time, so every column but the light's own repeats the
 # decoded and spread light of the point it is taken at (decoding and spreading took 75 of a 101 s calibration,
@@ -59,8 +59,9 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         self, kind: str, feats: dict, effects, params: dict, names: tuple, compute: Callable[[], torch.Tensor]
     ) -> torch.Tensor:
         """``compute()``, reused while the pixels (``feats``), the effects and the parameters ``names`` repeat."""
-        key = (kind, frozenset(effects), parameter_values(params, names))
-        return self.light_memo.get(feats["pixel"], key, compute)
+        return self.light_memo.get(
+            feats["pixel"], lambda: (kind, frozenset(effects), parameter_values(params, names)), compute
+        )
 
     def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
         pair = self.pairs[index]
