@@ -110,6 +110,9 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
+# rounds of grid and joint fit after the first joint fit (fit_drift): each round takes a drift out of the flat region
+# at 0 that the first grid, at the locked model's readout, left it in
+DRIFT_REGRID_ROUNDS = 2
 # a recording keeps its drift when its fit rows' variance-weighted squared error drops by at least this much against a
 # lock: the 5% critical value of the likelihood ratio for one parameter at its bound (a 50:50 mixture of 0 and
 # chi-square with one degree of freedom; Self & Liang 1987)
@@ -521,8 +524,17 @@ class StripeProblem(Problem):
         placements the drift starts from, by ``fit``'s search (or ``start`` itself when it is that model, fitted on
         these items by the selection step it extends); then each recording's drift from ``DRIFT_GRID``
         (recordings share no drift, so one batched evaluation scores every recording at every grid value); then
-        all parameters jointly from there; then the drifts their recordings' fit rows do not call for
-        (``drifts_without_evidence``) are locked and the rest refitted once (listed in the fit's extra)."""
+        all parameters jointly from there; then the grid again at the joint fit's shared parameters, and the joint
+        fit again from every drift the grid improves (up to ``DRIFT_REGRID_ROUNDS`` times); then the drifts their
+        recordings' fit rows do not call for (``drifts_without_evidence``) are locked and the rest refitted once
+        (listed in the fit's extra).
+
+        The second grid is needed because the locked model meets drifting recordings with a wrong readout: the
+        row time that best splits their cut stripes' misfit can leave another drifting recording's rows best
+        predicted locked, and a drift the first grid set to 0 stays there (a small drift cuts no stripe, so the
+        joint fit sees no slope). Without it, a recording drifting a third of a period kept its drift at 0 while
+        the joint fit moved the row time to the truth, and predicted its widest held-out stripes 44-75 rows too
+        wide (tests/calibration/test_stripes.py, entry start, STRIPES_SEED=1002; docs/bench/session38.md)."""
         locked = effects - set(DRIFT_EFFECTS)
         if start is not None and start.effects == locked and start.extra.get("frames") == "interior":
             base = start  # the locked model on these very items (the selection step's fit it extends)
@@ -533,23 +545,28 @@ class StripeProblem(Problem):
                 shared = Fit(locked, kept, {"frames": "interior"})
             base = self.fit_rules(locked, items, shared, ("interior",))
         target = torch.as_tensor(self.rows[items])
-        grid = torch.as_tensor(DRIFT_GRID)
-        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in base.params.items()}
-        with torch.no_grad():
-            predicted = self.predict(effects, values | {n: grid for n in self.drift_names}, items, "interior")
-        squared = ((predicted - target) ** 2).numpy()
-        recordings = self.recording[items]
-        warm = dict(base.params)
-        for index, name in enumerate(self.drift_names):
-            mine = recordings == index
-            warm[name] = float(DRIFT_GRID[np.argmin(squared[:, mine].sum(1))]) if mine.any() else 0.0
         specs = self.param_specs(effects)
-        params = fit_least_squares(
-            specs,
-            lambda p: self.predict(effects, p, items, "interior") - target,
-            warm=warm,
-            jacobian=DRIFT_JACOBIAN,
-        )
+
+        def joint_fit(warm: dict[str, float]) -> dict[str, float]:
+            return fit_least_squares(
+                specs,
+                lambda p: self.predict(effects, p, items, "interior") - target,
+                warm=warm,
+                jacobian=DRIFT_JACOBIAN,
+            )
+
+        def error(params: dict[str, float]) -> float:
+            return self.squared_errors(Fit(effects, params, {"frames": "interior"}), items)[0]
+
+        params = joint_fit(dict(base.params) | self.grid_drifts(effects, base.params, items))
+        for _ in range(DRIFT_REGRID_ROUNDS):
+            better = self.grid_drifts(effects, params, items, only_improving=True)
+            if not better:
+                break
+            refitted = joint_fit(params | better)
+            if error(refitted) >= error(params):
+                break
+            params = refitted
         unsupported = self.drifts_without_evidence(effects, params, items)
         if unsupported:
             # the drifts the recordings' own fit rows do not call for are locked, the rest refitted with them
@@ -563,6 +580,38 @@ class StripeProblem(Problem):
             )
             params = {spec.name: refitted[spec.name] for spec in specs}
         return Fit(effects, params, {"frames": "interior", "drifts_locked_for_want_of_evidence": unsupported})
+
+    def grid_drifts(
+        self, effects: frozenset[str], params: dict, items: np.ndarray, only_improving: bool = False
+    ) -> dict[str, float]:
+        """Each recording's drift from ``DRIFT_GRID`` at ``params``' shared parameters (the value whose fit rows'
+        squared error is least; 0 for a recording without fit rows). ``only_improving``: only the recordings whose
+        best grid value lowers their error below that of their drift in ``params``."""
+        target = torch.as_tensor(self.rows[items])
+        grid = torch.as_tensor(DRIFT_GRID)
+        shared = {
+            k: torch.tensor(v, dtype=torch.float64) for k, v in params.items() if k not in self.drift_names
+        }
+        with torch.no_grad():
+            predicted = self.predict(effects, shared | {n: grid for n in self.drift_names}, items, "interior")
+            squared = ((predicted - target) ** 2).numpy()
+            if only_improving:
+                drifts = {n: torch.tensor(params[n], dtype=torch.float64) for n in self.drift_names}
+                current = ((self.predict(effects, shared | drifts, items, "interior") - target) ** 2).numpy()
+        recordings = self.recording[items]
+        drifts = {}
+        for index, name in enumerate(self.drift_names):
+            mine = recordings == index
+            if not mine.any():
+                if not only_improving:
+                    drifts[name] = 0.0
+                continue
+            errors = squared[:, mine].sum(1)
+            best = int(np.argmin(errors))
+            # a drift in the flat region ties with the grid's 0 up to rounding, which is no improvement
+            if not only_improving or errors[best] < current[mine].sum() * (1.0 - 1e-9) - 1e-12:
+                drifts[name] = float(DRIFT_GRID[best])
+        return drifts
 
     def drifts_without_evidence(self, effects: frozenset[str], params: dict, items: np.ndarray) -> list[str]:
         """The recordings' drifts that their own fit rows do not call for: a drift is a parameter per recording,

@@ -636,6 +636,28 @@ def test_recordings_that_drift_are_named_and_locked_ones_are_not(drift_reports, 
     assert report["extended"]["heldout_rmse"] < problem.rmse(locked, heldout), about
 
 
+@pytest.mark.slow
+def test_a_drift_the_locked_readout_hides_is_found(tmp_path):
+    """A regression draw (STRIPES_SEED=1002, entry start; drifts of 0.37 and 0.55 of a period at the first and fourth
+    exposures): the locked model, fitted first, meets the cut stripes with a row time 8% long, at which the first
+    recording's fit rows are predicted best locked, so the first grid set its drift to 0; the joint fit then moved
+    the row time to the truth and left that drift at 0 (a small drift cuts no stripe: the error has no slope there),
+    and the widest held-out stripes were predicted 44 and 75 rows too wide (held-out 30.8 rows against the locked
+    model's 24.9). The drift fit's second grid, at the joint fit's readout, finds both drifts."""
+    rng, camera, drifts = drifting_draw(1002, drifting=True)
+    table = tmp_path / "drifting.csv"
+    drifting_table(table, camera, rng, drifts, start_at="entry")
+    problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
+    fit_items, heldout = seeded_split(problem.n_items, 0.2, 1002 % 1000)
+    fit = problem.fit(frozenset({"exposure_overlap", "phase_drift", "drift_from_entry"}), fit_items)
+    found = np.array([fit.params[name] for name in problem.drift_names])
+    about = (
+        f"drifts {drifts}, found {found}, row time {fit.params['row_time_s']} (truth {camera['row_time']})"
+    )
+    assert np.all(np.abs(found - drifts)[drifts > 0] < 0.1), about
+    assert problem.rmse(fit, heldout) < 5.0, about
+
+
 def gain_interval(report: dict, effect: str) -> tuple[float, float] | None:
     """The interval of the cross-validated error ratio on which ``effect`` was identified (None: not named)."""
     for result in report["identification"]:
