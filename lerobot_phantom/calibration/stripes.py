@@ -817,7 +817,7 @@ class StripeProblem(Problem):
                     "drift_evidence_rule": (
                         f"a recording keeps its drift when its fit rows' squared error, weighted by each row's "
                         f"variance (standard error of its mean + the model's error beyond it), drops by >= "
-                        f"{DRIFT_EVIDENCE} against a lock"
+                        f"{DRIFT_EVIDENCE} against a lock without the row that gains most (two videos call for it)"
                     ),
                 }
                 if "drifts_locked_for_want_of_evidence" in fit.extra
