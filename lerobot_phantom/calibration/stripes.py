@@ -110,12 +110,9 @@ MIN_ROWS_PER_RECORDING = 4
 # the drift's grid makes its error piecewise: finite differences reach the fit exact derivatives reach, at a third of
 # forward mode's CPU and a fifteenth of reverse mode's (session 28, the Axis table)
 DRIFT_JACOBIAN = "2-point"
-# rounds of grid and joint fit after the first joint fit (fit_drift): each round takes a drift out of the flat region
-# at 0 that the first grid, at the locked model's readout, left it in
-DRIFT_REGRID_ROUNDS = 2
 # a recording keeps its drift when its fit rows' variance-weighted squared error drops by at least this much against a
-# lock, without the row that gains most: the 5% critical value of the likelihood ratio for one parameter at its bound
-# (a 50:50 mixture of 0 and chi-square with one degree of freedom; Self & Liang 1987)
+# lock: the 5% critical value of the likelihood ratio for one parameter at its bound (a 50:50 mixture of 0 and
+# chi-square with one degree of freedom; Self & Liang 1987)
 DRIFT_EVIDENCE = 2.706
 
 
@@ -524,17 +521,8 @@ class StripeProblem(Problem):
         placements the drift starts from, by ``fit``'s search (or ``start`` itself when it is that model, fitted on
         these items by the selection step it extends); then each recording's drift from ``DRIFT_GRID``
         (recordings share no drift, so one batched evaluation scores every recording at every grid value); then
-        all parameters jointly from there; then the grid again at the joint fit's shared parameters, and the joint
-        fit again from every drift the grid improves (up to ``DRIFT_REGRID_ROUNDS`` times); then the drifts their
-        recordings' fit rows do not call for (``drifts_without_evidence``) are locked and the rest refitted once
-        (listed in the fit's extra).
-
-        The second grid is needed because the locked model meets drifting recordings with a wrong readout: the
-        row time that best splits their cut stripes' misfit can leave another drifting recording's rows best
-        predicted locked, and a drift the first grid set to 0 stays there (a small drift cuts no stripe, so the
-        joint fit sees no slope). Without it, a recording drifting a third of a period kept its drift at 0 while
-        the joint fit moved the row time to the truth, and predicted its widest held-out stripes 44-75 rows too
-        wide (tests/calibration/test_stripes.py, entry start, STRIPES_SEED=1002; docs/bench/session38.md)."""
+        all parameters jointly from there; then the drifts their recordings' fit rows do not call for
+        (``drifts_without_evidence``) are locked and the rest refitted once (listed in the fit's extra)."""
         locked = effects - set(DRIFT_EFFECTS)
         if start is not None and start.effects == locked and start.extra.get("frames") == "interior":
             base = start  # the locked model on these very items (the selection step's fit it extends)
@@ -545,28 +533,23 @@ class StripeProblem(Problem):
                 shared = Fit(locked, kept, {"frames": "interior"})
             base = self.fit_rules(locked, items, shared, ("interior",))
         target = torch.as_tensor(self.rows[items])
+        grid = torch.as_tensor(DRIFT_GRID)
+        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in base.params.items()}
+        with torch.no_grad():
+            predicted = self.predict(effects, values | {n: grid for n in self.drift_names}, items, "interior")
+        squared = ((predicted - target) ** 2).numpy()
+        recordings = self.recording[items]
+        warm = dict(base.params)
+        for index, name in enumerate(self.drift_names):
+            mine = recordings == index
+            warm[name] = float(DRIFT_GRID[np.argmin(squared[:, mine].sum(1))]) if mine.any() else 0.0
         specs = self.param_specs(effects)
-
-        def joint_fit(warm: dict[str, float]) -> dict[str, float]:
-            return fit_least_squares(
-                specs,
-                lambda p: self.predict(effects, p, items, "interior") - target,
-                warm=warm,
-                jacobian=DRIFT_JACOBIAN,
-            )
-
-        def error(params: dict[str, float]) -> float:
-            return self.squared_errors(Fit(effects, params, {"frames": "interior"}), items)[0]
-
-        params = joint_fit(dict(base.params) | self.grid_drifts(effects, base.params, items))
-        for _ in range(DRIFT_REGRID_ROUNDS):
-            better = self.grid_drifts(effects, params, items, only_improving=True)
-            if not better:
-                break
-            refitted = joint_fit(params | better)
-            if error(refitted) >= error(params):
-                break
-            params = refitted
+        params = fit_least_squares(
+            specs,
+            lambda p: self.predict(effects, p, items, "interior") - target,
+            warm=warm,
+            jacobian=DRIFT_JACOBIAN,
+        )
         unsupported = self.drifts_without_evidence(effects, params, items)
         if unsupported:
             # the drifts the recordings' own fit rows do not call for are locked, the rest refitted with them
@@ -581,38 +564,6 @@ class StripeProblem(Problem):
             params = {spec.name: refitted[spec.name] for spec in specs}
         return Fit(effects, params, {"frames": "interior", "drifts_locked_for_want_of_evidence": unsupported})
 
-    def grid_drifts(
-        self, effects: frozenset[str], params: dict, items: np.ndarray, only_improving: bool = False
-    ) -> dict[str, float]:
-        """Each recording's drift from ``DRIFT_GRID`` at ``params``' shared parameters (the value whose fit rows'
-        squared error is least; 0 for a recording without fit rows). ``only_improving``: only the recordings whose
-        best grid value lowers their error below that of their drift in ``params``."""
-        target = torch.as_tensor(self.rows[items])
-        grid = torch.as_tensor(DRIFT_GRID)
-        shared = {
-            k: torch.tensor(v, dtype=torch.float64) for k, v in params.items() if k not in self.drift_names
-        }
-        with torch.no_grad():
-            predicted = self.predict(effects, shared | {n: grid for n in self.drift_names}, items, "interior")
-            squared = ((predicted - target) ** 2).numpy()
-            if only_improving:
-                drifts = {n: torch.tensor(params[n], dtype=torch.float64) for n in self.drift_names}
-                current = ((self.predict(effects, shared | drifts, items, "interior") - target) ** 2).numpy()
-        recordings = self.recording[items]
-        drifts = {}
-        for index, name in enumerate(self.drift_names):
-            mine = recordings == index
-            if not mine.any():
-                if not only_improving:
-                    drifts[name] = 0.0
-                continue
-            errors = squared[:, mine].sum(1)
-            best = int(np.argmin(errors))
-            # a drift in the flat region ties with the grid's 0 up to rounding, which is no improvement
-            if not only_improving or errors[best] < current[mine].sum() * (1.0 - 1e-9) - 1e-12:
-                drifts[name] = float(DRIFT_GRID[best])
-        return drifts
-
     def drifts_without_evidence(self, effects: frozenset[str], params: dict, items: np.ndarray) -> list[str]:
         """The recordings' drifts that their own fit rows do not call for: a drift is a parameter per recording,
         and a recording whose one cut video sits within its measurement error, or whose fit stripes are all narrow
@@ -622,15 +573,7 @@ class StripeProblem(Problem):
         a lock: the drop in its fit rows' squared error, each row weighted by its variance (the row's standard
         error of the mean from the table, plus the model's error beyond measurement, estimated from every fit row's
         residual). A drift is kept when the drop reaches ``DRIFT_EVIDENCE`` (the 5% critical value of a likelihood
-        ratio for a parameter at its bound) without the fit row whose drop is largest.
-
-        A drift is the beat of the laser and frame clocks, which every video of the recording shares; a single
-        video's cut stripe is as well explained by where that one video started. So the evidence must come from at
-        least two videos. Measured at the joint optimum (session 38), every drift a synthetic recording did not have
-        and every drift that cut the Axis table's locked held-out videos rested on one fit row, with nothing left
-        without it (drops of 0.8-36 rows^2/variance); every drift the data call for kept 66 or more without its
-        largest row (the Axis exposure-50 sweep, the Logitech exposures 1 and 5, the synthetic drifting recordings;
-        docs/bench/session38.md)."""
+        ratio for a parameter at its bound)."""
         drifting = [n for n in self.drift_names if params[n] > 0.0]
         if not drifting:
             return []
@@ -649,12 +592,11 @@ class StripeProblem(Problem):
             model_variance + measured_variance
         )
         recordings = self.recording[items]
-        unsupported = []
-        for name in drifting:
-            mine = drop[recordings == self.drift_names.index(name)]
-            if mine.sum() - mine.max(initial=0.0) < DRIFT_EVIDENCE:
-                unsupported.append(name)
-        return unsupported
+        return [
+            name
+            for name in drifting
+            if drop[recordings == self.drift_names.index(name)].sum() < DRIFT_EVIDENCE
+        ]
 
     @staticmethod
     def regime_starts(
@@ -817,7 +759,7 @@ class StripeProblem(Problem):
                     "drift_evidence_rule": (
                         f"a recording keeps its drift when its fit rows' squared error, weighted by each row's "
                         f"variance (standard error of its mean + the model's error beyond it), drops by >= "
-                        f"{DRIFT_EVIDENCE} against a lock without the row that gains most (two videos call for it)"
+                        f"{DRIFT_EVIDENCE} against a lock"
                     ),
                 }
                 if "drifts_locked_for_want_of_evidence" in fit.extra
