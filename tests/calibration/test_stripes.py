@@ -654,7 +654,7 @@ def test_recordings_that_drift_are_named_and_locked_ones_are_not(drift_reports, 
     "the drifting recordings bias; a recording the grid leaves at 0 stays there. Grid again at the joint fit's "
     "readout (tried in session 38, e8f7105) finds it, but on the Axis table it also gave two locked sweeps drifts "
     "from one video each (splits 3 and 6: 3.21 -> 6.42 and 2.82 -> 6.23 rows held-out), named drift_from_entry on "
-    "a placement table (STRIPES_SEED=1010) and cost 15-150% more CPU; requiring two videos' evidence (3874924) "
+    "a placement table (STRIPES_SEED=1010) and cost 1.1-2.5x the CPU; requiring two videos' evidence (3874924) "
     "undid split 2 (3.95 -> 26.4) and a placement draw. Both were taken back (docs/bench/session38.md)",
 )
 def test_a_drift_the_locked_readout_hides_is_found(tmp_path):
