@@ -12,7 +12,9 @@ Every prediction is an expectation over the pulse phase (the phase of one frame 
 or a whole-stripe placement and the recording's drift from it), so no held-out row informs its own prediction; a
 recording's drift is fitted on its fit rows only, and kept only where they call for it beyond their measurement
 error (``StripeProblem.drifts_without_evidence``; the standard error of each mean comes from an
-``affected_rows_95ci``/``affected_rows_99ci`` column when the table has one).
+``affected_rows_95ci``/``affected_rows_99ci`` column when the table has one). A ``recording_frames`` column (the
+frames of each row's video) sets how many frames a drifting recording's mean is over; without it the recordings are
+taken as long.
 
 Units and geometry come from the table when it says them (``exposure_us``/``exposure_ms``/``exposure_s`` columns
 or values such as ``32us``; an ``image_height``/``image_rows`` column); otherwise ``--exposure-unit-s`` and
@@ -44,6 +46,9 @@ STRIPE_COLUMNS = ("frequency", "exposure", "duty_cycle", "affected_rows_mean")
 EXPOSURE_COLUMN_UNITS = {"exposure_s": 1.0, "exposure_ms": 1e-3, "exposure_us": 1e-6}
 HEIGHT_COLUMNS = ("image_height", "image_rows")
 SPREAD_COLUMN = "affected_rows_std"
+# how many frames the video behind each row holds: a drifting recording's mean over its lit frames depends on it
+# (physics.rolling_shutter_rows_lit, recording length); without it the kernel takes a long recording's limit
+RECORDING_FRAMES_COLUMN = "recording_frames"
 # a row's confidence half-width of its mean over frames, and the normal quantile it was taken at ("They See Me
 # Rollin'" tables give both): the standard error of each measured mean
 CONFIDENCE_COLUMNS = {"affected_rows_95ci": 1.959964, "affected_rows_99ci": 2.575829}
@@ -202,9 +207,26 @@ def read_stripe_table(
         sources["standard_error"] = "none in the table: model error only"
     if not np.isfinite(standard_error).all() or (standard_error < 0).any():
         raise ValueError(f"{path}: confidence half-widths must be finite and non-negative")
+    recording_frames = None
+    if RECORDING_FRAMES_COLUMN in table.columns:
+        recording_frames = pd.to_numeric(table[RECORDING_FRAMES_COLUMN], errors="coerce").to_numpy(np.float64)
+        if (
+            not (np.isfinite(recording_frames) & (recording_frames >= 1)).all()
+            or (recording_frames != np.round(recording_frames)).any()
+        ):
+            raise ValueError(
+                f"{path}: column {RECORDING_FRAMES_COLUMN} must hold whole frame counts >= 1 (the frames of the "
+                "video behind each row)"
+            )
+        sources["recording_frames"] = f"column {RECORDING_FRAMES_COLUMN}"
+    else:
+        sources["recording_frames"] = (
+            f"no {RECORDING_FRAMES_COLUMN} column: a drifting recording is taken as long (the arc's limit)"
+        )
     meta = {
         "spread": spread,
         "standard_error": standard_error,
+        "recording_frames": recording_frames,
         "frequency_hz": frequency_hz,
         "duty": duty,
         "exposure_s": exposure * data_unit,
@@ -321,6 +343,7 @@ class StripeProblem(Problem):
         self.rows = meta["rows"]
         self.spread = meta["spread"]
         self.standard_error = meta["standard_error"]
+        self.recording_frames = meta["recording_frames"]
         # a recording: the rows of one laser frequency and exposure setting (a duty-cycle sweep, one video per row
         # in the measured tables), assumed to share the beat of the laser and frame clocks
         keys = np.c_[self.frequency_hz, self.exposure_s]
@@ -388,13 +411,15 @@ class StripeProblem(Problem):
     ) -> torch.Tensor:
         if "exposure_overlap" not in effects:
             return torch.as_tensor(params["band_rows"], dtype=torch.float64).expand(len(items))
-        drift = None
+        drift, recording_frames = None, None
         if "phase_drift" in effects:
             # a drift starts from the interior rule's placements: fit_drift fits it under that rule only
             drift = torch.stack(
                 [torch.as_tensor(params[n], dtype=torch.float64) for n in self.drift_names], -1
             )
             drift = drift[..., torch.as_tensor(self.recording[items])]
+            if self.recording_frames is not None:
+                recording_frames = torch.as_tensor(self.recording_frames[items])
         return rolling_shutter_rows_lit(
             torch.as_tensor(self.frequency_hz[items]),
             torch.as_tensor(self.duty[items]),
@@ -407,6 +432,7 @@ class StripeProblem(Problem):
             frames=frames,
             drift=drift,
             drift_start="entry" if "drift_from_entry" in effects else "placement",
+            recording_frames=recording_frames,
         )
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:

@@ -363,6 +363,7 @@ def rolling_shutter_rows_lit(
     frames: str = "lit",
     drift: float | torch.Tensor | None = None,
     drift_start: str = "placement",
+    recording_frames: int | torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Mean number of rows a pulsed laser lights per counted frame, over a uniformly random pulse phase.
 
@@ -401,6 +402,12 @@ def rolling_shutter_rows_lit(
       (uniform), ``"entry"`` at the first frame of a run of whole-stripe frames as the stripes move (a recording
       started once its stripes came whole into view): the stripes then cross the frame's whole free span before an
       edge cuts them, so a drift shorter than that span cuts nothing.
+    - recording length (``recording_frames``, per condition): a table row is one recording's mean over its lit
+      frames, a ratio of two sums over ``N`` frames (frame ``k`` advanced by ``k drift / N``). Its expectation
+      exceeds the ratio of the arc's integrals (``None``, a long recording) by a term of order ``1 / N``: the lit
+      frames' count and their rows vary together with where the recording starts. At 24 frames a recording whose
+      wide stripe leaves the frame reads up to 2% more rows than the long-recording limit; at 96 a quarter of
+      that (docs/bench/session39.md).
     """
     if frames not in STRIPE_FRAME_RULES:
         raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
@@ -437,7 +444,14 @@ def rolling_shutter_rows_lit(
     if drift is not None:
         drift = torch.as_tensor(drift, dtype=torch.float64)
         interior = _drifting_interior_rows(
-            p, w, height, edge_span, placements, drift, drift_start=drift_start
+            p,
+            w,
+            height,
+            edge_span,
+            placements,
+            drift,
+            drift_start=drift_start,
+            recording_frames=recording_frames,
         )
     else:
         weighted = sum(length * stripes for _, stripes, length in placements)
@@ -464,7 +478,7 @@ def _interior_placements(
 
 
 DRIFT_PLACEMENTS = 16  # grid points per interval of whole-stripe placements
-DRIFT_STEPS = 64  # grid points along the drift arc
+DRIFT_STEPS = 64  # grid points along the drift arc of a long recording (recording_frames=None)
 DRIFT_STARTS = ("placement", "entry")
 
 
@@ -476,6 +490,7 @@ def _drifting_interior_rows(
     placements: list[tuple[torch.Tensor, torch.Tensor, torch.Tensor]],
     drift: torch.Tensor,
     drift_start: str = "placement",
+    recording_frames: int | torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Mean over recordings of a recording's mean lit rows over its frames with a lit row, when each recording
     starts from a whole-stripe placement (``_interior_placements`` over ``edge_span``, uniform; a placement's
@@ -485,7 +500,9 @@ def _drifting_interior_rows(
     rows, ``C(y)`` the lit length of ``[0, y)`` under stripes of width ``w`` every ``p`` rows
     (``cumulative_on_time``). With ``drift_start="entry"`` each interval of placements contributes only its end the
     stripes move away from (the frame's stripes just whole, a row inside; ``s`` grows, so the stripes move
-    down), weighted by the interval's length as before."""
+    down), weighted by the interval's length as before. ``recording_frames`` (``N``, per condition) takes the arc
+    at a recording's own frames, ``k / N`` of the drift for ``k = 0 .. N - 1``; ``None`` at the midpoints of
+    ``DRIFT_STEPS`` (the limit of a long recording)."""
     grid = (torch.arange(DRIFT_PLACEMENTS, dtype=p.dtype) + 0.5) / DRIFT_PLACEMENTS
     starts, weights = [], []
     for lowest, _, length in placements:
@@ -502,12 +519,22 @@ def _drifting_interior_rows(
         starts.append(edge_span.unsqueeze(-1) - c_prime)
         weights.append(weight)
     start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
-    arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
+    if recording_frames is None:
+        arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
+        frame = torch.ones_like(arc)
+    else:
+        n = torch.as_tensor(recording_frames, dtype=p.dtype)
+        if not (torch.isfinite(n).all() and (n >= 1).all() and (n == torch.round(n)).all()):
+            raise ValueError(f"recording_frames must be whole numbers >= 1, got {recording_frames}")
+        k = torch.arange(int(n.max()), dtype=p.dtype)
+        n = n.unsqueeze(-1).unsqueeze(-1)
+        # rows of shorter recordings pad their arc past their last frame; those steps count for nothing
+        arc, frame = k / n, (k < n).to(p.dtype)
     p3, w3 = p.unsqueeze(-1).unsqueeze(-1), w.unsqueeze(-1).unsqueeze(-1)
     s = start.unsqueeze(-1) + (drift * p).unsqueeze(-1).unsqueeze(-1) * arc
     rows = cumulative_on_time(height - s, p3, w3) - cumulative_on_time(-s, p3, w3)
     # a table row is one recording's mean over its lit frames (its first frame is lit: whole stripes in view)
-    lit = (rows > 1e-9).to(rows.dtype)
+    lit = (rows > 1e-9).to(rows.dtype) * frame
     recording = (rows * lit).sum(-1) / lit.sum(-1).clamp(min=1.0)
     return (recording * weight).sum(-1) / weight.sum(-1).clamp(min=1e-300)
 

@@ -32,6 +32,7 @@ from lerobot_phantom.transforms import physics
 
 SEED = int(os.environ["STRIPES_SEED"])  # drawn fresh per run by tests/conftest.py
 DUTIES = (1, 5, 10, 20, 35, 50)
+RECORDING_FRAMES = 24  # frames per video of the drifting tables, written in their recording_frames column
 
 
 # -- the independent simulator ---------------------------------------------------------------------------------
@@ -506,7 +507,7 @@ def test_a_drifting_recording_matches_the_simulator(drift, start_at):
             drift,
             rng,
             recordings=60 if start_at == "placement" else 6,
-            frames=24,
+            frames=RECORDING_FRAMES,
             start_at=start_at,
         )
         interior_rows = functools.partial(
@@ -520,8 +521,11 @@ def test_a_drifting_recording_matches_the_simulator(drift, start_at):
             threshold_s=camera["threshold_grey"] / camera["gain"],
             frames="interior",
         )
-        kernel, locked = interior_rows(drift=torch.tensor([drift]), drift_start=start_at), interior_rows()
-        error = 4.0 * means.std(ddof=1) / np.sqrt(len(means)) + 0.02 * float(kernel) + 2.0
+        kernel = interior_rows(
+            drift=torch.tensor([drift]), drift_start=start_at, recording_frames=RECORDING_FRAMES
+        )
+        locked = interior_rows()
+        error = 4.0 * means.std(ddof=1) / np.sqrt(len(means)) + 0.005 * float(kernel) + 1.0
         about = (
             f"{camera_summary(camera)} duty {duty} drift {drift} from {start_at}: kernel {float(kernel):.1f} "
         )
@@ -542,17 +546,17 @@ def drifting_table(
     path, camera: dict, rng: np.random.Generator, drifts: np.ndarray, start_at: str = "placement"
 ) -> None:
     """A duty sweep per exposure setting at a laser near the frame rate (one stripe per frame, a period of two
-    readouts): each row is one recording of 24 frames, whose phase drifts by ``drifts[k]`` of a period at the k-th
-    exposure (0: locked)."""
+    readouts): each row is one recording of ``RECORDING_FRAMES`` frames, whose phase drifts by ``drifts[k]`` of a
+    period at the k-th exposure (0: locked)."""
     frequency = round(1.0 / (2.0 * camera["height"] * camera["row_time"]), 1)
-    lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean"]
+    lines = ["frequency,exposure_us,duty_cycle,affected_rows_mean,recording_frames"]
     for exposure, drift in zip(camera["exposures_us"], drifts, strict=True):
         for duty in (2, 5, 10, 15, 20, 25, 30, 35):
             condition = (frequency, duty / 100.0, exposure * 1e-6)
             mean = simulate_drifting_recordings(
-                camera, condition, drift, rng, recordings=1, frames=24, start_at=start_at
+                camera, condition, drift, rng, recordings=1, frames=RECORDING_FRAMES, start_at=start_at
             )[0]
-            lines.append(f"{frequency:g}Hz,{exposure:g},{duty},{mean:.3f}")
+            lines.append(f"{frequency:g}Hz,{exposure:g},{duty},{mean:.3f},{RECORDING_FRAMES}")
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -898,6 +902,48 @@ def test_units_and_height_read_from_the_table(tmp_path):
     assert meta["image_height"] == 600 and meta["sources"]["image_height"] == "column image_height"
     with pytest.raises(ValueError, match="contradicts column image_height"):
         read_stripe_table(tmp_path / "h.csv", image_height=720, exposure_unit_s=None)
+
+
+def test_each_rows_recording_length_is_read_and_predicts_its_drifting_videos(tmp_path):
+    """A ``recording_frames`` column gives the frames of each row's video: a drifting recording is predicted at
+    them (the kernel at N frames, not the long limit, which it differs from here); the source is reported; a count
+    that is not a whole number >= 1 is refused, naming the column."""
+    header = "frequency,exposure_us,duty_cycle,camera,affected_rows_mean"
+    plain = small_table(tmp_path / "plain.csv", header, "{}")
+    text = plain.read_text().splitlines()
+    lengths = (6, 6, 12, 12)
+    framed = tmp_path / "framed.csv"
+    rows = [f"{line},{n}" for line, n in zip(text[1:], lengths, strict=True)]
+    framed.write_text("\n".join([text[0] + ",recording_frames", *rows]) + "\n")
+    effects = frozenset({"exposure_overlap", "phase_drift"})
+    problems = {
+        name: StripeProblem(table, image_height=480, exposure_unit_s=None, frames="interior")
+        for name, table in (("plain", plain), ("framed", framed))
+    }
+    assert problems["framed"].sources["recording_frames"] == "column recording_frames"
+    assert "no recording_frames column" in problems["plain"].sources["recording_frames"]
+    # 100 Hz at 20 us rows: a period of 500 rows, one stripe per 480-row frame; both recordings drift 0.6
+    params = {"row_time_s": 2e-5} | {name: 0.6 for name in problems["framed"].drift_names}
+    items = np.arange(4)
+    framed_rows = problems["framed"].predict(effects, params, items, frames="interior")
+    expected = physics.rolling_shutter_rows_lit(
+        torch.as_tensor(problems["framed"].frequency_hz),
+        torch.as_tensor(problems["framed"].duty),
+        torch.as_tensor(problems["framed"].exposure_s),
+        2e-5,
+        image_rows=480,
+        frames="interior",
+        drift=torch.full((4,), 0.6, dtype=torch.float64),
+        recording_frames=torch.tensor(lengths),
+    )
+    torch.testing.assert_close(framed_rows, expected, rtol=1e-12, atol=1e-12)
+    long_rows = problems["plain"].predict(effects, params, items, frames="interior")
+    assert float((framed_rows - long_rows).abs().max()) > 0.5, (framed_rows, long_rows)
+    for bad in ("0", "2.5", "many"):
+        broken = tmp_path / f"bad_{bad}.csv"
+        broken.write_text(framed.read_text().replace(",12\n", f",{bad}\n", 1))
+        with pytest.raises(ValueError, match="recording_frames must hold whole frame counts >= 1"):
+            read_stripe_table(broken, image_height=480, exposure_unit_s=None)
 
 
 def test_a_table_of_two_cameras_is_refused(tmp_path):

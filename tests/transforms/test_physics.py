@@ -5,6 +5,7 @@ from __future__ import annotations
 import functools
 import math
 
+import numpy as np
 import pytest
 import torch
 
@@ -275,3 +276,49 @@ def test_a_recording_that_starts_as_its_stripes_come_into_view_is_cut_only_after
     for drift in (torch.zeros(4), None):  # a bad start is an error whether or not a drift is given
         with pytest.raises(ValueError, match="placement, entry"):
             physics.rolling_shutter_rows_lit(f, duty, exposure, 2e-5, drift=drift, drift_start="x", **kwargs)
+
+
+def test_a_recording_of_n_frames_averages_its_own_frames():
+    """``recording_frames=N`` takes a drifting recording at its N frames (frame k advanced by k drift / N): one
+    frame is the locked interior count; from the entry, one stripe per frame, the mean over lit frames is a sum over
+    the N frames in closed form; a long recording reaches the arc's midpoint limit (``None``); rows of different
+    lengths in one batch each count only their own frames; a count that is not a whole number >= 1 is refused."""
+    row_time, height = 2e-5, 720
+    kwargs = {"image_rows": height, "integration_offset_s": 3e-4, "frames": "interior"}
+    f, duty, exposure = torch.tensor([25.0, 25.0, 300.0]), torch.tensor([0.3, 0.1, 0.05]), 5e-5
+    interior = physics.rolling_shutter_rows_lit(f, duty, exposure, row_time, **kwargs)
+    one_frame = physics.rolling_shutter_rows_lit(
+        f, duty, exposure, row_time, drift=torch.full((3,), 0.4), recording_frames=1, **kwargs
+    )
+    torch.testing.assert_close(one_frame, interior, rtol=1e-9, atol=1e-9)
+
+    period_rows = 1.0 / (25.0 * row_time)  # 2000 rows: one stripe per frame
+    width = (0.25 / 25.0 + exposure + 3e-4) / row_time  # 517.5 rows
+    free = (height - 1) - width
+    travel = 1.6 * free  # the stripe crosses the free span, then leaves the frame in part of the frames
+    frames = torch.tensor([6, 24, 96])
+    drifting = functools.partial(
+        physics.rolling_shutter_rows_lit,
+        torch.full((3,), 25.0),
+        torch.full((3,), 0.25),
+        exposure,
+        row_time,
+        drift=torch.full((3,), travel / period_rows),
+        drift_start="entry",
+        **kwargs,
+    )
+    counts = drifting(recording_frames=frames)
+    for n, count in zip(frames.tolist(), counts, strict=True):
+        moved = travel * np.arange(n) / n
+        rows = width - np.clip(moved - free, 0.0, None)
+        torch.testing.assert_close(float(count), float(rows[rows > 0].mean()), rtol=0.01, atol=1.0)
+    torch.testing.assert_close(counts[1:2], drifting(recording_frames=24)[1:2], rtol=1e-12, atol=1e-9)
+    long = drifting(recording_frames=4096)
+    torch.testing.assert_close(long, drifting(), rtol=2e-3, atol=0.0)
+    assert float(counts[0] - long[0]) > 5.0, (
+        counts,
+        long,
+    )  # six frames differ from the limit: the check bites
+    for bad in (0, 2.5, torch.tensor([24.0, float("nan"), 24.0])):
+        with pytest.raises(ValueError, match="whole numbers >= 1"):
+            drifting(recording_frames=bad)
