@@ -327,10 +327,13 @@ def pulse_overlap_lit_time(
         above = high - threshold.unsqueeze(-1)
         # a flat piece (a plateau: the window holds the whole pulse) is lit or not as a whole: a step in the
         # threshold whose derivative is 0, not the 1/(high - low) of a slope of no width (seen: a Jacobian column
-        # of 5e11 that froze a fit's threshold where it equalled a pulse's on-time)
-        flat = (high - low) <= 1e-9 * period.unsqueeze(-1)
+        # of 5e11 that froze a fit's threshold where it equalled a pulse's on-time). It must clear the threshold by
+        # more than rounding: a dark piece's light is 0 only up to it (seen: 6.9e-18 s at 24.3 Hz, 2% duty, a
+        # 281 us window, which with no threshold lit the whole period, 600 rows for 32)
+        tolerance = 1e-9 * period.unsqueeze(-1)
+        flat = (high - low) <= tolerance
         sloped = (above / (high - low).clamp(min=1e-15)).clamp(0.0, 1.0)
-        share = torch.where(flat, (above > 0).to(light.dtype), sloped)
+        share = torch.where(flat, (above > tolerance).to(light.dtype), sloped)
         return (share * lengths).sum(-1)
     # read noise: a row is lit with probability Phi((L - threshold) / noise); along a linear piece of L the
     # integral of Phi(z) is G(z) = z Phi(z) + phi(z) over the slope

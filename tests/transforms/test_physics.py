@@ -322,3 +322,24 @@ def test_a_recording_of_n_frames_averages_its_own_frames():
     for bad in (0, 2.5, torch.tensor([24.0, float("nan"), 24.0])):
         with pytest.raises(ValueError, match="whole numbers >= 1"):
             drifting(recording_frames=bad)
+
+
+def test_without_a_threshold_a_row_is_lit_for_the_pulse_plus_its_window_and_no_longer():
+    """Threshold 0: the start times that collect any pulse span on + window, capped at the period, whatever the
+    rounding of the light on the dark pieces (once 6.9e-18 s, not 0, at 24.3 Hz, 2% duty and a 281 us window: the
+    whole period counted as lit); drawn over frequencies, duties and windows of several cameras, in float64."""
+    generator = torch.Generator().manual_seed(20261129)
+    n = 20000
+    frequency = 10.0 ** (1.0 + 3.0 * torch.rand(n, generator=generator, dtype=torch.float64))
+    frequency = torch.round(frequency * 10.0) / 10.0  # as tables write them: 24.3 Hz
+    duty = torch.randint(1, 100, (n,), generator=generator).to(torch.float64) / 100.0
+    window = torch.round(10.0 ** (1.0 + 2.6 * torch.rand(n, generator=generator, dtype=torch.float64))) * 1e-6
+    frequency, duty, window = (
+        torch.cat([torch.tensor([24.3], dtype=torch.float64), v]) for v in (frequency, duty, window)
+    )
+    duty[0], window[0] = 0.02, 281e-6
+    period = 1.0 / frequency
+    on = duty * period
+    reached = physics.pulse_overlap_lit_time(period, on, window)
+    expected = torch.minimum(on + window, period)
+    torch.testing.assert_close(reached, expected, rtol=1e-9, atol=0.0)
