@@ -327,13 +327,13 @@ def pulse_overlap_lit_time(
         above = high - threshold.unsqueeze(-1)
         # a flat piece (a plateau: the window holds the whole pulse) is lit or not as a whole: a step in the
         # threshold whose derivative is 0, not the 1/(high - low) of a slope of no width (seen: a Jacobian column
-        # of 5e11 that froze a fit's threshold where it equalled a pulse's on-time). It must clear the threshold by
-        # more than rounding: a dark piece's light is 0 only up to it (seen: 6.9e-18 s at 24.3 Hz, 2% duty, a
-        # 281 us window, which with no threshold lit the whole period, 600 rows for 32)
+        # of 5e11 that froze a fit's threshold where it equalled a pulse's on-time). A dark piece is never lit: its
+        # light is 0 only up to rounding (seen: 6.9e-18 s at 24.3 Hz, 2% duty, a 281 us window, which with no
+        # threshold lit the whole period, 600 rows for 32)
         tolerance = 1e-9 * period.unsqueeze(-1)
         flat = (high - low) <= tolerance
         sloped = (above / (high - low).clamp(min=1e-15)).clamp(0.0, 1.0)
-        share = torch.where(flat, (above > tolerance).to(light.dtype), sloped)
+        share = torch.where(flat, ((above > 0) & (high > tolerance)).to(light.dtype), sloped)
         return (share * lengths).sum(-1)
     # read noise: a row is lit with probability Phi((L - threshold) / noise); along a linear piece of L the
     # integral of Phi(z) is G(z) = z Phi(z) + phi(z) over the slope
@@ -408,9 +408,9 @@ def rolling_shutter_rows_lit(
     - recording length (``recording_frames``, per condition): a table row is one recording's mean over its lit
       frames, a ratio of two sums over ``N`` frames (frame ``k`` advanced by ``k drift / N``). Its expectation
       exceeds the ratio of the arc's integrals (``None``, a long recording) by a term of order ``1 / N``: the lit
-      frames' count and their rows vary together with where the recording starts. At 24 frames a recording whose
-      wide stripe leaves the frame reads up to 2% more rows than the long-recording limit; at 96 a quarter of
-      that (docs/bench/session39.md).
+      frames' count and their rows vary together with where the recording starts. On a drift-test draw whose
+      wide stripes leave the frame, 24 frames read 2.1% more rows than the long-recording limit and 96 frames
+      0.6% (docs/bench/session39.md).
     """
     if frames not in STRIPE_FRAME_RULES:
         raise ValueError(f"unknown frame rule {frames!r}; valid: {', '.join(STRIPE_FRAME_RULES)}")
