@@ -524,7 +524,7 @@ def _drifting_interior_rows(
     start, weight = torch.cat(starts, -1), torch.cat(weights, -1)
     if recording_frames is None:
         arc = (torch.arange(DRIFT_STEPS, dtype=p.dtype) + 0.5) / DRIFT_STEPS
-        frame = torch.ones_like(arc)
+        in_recording = torch.ones_like(arc)
     else:
         n = torch.as_tensor(recording_frames, dtype=p.dtype)
         if not (torch.isfinite(n).all() and (n >= 1).all() and (n == torch.round(n)).all()):
@@ -532,12 +532,12 @@ def _drifting_interior_rows(
         k = torch.arange(int(n.max()), dtype=p.dtype)
         n = n.unsqueeze(-1).unsqueeze(-1)
         # rows of shorter recordings pad their arc past their last frame; those steps count for nothing
-        arc, frame = k / n, (k < n).to(p.dtype)
+        arc, in_recording = k / n, (k < n).to(p.dtype)
     p3, w3 = p.unsqueeze(-1).unsqueeze(-1), w.unsqueeze(-1).unsqueeze(-1)
     s = start.unsqueeze(-1) + (drift * p).unsqueeze(-1).unsqueeze(-1) * arc
     rows = cumulative_on_time(height - s, p3, w3) - cumulative_on_time(-s, p3, w3)
     # a table row is one recording's mean over its lit frames (its first frame is lit: whole stripes in view)
-    lit = (rows > 1e-9).to(rows.dtype) * frame
+    lit = (rows > 1e-9).to(rows.dtype) * in_recording
     recording = (rows * lit).sum(-1) / lit.sum(-1).clamp(min=1.0)
     return (recording * weight).sum(-1) / weight.sum(-1).clamp(min=1e-300)
 
