@@ -220,6 +220,10 @@ class Problem:
     # what inner cross-validation compares models by (``SELECTION_SCORES``); held-out figures are RMSE either way
     selection_score: str = "rmse"
     selection_score_reason: str = ""  # why, when it is not the RMSE (the report says it)
+    # which effects a selection step prefers among groups whose scores tie within ``TIE_SHARE`` (the fit items do
+    # not tell them apart; ``lowest_scoring``), earliest first, and why (the report says it); unlisted effects by name
+    tie_preference: tuple[str, ...] = ()
+    tie_preference_reason: str = ""
 
     @property
     def n_items(self) -> int:
@@ -363,6 +367,9 @@ class Step:
     paired: bool = False
     # scored groups this step could not take, with the reason (groups_set_aside)
     set_aside: dict[str, str] = field(default_factory=dict)
+    # scored groups whose score tied with the group the next step took (``lowest_scoring``): the fit items did not
+    # tell them apart, and the problem's tie preference decided
+    tied: list[str] = field(default_factory=list)
     # per scored group (by its label in ``tried``): its per-item terms, like ``item_errors``; what a simpler form
     # that lost this step to a richer one is judged by if the richer one is not identified (identify.py)
     tried_item_errors: dict[str, np.ndarray] = field(default_factory=dict)
@@ -545,8 +552,9 @@ def forward_select(
         set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
         steps[-1].set_aside = {labels[g]: why for g, why in set_aside.items()}
         eligible = {g: v[0] for g, v in scored.items() if g not in set_aside}
-        joint = joint_group_taken(problem, eligible, current, margin)
+        joint, tied = joint_group_taken(problem, eligible, current, margin)
         if joint is not None:
+            steps[-1].tied = [labels[g] for g in tied]
             # its prefixes may have been set aside alone: they are steps inside it all the same
             for prefix in steps_inside(joint, {g: v[0] for g, v in scored.items()}):
                 steps.append(
@@ -560,10 +568,11 @@ def forward_select(
                 )
             taken = joint
         else:
-            best_single = min((g for g in eligible if len(g) == 1), key=eligible.get, default=None)
+            best_single, tied = lowest_scoring(problem, {g: v for g, v in eligible.items() if len(g) == 1})
             if best_single is None or eligible[best_single] > (1.0 - margin) * current:
                 break
             taken = best_single
+            steps[-1].tied = [labels[g] for g in tied]
         chosen = chosen | taken
         current, parents, per_item = scored[taken]
         steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
@@ -600,17 +609,42 @@ def scored_groups(
 
 def joint_group_taken(
     problem: Problem, eligible: dict[frozenset[str], float], current: float, margin: float
-) -> frozenset[str] | None:
-    """The group of two or more new effects a step takes, or None: of the groups under what they need, the one
-    with the lowest score. A group needs ``margin`` under the best smaller eligible group and, over the ``current``
-    score, the margin once per member that stands on its own (one that builds on another member only carries it).
+) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
+    """The group of two or more new effects a step takes, or None, and the groups its score tied with
+    (:func:`lowest_scoring`): of the groups under what they need, the one with the lowest score. A group needs
+    ``margin`` under the best smaller eligible group and, over the ``current`` score, the margin once per member
+    that stands on its own (one that builds on another member only carries it).
 
     Lowest score, not furthest under its need: a pair far under its need can be the first step of a worse model
     (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
     larger group under its need has already beaten every smaller one by the margin."""
     needed = group_needs(requirements(problem), eligible, current, margin)
-    return min((g for g in needed if eligible[g] <= needed[g]), key=eligible.get, default=None)
+    return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]})
+
+
+def lowest_scoring(
+    problem: Problem, scores: dict[frozenset[str], float]
+) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
+    """The group with the lowest score (None when there is none), and the other groups within ``TIE_SHARE`` of it.
+    Among tied groups the one with the effect earliest in ``problem.tie_preference`` is taken, then the lowest: a
+    tie is the fit items not telling two models apart, and which one won it was rounding (drawn stripe camera
+    1804228398, lit frames: a detection threshold and a negative integration offset scored 0.852099314 and
+    0.852099313 rows, the order flipped by a rounding fix in the overlap kernel, and the two predict the held-out
+    rows to 10.0 and 116 rows)."""
+    if not scores:
+        return None, []
+    lowest = min(scores.values())
+    tied = [g for g, v in scores.items() if v <= lowest + abs(lowest) * TIE_SHARE]
+    preference = {name: rank for rank, name in enumerate(problem.tie_preference)}
+
+    def rank(group: frozenset[str]) -> tuple:
+        return min((preference.get(e, len(preference)) for e in group), default=len(preference)), scores[
+            group
+        ]
+
+    taken = min(tied, key=rank)
+    return taken, sorted((g for g in tied if g != taken), key=rank)
 
 
 def group_needs(

@@ -38,7 +38,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import SELECTION_SCORES, Fit, Problem, Step
+from lerobot_phantom.calibration.core import SELECTION_SCORES, TIE_SHARE, Fit, Problem, Step
 from lerobot_phantom.calibration.identify import Interval, Selection, Withdrawal, error_ratio, rmse_interval
 from lerobot_phantom.calibration.structure import residual_structure
 
@@ -211,7 +211,15 @@ def selection_section(
         f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
         f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group; a group is set "
         "aside when a member's own parameter sits at a bound of its range in most folds, and the richer of two "
-        f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one); then each kept "
+        f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one; among groups whose "
+        f"scores agree within a share of {TIE_SHARE:g}, which the fit items do not tell apart, "
+        + (
+            f"the one holding the earliest of {', '.join(problem.tie_preference)} ({problem.tie_preference_reason}), "
+            "then the lowest"
+            if problem.tie_preference
+            else "the lowest"
+        )
+        + "); then each kept "
         "extension must pass the identification rule "
         "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
         "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
@@ -229,6 +237,7 @@ def selection_section(
                 "validation_error": s.validation_error,
                 "tried": s.tried,
                 "set_aside": s.set_aside,
+                "tied": s.tied,
             }
             for s in steps
         ],
@@ -432,9 +441,16 @@ def _selection_lines(selection: dict) -> list[str]:
             f"{k}: {v:.3g}" + (f" (not eligible: {set_aside[k]})" if k in set_aside else "")
             for k, v in step["tried"].items()
         )
+        tied = step.get("tied") or []
         lines.append(
             f"- {step['effects'] or ['base']}: validation {selection['score']} "
-            f"{step['validation_error']:.3g}" + (f"; candidates tried next: {tried}" if tried else "")
+            f"{step['validation_error']:.3g}"
+            + (f"; candidates tried next: {tried}" if tried else "")
+            + (
+                f"; the step taken tied with {', '.join(tied)} (not told apart by the fit items)"
+                if tied
+                else ""
+            )
         )
     return lines
 

@@ -320,6 +320,16 @@ class StripeProblem(Problem):
         "each table row's absolute error, averaged: a condition alone in its regime, which no fold that validates "
         "it can predict, must not decide every comparison"
     )
+    # A threshold and a negative integration offset shorten every stripe alike (on + window + offset - 2 threshold)
+    # and part only where a pulse or window is shorter than the threshold; fit rows with no such condition score
+    # the two equal. Every table is measured by a detection rule (a row counts when a pixel clears a level above the
+    # dark frame), so the threshold is there in any case; a negative offset is a claim about the sensor's timing
+    # that such rows cannot back.
+    tie_preference = ("detection_threshold",)
+    tie_preference_reason = (
+        "every table is counted by a detection rule, and fit rows that no pulse or window shorter than the "
+        "threshold reaches cannot tell it from a negative integration offset"
+    )
 
     def __init__(
         self,

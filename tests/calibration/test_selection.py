@@ -326,3 +326,54 @@ def test_light_projection_selects_the_tone_form_the_frames_were_made_with(
     chosen, steps = forward_select(problem, np.arange(6), seed=0, margin=0.05)
     assert named in chosen and not_named not in chosen, [(s.effects, s.tried, s.set_aside) for s in steps]
     assert {"additive_light", "albedo_modulation"} <= chosen
+
+
+class WidthTerms(FixedErrors):
+    """``overlap`` alone, then ``threshold`` or ``offset`` on it, each as good as the other on the fit items (as a
+    stripe table's detection threshold and a negative integration offset, which shorten every stripe alike) up to
+    ``gap`` (``offset`` the lower), or ``gap`` apart in either direction; both together no better."""
+
+    candidates = (
+        Effect("overlap", "the pulse/exposure overlap"),
+        Effect("threshold", "a detection threshold", requires=("overlap",)),
+        Effect("offset", "an integration offset", requires=("overlap",)),
+    )
+
+    def __init__(self, gap: float, preference: tuple[str, ...], joint_effects: int = 2) -> None:
+        self.gap = gap
+        self.tie_preference = preference
+        self.joint_effects = joint_effects
+
+    def error(self, effects: frozenset[str]) -> float:
+        if "overlap" not in effects:
+            return 10.0
+        width = {"threshold": 1.0, "offset": 1.0 - self.gap}
+        return min((width[e] for e in effects if e in width), default=3.0)
+
+
+@pytest.mark.parametrize("joint_effects", [1, 2])
+def test_groups_the_fit_items_do_not_tell_apart_are_taken_by_the_stated_preference(joint_effects):
+    """A tie within ``TIE_SHARE`` is decided by the problem's ``tie_preference``, and the step says what it tied
+    with; a gap beyond the share is decided by the score, whatever the preference (once as pairs on the base,
+    once as single effects on ``overlap``)."""
+    rounding = 1e-12
+    chosen, steps = forward_select(
+        WidthTerms(rounding, ("threshold",), joint_effects), np.arange(20), seed=0, margin=0.05
+    )
+    assert chosen == {"overlap", "threshold"}, [s.tried for s in steps]
+    tied = [s.tied for s in steps if s.tied]
+    assert tied == [["overlap+offset" if joint_effects == 2 else "offset"]], [
+        (s.tried, s.tied) for s in steps
+    ]
+    # without a preference the lowest score decides, as before
+    chosen, steps = forward_select(
+        WidthTerms(rounding, (), joint_effects), np.arange(20), seed=0, margin=0.05
+    )
+    assert chosen == {"overlap", "offset"}
+    # a real gap (1%) is the data telling them apart: no tie, and the preference does not override it
+    for gap in (0.01, -0.01):
+        chosen, steps = forward_select(
+            WidthTerms(gap, ("threshold",), joint_effects), np.arange(20), seed=0, margin=0.05
+        )
+        assert chosen == ({"overlap", "offset"} if gap > 0 else {"overlap", "threshold"})
+        assert not any(s.tied for s in steps)
