@@ -783,6 +783,23 @@ def test_an_overlap_of_no_use_alone_is_named_with_the_threshold_it_hosts(tmp_pat
     assert report["extended"]["heldout_rmse"] <= 30.0
 
 
+@pytest.mark.slow
+def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as_the_threshold(tmp_path):
+    """A drawn camera (seed 1804228398, lit frames) whose fit rows hold no pulse or window shorter than its
+    threshold: the threshold and a negative integration offset score the same to 1e-12, and which one won was
+    rounding (at 02c74c0 the offset, 116 rows held-out: a window longer than the laser period then lights every
+    row). The tie is recorded and the threshold, which every table's detection rule implies, is taken."""
+    _, report = calibrate_drawn_camera(tmp_path, 1804228398, "lit", "exposure_us", calibration_seed=398)
+    steps = report["selection"]["steps"]
+    assert steps[0]["tied"] == ["exposure_overlap+integration_offset"], steps[0]
+    tried = steps[0]["tried"]
+    assert tried["exposure_overlap+integration_offset"] == pytest.approx(
+        tried["exposure_overlap+detection_threshold"], rel=1e-6
+    )
+    assert set(report["extended"]["effects"]) == {"exposure_overlap", "detection_threshold"}
+    assert report["extended"]["heldout_rmse"] <= 30.0
+
+
 def fixed_band_table(path, rng: np.random.Generator, camera: dict):
     """A null stripe table on ``camera``'s settings: the paper's band (H/3 rows whatever the settings) plus frame
     noise of 2 rows."""
