@@ -221,7 +221,7 @@ class Problem:
     selection_score: str = "rmse"
     selection_score_reason: str = ""  # why, when it is not the RMSE (the report says it)
     # which effects a selection step prefers among groups whose scores tie within ``TIE_SHARE`` (the fit items do
-    # not tell them apart; ``lowest_scoring``), earliest first, and why (the report says it); unlisted effects by name
+    # not tell them apart; ``lowest_scoring``), earliest first, and why (the report says it); otherwise the lowest
     tie_preference: tuple[str, ...] = ()
     tie_preference_reason: str = ""
 
@@ -638,10 +638,9 @@ def lowest_scoring(
     tied = [g for g, v in scores.items() if v <= lowest + abs(lowest) * TIE_SHARE]
     preference = {name: rank for rank, name in enumerate(problem.tie_preference)}
 
-    def rank(group: frozenset[str]) -> tuple:
-        return min((preference.get(e, len(preference)) for e in group), default=len(preference)), scores[
-            group
-        ]
+    def rank(group: frozenset[str]) -> tuple[int, float]:
+        preferred = min((preference.get(e, len(preference)) for e in group), default=len(preference))
+        return preferred, scores[group]
 
     taken = min(tied, key=rank)
     return taken, sorted((g for g in tied if g != taken), key=rank)

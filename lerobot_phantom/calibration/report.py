@@ -441,7 +441,7 @@ def _selection_lines(selection: dict) -> list[str]:
             f"{k}: {v:.3g}" + (f" (not eligible: {set_aside[k]})" if k in set_aside else "")
             for k, v in step["tried"].items()
         )
-        tied = step.get("tied") or []
+        tied = step["tied"]
         lines.append(
             f"- {step['effects'] or ['base']}: validation {selection['score']} "
             f"{step['validation_error']:.3g}"
