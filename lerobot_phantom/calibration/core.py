@@ -58,7 +58,13 @@ def exclusive(candidates: tuple[Effect, ...], effects: frozenset[str] | set[str]
 
 
 BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as sitting at the bound
-TIE_SHARE = 1e-6  # fits whose errors agree within this share are equal (preferred_fit)
+TIE_SHARE = 1e-6  # errors or scores that agree within this share are equal (preferred_fit, lowest_scoring)
+
+
+def ties_lowest(value: float, lowest: float) -> bool:
+    """Whether ``value`` ties with ``lowest``, the least of its kind: within ``TIE_SHARE`` of it, where the data do
+    not tell the two apart."""
+    return value <= lowest + abs(lowest) * TIE_SHARE
 
 
 @dataclass(frozen=True)
@@ -195,7 +201,7 @@ def preferred_fit(specs: Sequence[Param], fits: Sequence[tuple]) -> tuple:
     start matched to 1e-6, and on the selection paths of two changes tried that session the one kept at a 0.37 us
     row time made selection withdraw exposure_overlap and write the base model, 178 rows held-out against 3.0)."""
     lowest = min(fit[0] for fit in fits)
-    tied = [fit for fit in fits if fit[0] <= lowest * (1.0 + TIE_SHARE)]
+    tied = [fit for fit in fits if ties_lowest(fit[0], lowest)]
     return min(
         tied,
         key=lambda fit: (sum(at_bound(fit[1][p.name], p.low, p.high) is not None for p in specs), fit[0]),
@@ -635,7 +641,7 @@ def lowest_scoring(
     if not scores:
         return None, []
     lowest = min(scores.values())
-    tied = [g for g, v in scores.items() if v <= lowest + abs(lowest) * TIE_SHARE]
+    tied = [g for g, v in scores.items() if ties_lowest(v, lowest)]
     preference = {name: rank for rank, name in enumerate(problem.tie_preference)}
 
     def rank(group: frozenset[str]) -> tuple[int, float]:
