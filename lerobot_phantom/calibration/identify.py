@@ -641,6 +641,9 @@ class Withdrawal:
     effect: str
     selection_pass: int
     reasons: list[str]
+    # the steps of the pass that took it (report.json ``selection.earlier_passes``): the last pass's steps alone do
+    # not show what was tried with it, nor why its pass chose it
+    pass_steps: list[Step] = field(default_factory=list, repr=False, compare=False)
 
     def as_dict(self) -> dict:
         return {"effect": self.effect, "pass": self.selection_pass, "reasons": list(self.reasons)}
@@ -657,7 +660,7 @@ def select_and_identify(
 ) -> tuple[list[Step], list[Fit], Selection, list[Withdrawal]]:
     """Forward selection and identification, repeated without the effects identification rejects on their own
     evidence (the module docstring says why) until a pass rejects none: (steps, chain, selection) of the last pass
-    and what was withdrawn. Each pass sees the fit items only and has the same seeds, so a pass that withdraws
+    and what was withdrawn (each withdrawal holds its pass's steps). Each pass sees the fit items only and has the same seeds, so a pass that withdraws
     nothing is the single pass of before. Measured case: camsim's blinding auto-exposure (master seed 3986568970),
     where a power law at its bound 4 beat the meter with linear light by 0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
@@ -678,4 +681,6 @@ def select_and_identify(
             return steps, chain, selection, withdrawn
         number = 1 + max((w.selection_pass for w in withdrawn), default=0)
         reasons = {r["effect"]: r["reasons"] for r in selection.results if r["effect"] in selection.rejected}
-        withdrawn += [Withdrawal(effect, number, list(reasons[effect])) for effect in selection.rejected]
+        withdrawn += [
+            Withdrawal(effect, number, list(reasons[effect]), steps) for effect in selection.rejected
+        ]

@@ -13,7 +13,7 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
   rejected, withdrawn [{effect, pass, reasons}]: effects an earlier pass selected and identification rejected on
   their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and ``steps``
-  are the last pass's};
+  are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
@@ -231,19 +231,39 @@ def selection_section(
         "score": score_name,
         "criterion": criterion,
         "selected": selection.selected,
-        "steps": [
-            {
-                "effects": s.effects,
-                "validation_error": s.validation_error,
-                "tried": s.tried,
-                "set_aside": s.set_aside,
-                "tied": s.tied,
-            }
-            for s in steps
-        ],
+        "steps": [step_entry(s) for s in steps],
         "rejected": dict(steps[-1].tried),
         "withdrawn": [w.as_dict() for w in withdrawn],
+        "earlier_passes": earlier_passes(withdrawn),
     }
+
+
+def step_entry(step: Step) -> dict:
+    """A selection step as report.json's ``selection.steps`` holds it."""
+    return {
+        "effects": step.effects,
+        "validation_error": step.validation_error,
+        "tried": step.tried,
+        "set_aside": step.set_aside,
+        "tied": step.tied,
+    }
+
+
+def earlier_passes(withdrawn: Sequence[Withdrawal]) -> list[dict]:
+    """Every pass that withdrew an effect, in order: what it selected, what it withdrew and its steps."""
+    passes: dict[int, dict] = {}
+    for withdrawal in withdrawn:
+        entry = passes.setdefault(
+            withdrawal.selection_pass,
+            {
+                "pass": withdrawal.selection_pass,
+                "selected": sorted(withdrawal.pass_steps[-1].effects) if withdrawal.pass_steps else [],
+                "withdrawn": [],
+                "steps": [step_entry(s) for s in withdrawal.pass_steps],
+            },
+        )
+        entry["withdrawn"].append(withdrawal.effect)
+    return [passes[k] for k in sorted(passes)]
 
 
 def calibrated_payload(problem: Problem, extended: Fit, report: dict) -> dict:
@@ -433,9 +453,24 @@ def _selection_lines(selection: dict) -> list[str]:
         lines.append(
             f"- withdrawn after pass {withdrawal['pass']}: `{withdrawal['effect']}`, not identified ("
             + "; ".join(withdrawal["reasons"])
-            + "); the steps below are the last pass's"
+            + ")"
         )
-    for step in selection["steps"]:
+    earlier_passes = selection.get("earlier_passes", [])
+    for earlier in earlier_passes:
+        lines.append(
+            f"- pass {earlier['pass']} selected {earlier['selected']} and withdrew {earlier['withdrawn']}; its steps:"
+        )
+        lines += ["  " + line for line in _step_lines(earlier["steps"], selection["score"])]
+    if not earlier_passes:
+        return lines + _step_lines(selection["steps"], selection["score"])
+    lines.append(f"- pass {earlier_passes[-1]['pass'] + 1}, the last, whose model is written; its steps:")
+    return lines + ["  " + line for line in _step_lines(selection["steps"], selection["score"])]
+
+
+def _step_lines(steps: list[dict], score: str) -> list[str]:
+    """One line per selection step: its score, the candidates it tried and a tie it was taken over."""
+    lines = []
+    for step in steps:
         set_aside = step["set_aside"]
         tried = ", ".join(
             f"{k}: {v:.3g}" + (f" (not eligible: {set_aside[k]})" if k in set_aside else "")
@@ -443,8 +478,7 @@ def _selection_lines(selection: dict) -> list[str]:
         )
         tied = step["tied"]
         lines.append(
-            f"- {step['effects'] or ['base']}: validation {selection['score']} "
-            f"{step['validation_error']:.3g}"
+            f"- {step['effects'] or ['base']}: validation {score} {step['validation_error']:.3g}"
             + (f"; candidates tried next: {tried}" if tried else "")
             + (
                 f"; the step taken tied with {', '.join(tied)} (not told apart by the fit items)"

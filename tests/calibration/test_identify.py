@@ -760,6 +760,16 @@ def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tm
         "withdrawn after pass 1: `power`, not identified (gamma = 4 sits at its high bound 4)"
         in (tmp_path / "report.md").read_text()
     )
+    # the pass that took the power law is on record: its selection and its steps, beside the last pass's
+    (earlier,) = report["selection"]["earlier_passes"]
+    assert earlier["pass"] == 1 and earlier["withdrawn"] == ["power"]
+    assert earlier["selected"] == ["meter", "power"]
+    assert [s["effects"] for s in earlier["steps"]] == [[], ["power"], ["meter", "power"]]
+    assert "power" in earlier["steps"][0]["tried"]
+    assert (
+        "- pass 1 selected ['meter', 'power'] and withdrew ['power']; its steps:"
+        in (tmp_path / "report.md").read_text()
+    )
 
 
 def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
