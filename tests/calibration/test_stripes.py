@@ -800,6 +800,27 @@ def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as
     assert report["extended"]["heldout_rmse"] <= 30.0
 
 
+@pytest.mark.slow
+def test_an_offset_taken_with_the_threshold_is_judged_with_the_noise_the_pair_made_possible(tmp_path):
+    """A drawn camera (seed 4111198912, lit frames): selection takes the threshold and an integration offset as one
+    step (ratio 1.22, its interval spanning 1), then read noise on the threshold (to 4.09 rows from 8.03); without
+    the offset, threshold and noise score 8.23, the noise pinned at 0. Judged only to the pair's step the offset
+    was withdrawn, and the model left (the overlap alone) lit every row of a held-out row whose window is longer than
+    the laser period: 341 rows held-out. The pair is judged together, with what it hosts."""
+    _, report = calibrate_drawn_camera(tmp_path, 4111198912, "lit", "exposure_us", calibration_seed=912)
+    assert report["selection"]["withdrawn"] == []
+    results = {r["effect"]: r for r in report["identification"]}
+    assert results["integration_offset"]["compared_steps"] == results["detection_threshold"]["compared_steps"]
+    assert results["integration_offset"]["identified"], results["integration_offset"]["reasons"]
+    assert set(report["extended"]["effects"]) == {
+        "exposure_overlap",
+        "integration_offset",
+        "detection_threshold",
+        "detection_noise",
+    }
+    assert report["extended"]["heldout_rmse"] <= 30.0
+
+
 def fixed_band_table(path, rng: np.random.Generator, camera: dict):
     """A null stripe table on ``camera``'s settings: the paper's band (H/3 rows whatever the settings) plus frame
     noise of 2 rows."""
