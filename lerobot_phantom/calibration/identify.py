@@ -660,8 +660,8 @@ def select_and_identify(
 ) -> tuple[list[Step], list[Fit], Selection, list[Withdrawal]]:
     """Forward selection and identification, repeated without the effects identification rejects on their own
     evidence (the module docstring says why) until a pass rejects none: (steps, chain, selection) of the last pass
-    and what was withdrawn (each withdrawal holds its pass's steps). Each pass sees the fit items only and has the same seeds, so a pass that withdraws
-    nothing is the single pass of before. Measured case: camsim's blinding auto-exposure (master seed 3986568970),
+    and what was withdrawn (each withdrawal holds its pass's steps). Each pass sees the fit items only and has the
+    same seeds, so a pass that withdraws nothing is the single pass of before. Measured case: camsim's blinding auto-exposure (master seed 3986568970),
     where a power law at its bound 4 beat the meter with linear light by 0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
     while True:

@@ -455,15 +455,15 @@ def _selection_lines(selection: dict) -> list[str]:
             + "; ".join(withdrawal["reasons"])
             + ")"
         )
-    earlier_passes = selection.get("earlier_passes", [])
-    for earlier in earlier_passes:
+    passes = selection.get("earlier_passes", [])
+    for earlier in passes:
         lines.append(
             f"- pass {earlier['pass']} selected {earlier['selected']} and withdrew {earlier['withdrawn']}; its steps:"
         )
         lines += ["  " + line for line in _step_lines(earlier["steps"], selection["score"])]
-    if not earlier_passes:
+    if not passes:
         return lines + _step_lines(selection["steps"], selection["score"])
-    lines.append(f"- pass {earlier_passes[-1]['pass'] + 1}, the last, whose model is written; its steps:")
+    lines.append(f"- pass {passes[-1]['pass'] + 1}, the last, whose model is written; its steps:")
     return lines + ["  " + line for line in _step_lines(selection["steps"], selection["score"])]
 
 
