@@ -1,6 +1,6 @@
 """Two camsim core batches (``docs/bench/camsim_core_batch.sh``) of the same master seeds compared case by case: each
-case's written effects, held-out RMSE, identified effects and withdrawals, from the ``report.json`` under each
-batch's pytest basetemp. Prints one line per case that differs and a count.
+case's written effects, held-out RMSE, identified effects, withdrawals and the steps each effect's ratio compares,
+from the ``report.json`` under each batch's pytest basetemp. Prints one line per case that differs and a count.
 
     python docs/bench/session41/camsim_ab_compare.py BEFORE_DIR AFTER_DIR SEED [SEED ...]
 """
@@ -19,6 +19,8 @@ def cases(batch: Path, seed: str) -> dict[str, dict]:
             "heldout_rmse": round(data["extended"]["heldout_rmse"], 6),
             "identified": sorted(r["effect"] for r in data["identification"] if r["identified"]),
             "withdrawn": [w["effect"] for w in data["selection"]["withdrawn"]],
+            # the selection steps each effect's ratio compares: where the group rule of session 41 applies, they move
+            "compared_steps": {r["effect"]: r.get("compared_steps") for r in data["identification"]},
         }
     return found
 
