@@ -258,16 +258,18 @@ def truth_started_fit(problem: StripeProblem, camera: dict, items: np.ndarray, f
 
 
 def calibrate_drawn_camera(
-    tmp_path, seed: int, frames: str, style: str, calibration_seed: int
+    tmp_path, seed: int, frames: str, style: str, calibration_seed: int, **options
 ) -> tuple[dict, dict]:
     """(camera, report.json) of ``lerobot-phantom-calibrate`` on a 60-row table of the camera drawn for ``seed``;
-    ``style="exposure"`` leaves the unit off the table, so it is given as a flag."""
+    ``style="exposure"`` leaves the unit off the table, so it is given as a flag; ``options`` are further flags."""
     rng = np.random.default_rng([seed, 2, len(frames)])
     camera = draw_camera(rng, frames)
     table = tmp_path / "second_camera.csv"
     write_table(table, camera, rng, n_rows=60, frames=60, style=style)
     unit = {"exposure_unit_s": 1e-6} if style == "exposure" else {}
-    return camera, calibrate_stripes(tmp_path, table, camera["height"], seed=calibration_seed, **unit)
+    return camera, calibrate_stripes(
+        tmp_path, table, camera["height"], seed=calibration_seed, **unit, **options
+    )
 
 
 def calibrate_stripes(tmp_path, table, image_height: int, **options) -> dict:
@@ -807,7 +809,10 @@ def test_an_offset_taken_with_the_threshold_is_judged_with_the_noise_the_pair_ma
     the offset, threshold and noise score 8.23, the noise pinned at 0. Judged only to the pair's step the offset
     was withdrawn, and the model left (the overlap alone) lit every row of a held-out row whose window is longer than
     the laser period: 341 rows held-out. The pair is judged together, with what it hosts."""
-    _, report = calibrate_drawn_camera(tmp_path, 4111198912, "lit", "exposure_us", calibration_seed=912)
+    # bootstrap=10: the suite's budget (the withdrawal is rule 2's, whose ratio draws are 200 whatever the flag)
+    _, report = calibrate_drawn_camera(
+        tmp_path, 4111198912, "lit", "exposure_us", calibration_seed=912, bootstrap=10
+    )
     assert report["selection"]["withdrawn"] == []
     results = {r["effect"]: r for r in report["identification"]}
     assert results["integration_offset"]["compared_steps"] == results["detection_threshold"]["compared_steps"]
