@@ -643,7 +643,7 @@ class Withdrawal:
     reasons: list[str]
     # the steps of the pass that took it (report.json ``selection.earlier_passes``): the last pass's steps alone do
     # not show what was tried with it, nor why its pass chose it
-    pass_steps: list[Step] = field(default_factory=list, repr=False, compare=False)
+    pass_steps: list[Step] = field(repr=False, compare=False)
 
     def as_dict(self) -> dict:
         return {"effect": self.effect, "pass": self.selection_pass, "reasons": list(self.reasons)}
@@ -661,8 +661,9 @@ def select_and_identify(
     """Forward selection and identification, repeated without the effects identification rejects on their own
     evidence (the module docstring says why) until a pass rejects none: (steps, chain, selection) of the last pass
     and what was withdrawn (each withdrawal holds its pass's steps). Each pass sees the fit items only and has the
-    same seeds, so a pass that withdraws nothing is the single pass of before. Measured case: camsim's blinding auto-exposure (master seed 3986568970),
-    where a power law at its bound 4 beat the meter with linear light by 0.6% at the first step."""
+    same seeds, so a pass that withdraws nothing is the single pass of before. Measured case: camsim's blinding
+    auto-exposure (master seed 3986568970), where a power law at its bound 4 beat the meter with linear light by
+    0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
     while True:
         _selected, steps = forward_select(

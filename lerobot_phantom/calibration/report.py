@@ -257,7 +257,7 @@ def earlier_passes(withdrawn: Sequence[Withdrawal]) -> list[dict]:
             withdrawal.selection_pass,
             {
                 "pass": withdrawal.selection_pass,
-                "selected": sorted(withdrawal.pass_steps[-1].effects) if withdrawal.pass_steps else [],
+                "selected": sorted(withdrawal.pass_steps[-1].effects),
                 "withdrawn": [],
                 "steps": [step_entry(s) for s in withdrawal.pass_steps],
             },

@@ -30,9 +30,10 @@ with tempfile.TemporaryDirectory() as tmp:
     test_stripes.write_table(table, camera, rng, n_rows=60, frames=60, style=style)
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=unit, frames="auto")
 fit_items, heldout = seeded_split(problem.n_items, 0.2, seed % 1000)
+threshold_us, noise_us = (camera[k] / camera["gain"] * 1e6 for k in ("threshold_grey", "read_noise"))
 print(
     f"camera: row time {camera['row_time'] * 1e6:.2f} us, offset {camera['offset'] * 1e6:.2f} us, threshold "
-    f"{camera['threshold_grey'] / camera['gain'] * 1e6:.2f} us, read noise {camera['read_noise'] / camera['gain'] * 1e6:.2f} us"
+    f"{threshold_us:.2f} us, read noise {noise_us:.2f} us"
 )
 for model in sys.argv[3:]:
     fit = problem.fit(frozenset(model.split("+")), fit_items)
