@@ -22,7 +22,11 @@ The rule (:func:`identify`): an extension is a named cause only if
    result's ``notes`` as at its limit (a bound on the quantity), and the effect is judged by the rest;
 4. where the extension reduces to the model without it at a *null value* of a parameter (a halo of amplitude 0,
    a cross-talk matrix with zero off-diagonal terms, a tone curve of exponent 1), the bootstrap interval of at
-   least one such parameter excludes its null value;
+   least one such parameter excludes its null value; where it has several such parameters whose nulls all sit at a
+   bound of their ranges (one drift per recording, each >= 0), it reduces to the model without it only in a draw
+   that has every one of them at its null, so the interval of the largest distance from the null among them (a
+   share of each range, :func:`joint_null_interval`) excluding 0 suffices: evidence held by few items of each
+   parameter leaves each one at its null in some draws, and the extension in none;
 5. the problem's own adequacy checks of the effect's physics pass, where it has any
    (``problem.identification_checks(effect, fit, items) -> [reasons]``; e.g. a stabiliser's motion blur must be one
    path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
@@ -70,6 +74,7 @@ LEVEL = 0.9  # two-sided coverage of every reported interval
 # times the optimiser's start inset (1e-9), far below any estimate; not core.BOUND_TOLERANCE (1e-3), which on a wide
 # range swallowed a real end (a read noise of 0.21 us on a 0-1365 us range, session 34)
 NULL_AT_BOUND_TOLERANCE = 1e-6
+JOINT_NULL_STATISTIC = "largest distance from the null, as a share of each range"
 
 
 @dataclass(frozen=True)
@@ -186,6 +191,7 @@ def identify(
     intervals: Mapping[str, Interval],
     nulls: Mapping[str, float],
     limits: Mapping[str, Mapping[str, str]] | None = None,
+    joint_null: Interval | None = None,
 ) -> Identification:
     """Apply the module's rule to one extension.
 
@@ -194,7 +200,8 @@ def identify(
     (empty when it has none: a change of functional form); ``validation_ratio``: the paired bootstrap interval
     of the inner cross-validated error ratio without / with the extension (None if it was never scored);
     ``limits``: parameter -> {bound side: what the model is there}, for bounds that are the form's physical limit
-    (``core.physical_limits``: ``Param.low_limit``/``high_limit``)."""
+    (``core.physical_limits``: ``Param.low_limit``/``high_limit``); ``joint_null``: the interval of the
+    extension's distance from its null when its nulls all sit at bounds (:func:`joint_null_interval`)."""
     limits = limits or {}
     reasons = []
     if not selected:
@@ -207,7 +214,7 @@ def identify(
             f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
             "does not exclude 1 (no gain)"
         )
-    parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits)
+    parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits, joint_null)
     reasons += parameter_reasons
     return Identification(effect, not reasons, tuple(reasons), tuple(notes))
 
@@ -233,8 +240,10 @@ def parameter_checks(
     intervals: Mapping[str, Interval],
     nulls: Mapping[str, float],
     limits: Mapping[str, Mapping[str, str]],
+    joint_null: Interval | None = None,
 ) -> tuple[list[str], list[str]]:
-    """Rules 3 and 4 on an extension's own parameters: (reasons it fails them, notes of values at their limit)."""
+    """Rules 3 and 4 on an extension's own parameters: (reasons it fails them, notes of values at their limit).
+    ``joint_null``: the interval of :func:`joint_null_interval`, which passes rule 4 when it excludes 0."""
     reasons, notes = [], []
     for name, value in params.items():
         side = at_bound(value, *bounds[name])
@@ -255,7 +264,19 @@ def parameter_checks(
             for n, null in nulls.items()
             if n in intervals and excludes_null(intervals[n], null, *bounds.get(n, (-np.inf, np.inf)))
         ]
-        if not excluded:
+        jointly = joint_null is not None and excludes_null(joint_null, 0.0, 0.0, 1.0)
+        if jointly and not excluded:
+            notes.append(
+                f"no single interval of {', '.join(n for n in nulls if n in intervals)} excludes its null value, "
+                f"but together they leave it: {JOINT_NULL_STATISTIC} {joint_null.estimate:.4g} "
+                f"[{joint_null.low:.4g}, {joint_null.high:.4g}]"
+            )
+        if not excluded and not jointly:
+            joint_text = (
+                ""
+                if joint_null is None
+                else f", and so does that of the {JOINT_NULL_STATISTIC} ({joint_null.low:.4g}-{joint_null.high:.4g})"
+            )
             reasons.append(
                 "the interval of "
                 + ", ".join(
@@ -264,8 +285,33 @@ def parameter_checks(
                 + " includes the null value "
                 + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
                 + " at which the extension reduces to the model without it"
+                + joint_text
             )
     return reasons, notes
+
+
+def joint_null_interval(
+    nulls: Mapping[str, float],
+    bounds: Mapping[str, tuple[float, float]],
+    estimate: Mapping[str, float],
+    samples: Sequence[Mapping[str, float]],
+) -> Interval | None:
+    """The interval over bootstrap ``samples`` of an extension's largest distance from its null among its null
+    parameters, each as a share of its range (0: the draw is the model without the extension), or None unless it
+    has two or more and every null sits at a bound (rule 4; a null inside a range, like a cross-talk leak that may
+    be negative, has draws on both sides of it and no draw exactly there, so its distance never reaches 0).
+    Measured case: on the Axis table's split 0 the drift of the exposure-50 recording rests on two of its fit rows,
+    both missing from about one draw in seven, and every recording's drift interval reached 0."""
+    names = [n for n in nulls if n in estimate and n in bounds]
+    on_bounds = all(at_bound(nulls[n], *bounds[n], NULL_AT_BOUND_TOLERANCE) is not None for n in names)
+    if len(names) < 2 or not on_bounds:
+        return None
+
+    def distance(params: Mapping[str, float]) -> float:
+        return max(abs(params[n] - nulls[n]) / (bounds[n][1] - bounds[n][0]) for n in names)
+
+    draws = [distance(s) if all(n in s for n in names) else np.nan for s in samples]
+    return percentile_interval(distance(estimate), draws)
 
 
 # ---------------------------------------------------------------------------------------------------------------
@@ -381,7 +427,7 @@ def identify_selection(
     intervals = draw_intervals(selected_fit, samples)
     entries = selection_entries(steps)
     own = own_evidence_results(
-        problem, steps, entries, selected_fit, intervals, fit_items, draws=draws, rng=rng
+        problem, steps, entries, selected_fit, intervals, fit_items, samples=samples, draws=draws, rng=rng
     )
     # taken before the passes below add collateral reasons (an effect it builds on, or a refit without one, failed)
     rejected = sorted(effect for effect, result in own.items() if not result["identified"])
@@ -430,11 +476,12 @@ def own_evidence_results(
     intervals: Mapping[str, Interval],
     fit_items: np.ndarray,
     *,
+    samples: Sequence[Mapping[str, float]],
     draws: int,
     rng: np.random.Generator,
 ) -> dict[str, dict]:
     """Each selected effect's result by the rule on its own evidence: its validation ratio and its own parameters
-    in the selected model. Leaves first: an effect that hosts others (the form their parameters live in) is judged
+    in the selected model (``samples``: the bootstrap refits ``intervals`` come from). Leaves first: an effect that hosts others (the form their parameters live in) is judged
     with those of them that pass on their own, because the model without it cannot have them either; so is every
     other member of a group taken with it in one step."""
     own: dict[str, dict] = {}
@@ -466,15 +513,18 @@ def own_evidence_results(
         specs = own_params(problem, selected_fit.effects, effect)
         params = {p.name: selected_fit.params[p.name] for p in specs}
         nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
+        bounds = {p.name: (p.low, p.high) for p in specs}
+        joint_null = joint_null_interval(nulls, bounds, selected_fit.params, samples)
         outcome = identify(
             effect,
             selected=True,
             validation_ratio=ratio,
             params=params,
-            bounds={p.name: (p.low, p.high) for p in specs},
+            bounds=bounds,
             intervals={p.name: intervals[p.name] for p in specs},
             nulls=nulls,
             limits=physical_limits(specs),
+            joint_null=joint_null,
         )
         result = outcome.as_dict()
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
@@ -493,6 +543,8 @@ def own_evidence_results(
             intervals={p.name: intervals[p.name].as_dict() for p in specs},
             nulls=nulls,
         )
+        if joint_null is not None:
+            result["joint_null"] = {"statistic": JOINT_NULL_STATISTIC, **joint_null.as_dict()}
         own[effect] = result
     return own
 
@@ -541,7 +593,11 @@ def refit_identified(
         failing = {
             effect: reasons
             for effect in sorted(kept)
-            if (reasons := refit_reasons(problem, final, final_intervals, effect, selected_effects - kept))
+            if (
+                reasons := refit_reasons(
+                    problem, final, final_intervals, effect, selected_effects - kept, final_samples
+                )
+            )
         }
         if not failing:
             for result in results:
@@ -620,16 +676,25 @@ def simpler_form_result(
 
 
 def refit_reasons(
-    problem: Problem, fit: Fit, intervals: Mapping[str, Interval], effect: str, dropped: frozenset[str]
+    problem: Problem,
+    fit: Fit,
+    intervals: Mapping[str, Interval],
+    effect: str,
+    dropped: frozenset[str],
+    samples: Sequence[Mapping[str, float]],
 ) -> list[str]:
-    """Why ``effect``'s own parameters in ``fit`` (the refit without ``dropped``) fail rules 3 or 4, if they do."""
+    """Why ``effect``'s own parameters in ``fit`` (the refit without ``dropped``, ``samples`` its bootstrap refits)
+    fail rules 3 or 4, if they do."""
     specs = own_params(problem, fit.effects, effect)
+    bounds = {p.name: (p.low, p.high) for p in specs}
+    nulls = {k: v for k, v in problem.null_values(effect).items() if k in fit.params}
     reasons, _ = parameter_checks(
         {p.name: fit.params[p.name] for p in specs},
-        {p.name: (p.low, p.high) for p in specs},
+        bounds,
         intervals,
-        {k: v for k, v in problem.null_values(effect).items() if k in fit.params},
+        nulls,
         physical_limits(specs),
+        joint_null_interval(nulls, bounds, fit.params, samples),
     )
     return [f"refitted without {', '.join(sorted(dropped))}, {reason}" for reason in reasons]
 

@@ -33,6 +33,7 @@ from lerobot_phantom.calibration.identify import (
     excludes_null,
     identify,
     identify_selection,
+    joint_null_interval,
     own_params,
     parameter_checks,
     percentile_interval,
@@ -485,6 +486,75 @@ def test_an_effect_that_falls_to_its_null_in_the_refit_is_not_identified():
     assert not meter["identified"]
     assert any("refitted without glare, meter = 0 sits at its low bound 0" in r for r in meter["reasons"])
     assert selection.identified == [] and selection.fit.effects == frozenset()
+
+
+class DriftPerRecording(Problem):
+    """One effect with a drift per recording (each >= 0, null 0), fitted on a recording's evidence items alone:
+    a drift is 0.3 in a resample holding any of its recording's evidence items, else at its null, as a locked
+    recording's drift is. ``evidence``: recording -> its evidence items among 20."""
+
+    candidates = (Effect("drift", "the phase drifts within each recording"),)
+
+    def __init__(self, evidence: dict[str, tuple[int, ...]]) -> None:
+        self.evidence = evidence
+
+    def param_specs(self, effects):
+        return (
+            [Param(name, 0.1, 0.0, 1.0, high_limit="") for name in self.evidence]
+            if "drift" in effects
+            else []
+        )
+
+    def null_values(self, effect):
+        return dict.fromkeys(self.evidence, 0.0) if effect == "drift" else {}
+
+    def fit(self, effects, items, start=None) -> Fit:
+        present = set(np.asarray(items).tolist())
+        return Fit(
+            effects,
+            {n: 0.3 if present & set(e) else 0.0 for n, e in self.evidence.items()}
+            if "drift" in effects
+            else {},
+        )
+
+
+@pytest.mark.parametrize("shared", [False, True])
+def test_drifts_each_reaching_their_null_in_some_draws_are_identified_when_no_draw_has_them_all_there(shared):
+    """Each recording's drift rests on two of 20 items, both missing from about one resample in eight, so each
+    interval reaches the null 0 (the Axis table's split 0, where the exposure-50 recording's drift rested on two
+    fit rows). With two recordings on different items, no draw has both at the null (about 1 in 90 would): the
+    effect is identified, with a note. When both drifts rest on the same two items, the draws that lose them lose
+    the effect, and it is not identified, with the joint interval in the reason."""
+    evidence = {"drift_a": (0, 1), "drift_b": (0, 1) if shared else (2, 3)}
+    problem, items = DriftPerRecording(evidence), np.arange(20)
+    steps = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["drift"], 1.0, {}, PER_ITEM)]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=100, rng=np.random.default_rng(3))
+    (result,) = selection.results
+    assert all(result["intervals"][n]["low"] == 0.0 for n in evidence), result["intervals"]
+    joint = result["joint_null"]
+    assert joint["estimate"] == pytest.approx(0.3) and joint["draws"] == 100
+    if shared:
+        assert joint["low"] == 0.0 and not result["identified"]
+        assert "and so does that of the largest distance from the null" in result["reasons"][-1], result[
+            "reasons"
+        ]
+    else:
+        assert joint["low"] == pytest.approx(0.3), joint
+        assert result["identified"], result["reasons"]
+        assert any("together they leave it" in note for note in result["notes"]), result["notes"]
+
+
+def test_a_joint_null_is_judged_only_for_several_nulls_all_at_bounds():
+    """One null parameter is judged by its own interval; a null inside its range (a colour leak that may be
+    negative) has no draw exactly at it, so a distance from it would always exclude 0 and judges nothing."""
+    bounds = {"a": (0.0, 1.0), "b": (0.0, 2.0), "leak": (-1.0, 1.0)}
+    samples = [{"a": 0.0, "b": 1.0, "leak": 0.01}, {"a": 0.5, "b": 0.0, "leak": -0.01}]
+    assert joint_null_interval({"a": 0.0}, bounds, samples[0], samples) is None
+    assert joint_null_interval({"a": 0.0, "leak": 0.0}, bounds, samples[0], samples) is None
+    joint = joint_null_interval({"a": 0.0, "b": 0.0}, bounds, samples[0], samples)
+    assert joint.estimate == 0.5 and joint.draws == 2  # b = 1 is half of its range; a = 0.5 half of its
+    assert joint.low == joint.high == 0.5
 
 
 class ShoulderedCurve(Problem):
