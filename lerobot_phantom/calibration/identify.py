@@ -300,8 +300,9 @@ def joint_null_interval(
     parameters, each as a share of its range (0: the draw is the model without the extension), or None unless it
     has two or more and every null sits at a bound (rule 4; a null inside a range, like a cross-talk leak that may
     be negative, has draws on both sides of it and no draw exactly there, so its distance never reaches 0).
-    Measured case: on the Axis table's split 0 the drift of the exposure-50 recording rests on two of its fit rows,
-    both missing from about one draw in seven, and every recording's drift interval reached 0."""
+    Measured case: on the Axis table's split 0 the exposure-50 recording's drift rests on two of its fit rows, both
+    missing from a draw with chance 0.132 (session 34), and every recording's drift interval reached 0; the draws
+    that lock it keep another recording's drift, and withdrawn, the drift left 59.4 rows held-out against 4.96."""
     names = [n for n in nulls if n in estimate and n in bounds]
     on_bounds = all(at_bound(nulls[n], *bounds[n], NULL_AT_BOUND_TOLERANCE) is not None for n in names)
     if len(names) < 2 or not on_bounds:
