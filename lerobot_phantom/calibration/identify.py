@@ -482,9 +482,9 @@ def own_evidence_results(
     rng: np.random.Generator,
 ) -> dict[str, dict]:
     """Each selected effect's result by the rule on its own evidence: its validation ratio and its own parameters
-    in the selected model (``samples``: the bootstrap refits ``intervals`` come from). Leaves first: an effect that hosts others (the form their parameters live in) is judged
-    with those of them that pass on their own, because the model without it cannot have them either; so is every
-    other member of a group taken with it in one step."""
+    in the selected model (``samples``: the bootstrap refits ``intervals`` come from). Leaves first: an effect that
+    hosts others (the form their parameters live in) is judged with those of them that pass on their own, because
+    the model without it cannot have them either; so is every other member of a group taken with it in one step."""
     own: dict[str, dict] = {}
     for effect, before, after in reversed(entries):
         hosted = {d for d in dependants(problem, selected_fit.effects, effect) if own[d]["identified"]}

@@ -499,11 +499,7 @@ class DriftPerRecording(Problem):
         self.evidence = evidence
 
     def param_specs(self, effects):
-        return (
-            [Param(name, 0.1, 0.0, 1.0, high_limit="") for name in self.evidence]
-            if "drift" in effects
-            else []
-        )
+        return [Param(name, 0.1, 0.0, 1.0) for name in self.evidence] if "drift" in effects else []
 
     def null_values(self, effect):
         return dict.fromkeys(self.evidence, 0.0) if effect == "drift" else {}
