@@ -311,8 +311,7 @@ def joint_null_interval(
     def distance(params: Mapping[str, float]) -> float:
         return max(abs(params[n] - nulls[n]) / (bounds[n][1] - bounds[n][0]) for n in names)
 
-    draws = [distance(s) if all(n in s for n in names) else np.nan for s in samples]
-    return percentile_interval(distance(estimate), draws)
+    return percentile_interval(distance(estimate), [distance(s) for s in samples])
 
 
 # ---------------------------------------------------------------------------------------------------------------

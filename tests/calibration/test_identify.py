@@ -29,6 +29,7 @@ from lerobot_phantom.calibration.identify import (
     at_bound,
     bootstrap,
     dependants,
+    draw_intervals,
     error_ratio,
     excludes_null,
     identify,
@@ -37,6 +38,7 @@ from lerobot_phantom.calibration.identify import (
     own_params,
     parameter_checks,
     percentile_interval,
+    refit_reasons,
     resample,
     rmse_interval,
     select_and_identify,
@@ -539,6 +541,18 @@ def test_drifts_each_reaching_their_null_in_some_draws_are_identified_when_no_dr
         assert joint["low"] == pytest.approx(0.3), joint
         assert result["identified"], result["reasons"]
         assert any("together they leave it" in note for note in result["notes"]), result["notes"]
+
+
+def test_the_refit_without_a_rejected_effect_judges_its_drifts_jointly_too():
+    """``refit_reasons`` holds the refit's effects to rule 4 with its own bootstrap draws: drifts that are each at
+    their null in some draw, never together, pass; with no draws to judge them jointly they fail."""
+    problem = DriftPerRecording({"drift_a": (0,), "drift_b": (1,)})
+    fit = Fit(frozenset({"drift"}), {"drift_a": 0.3, "drift_b": 0.3})
+    samples = [{"drift_a": 0.3, "drift_b": 0.0}, {"drift_a": 0.0, "drift_b": 0.3}] * 10
+    intervals = draw_intervals(fit, samples)
+    assert refit_reasons(problem, fit, intervals, "drift", frozenset({"glare"}), samples) == []
+    (reason,) = refit_reasons(problem, fit, intervals, "drift", frozenset({"glare"}), ())
+    assert reason.startswith("refitted without glare, the interval of drift_a (0-0.3)"), reason
 
 
 def test_a_joint_null_is_judged_only_for_several_nulls_all_at_bounds():
