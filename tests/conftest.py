@@ -8,6 +8,11 @@ so the artefact is built once rather than once per worker.
 Tests that draw fresh seeds each run (``CAMSIM_SEED``, ``STRIPES_SEED``; their failures report the seed to replay)
 draw them once per run, in the controlling process, before the workers start: the workers inherit the
 environment, so they collect the same cases and test the same draw. The run's last line names them.
+
+Workers share the cores: each gets its share of OpenMP threads (``OMP_NUM_THREADS``, which torch and OpenBLAS read
+when they load), unless the environment already sets it. At torch's default, one thread per core in each of two
+workers on two cores, a light projection selection took 298 s in the suite against 35 s alone (session 43,
+docs/bench/session43).
 """
 
 from __future__ import annotations
@@ -21,12 +26,20 @@ import pytest
 TESTS = Path(__file__).parent
 SESSION_ARTEFACT_DIRS = ("train", "datasets")
 FRESH_SEEDS = ("CAMSIM_SEED", "STRIPES_SEED")
+THREADS = "OMP_NUM_THREADS"
+
+
+def threads_per_worker(workers: int, cores: int | None) -> int:
+    return max(1, (cores or 1) // workers)
 
 
 def pytest_configure(config: pytest.Config) -> None:
     if not hasattr(config, "workerinput"):  # the controller (or a run without workers): workers inherit these
         for name in FRESH_SEEDS:
             os.environ.setdefault(name, str(np.random.SeedSequence().entropy % 2**32))
+        workers = config.getoption("numprocesses", default=None)  # an int once xdist resolved "auto"
+        if isinstance(workers, int) and workers > 1:
+            os.environ.setdefault(THREADS, str(threads_per_worker(workers, os.cpu_count())))
 
 
 def pytest_terminal_summary(terminalreporter) -> None:

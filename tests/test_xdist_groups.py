@@ -7,22 +7,29 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 CONFTEST = Path(__file__).with_name("conftest.py")
 
 RECORDER = """import os, time
 from pathlib import Path
 import pytest
+import torch
 
 @pytest.mark.parametrize("i", range(4))
 def test_record(i):
     time.sleep(0.2)  # long enough that both workers take work
-    line = f"{__name__} {os.getpid()} {os.environ['CAMSIM_SEED']} {os.environ['STRIPES_SEED']}\\n"
+    line = f"{__name__} {os.getpid()} {os.environ['CAMSIM_SEED']} {os.environ['STRIPES_SEED']} "
+    line += f"{os.environ.get('OMP_NUM_THREADS')} {torch.get_num_threads()}\\n"
     with open(os.environ["RECORD"], "a") as record:
         record.write(line)
 """
 
 
-def test_files_and_session_artefact_dirs_stay_on_one_worker_and_share_the_seeds(tmp_path):
+@pytest.mark.parametrize("own_threads", [None, "2"], ids=["threads unset", "threads set"])
+def test_files_and_session_artefact_dirs_stay_on_one_worker_and_share_the_seeds_and_the_cores(
+    tmp_path, own_threads
+):
     tests = tmp_path / "tests"
     (tests / "train").mkdir(parents=True)
     shutil.copy(CONFTEST, tests / "conftest.py")
@@ -30,7 +37,9 @@ def test_files_and_session_artefact_dirs_stay_on_one_worker_and_share_the_seeds(
         (tests / path).write_text(RECORDER)
     (tmp_path / "pyproject.toml").write_text("")
     record = tmp_path / "record.txt"
-    env = {k: v for k, v in os.environ.items() if k not in ("CAMSIM_SEED", "STRIPES_SEED")}
+    env = {k: v for k, v in os.environ.items() if k not in ("CAMSIM_SEED", "STRIPES_SEED", "OMP_NUM_THREADS")}
+    if own_threads is not None:
+        env["OMP_NUM_THREADS"] = own_threads
     run = subprocess.run(
         [
             sys.executable,
@@ -60,7 +69,10 @@ def test_files_and_session_artefact_dirs_stay_on_one_worker_and_share_the_seeds(
         workers.setdefault(group, set()).add(pid)
     assert all(len(pids) == 1 for pids in workers.values()), workers
     assert len({pid for _, pid, *_ in rows}) == 2  # the run did use both workers
-    seeds = {tuple(row[2:]) for row in rows}
+    seeds = {tuple(row[2:4]) for row in rows}
     assert len(seeds) == 1, seeds
     camsim, stripes = seeds.pop()
     assert f"CAMSIM_SEED={camsim} STRIPES_SEED={stripes}" in run.stdout  # the run names its draw for a replay
+    # two workers split the cores between them; a user's own thread count is kept
+    expected = own_threads or str(max(1, (os.cpu_count() or 1) // 2))
+    assert {tuple(row[4:]) for row in rows} == {(expected, expected)}
