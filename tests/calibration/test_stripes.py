@@ -439,8 +439,8 @@ def test_lit_time_is_the_overlap_minus_twice_the_threshold():
                 strict=True,
                 reason="open (issue 12): on the table of the simulator that holds each step's exact pulse mean "
                 "(session 43) the fit stops at a row time of 43.1 us (4.08 rows) where the truth's start reaches "
-                "44.6 us (1.69 rows); six grid starts per row time instead of two find it, at 2.7x the first "
-                "fit's CPU time (docs/bench/session43.md)",
+                "44.6 us (1.69 rows); six grid starts per row time instead of two find it, at 2.3x the first "
+                "fit's CPU time (docs/bench/session43/grid_starts_6_interior_0b32ffc.txt)",
             ),
         ),
         (22, "lit"),
