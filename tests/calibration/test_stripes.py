@@ -5,8 +5,8 @@ The simulator below shares no code with ``lerobot_phantom``: it steps the laser 
 (square pulses, their exact mean over each step, through a first-order low-pass, i.e. a laser driver with a rise
 time the package does not model), integrates it numerically over each row's exposure window for a random pulse
 phase per frame, converts it to grey levels with read noise, thresholds, dilates by a blooming spread, applies the
-measurement's frame rule and averages the counts over frames. Camera parameters are drawn fresh per run from the test's own seed, printed on
-failure (set ``STRIPES_SEED`` to replay a run).
+measurement's frame rule and averages the counts over frames. Camera parameters are drawn fresh per run from the
+test's own seed, printed on failure (set ``STRIPES_SEED`` to replay a run).
 """
 
 from __future__ import annotations
@@ -74,9 +74,8 @@ def frame_lit_rows(
     period = 1.0 / frequency
     window = exposure + camera["offset"]
     grid = np.arange(-period, starts[-1] + window + dt, dt)
-    if (
-        camera.get("pulses", "mean") == "sampled"
-    ):  # the simulator before session 43 (pulse_cells says why not)
+    # "sampled": the simulator before session 43, kept for the cases found on its tables (pulse_cells says why not)
+    if camera.get("pulses", "mean") == "sampled":
         square = (np.mod(grid - phase, period) < duty * period).astype(float)
     else:
         square = pulse_cells(grid, dt, phase, period, duty * period)
@@ -202,8 +201,8 @@ def kernel_against_simulator(seed: int, frames: str, n_frames: int = 300) -> dic
     The simulator holds the pulse train's exact mean over each step of ``dt`` (``pulse_cells``) and interpolates
     a row's collected light linearly inside a step, which is off by up to ``dt / 4`` at each end of its window where
     a pulse edge falls inside a step: the kernel is given as the band of its values over on-times ``dt`` apart (it
-    matters at a knife edge, where the detection threshold is within ``dt`` of the on-time). The simulated means carry their standard error over
-    frames."""
+    matters at a knife edge, where the detection threshold is within ``dt`` of the on-time). The simulated means
+    carry their standard error over frames."""
     rng = np.random.default_rng([seed, 1])
     camera = draw_camera(rng, frames) | {"rise": 1e-9, "read_noise": 0.0, "spread": 1}
     conditions = kernel_conditions(camera)

@@ -1,6 +1,7 @@
-"""Why drawn camera 3808238891 (lit frames) errs on two held-out rows at the camera's own parameters: the test's
-simulator against the package's kernel at one condition, with the camera's blooming and read noise switched on and
-off, and the simulator's time step (``dt``, 2 us in the test) at its own value and at 0.1 us. Run from a checkout, whose package is what is measured:
+"""Drawn camera 3808238891 (lit frames) at one condition of its held-out rows: the test's simulator against the
+package's kernel, with the camera's blooming and read noise switched on and off, and the simulator's time step
+(``dt``, 2 us in the test) at its own value and at 0.1 us. Run from a checkout, whose package and test simulator are
+what is measured:
 
     OMP_NUM_THREADS=1 HF_HUB_OFFLINE=1 PYTHONPATH=. python docs/bench/session43/noise_bloom.py SEED lit|interior \
         FREQUENCY_HZ DUTY EXPOSURE_US [FRAMES]
@@ -51,6 +52,6 @@ for dt in (camera["dt"], 1e-7):
             ).item()
             mean = np.mean(counts) if counts else float("nan")
             print(
-                f"dt {dt * 1e6:g} us, blooming {spread} rows, read noise {noise:g} grey: simulated {mean:.1f} rows over "
-                f"{len(counts)} counted frames, kernel {kernel:.1f} rows"
+                f"dt {dt * 1e6:g} us, blooming {spread} rows, read noise {noise:g} grey: simulated {mean:.1f} rows "
+                f"over {len(counts)} counted frames, kernel {kernel:.1f} rows"
             )
