@@ -29,17 +29,13 @@ FRESH_SEEDS = ("CAMSIM_SEED", "STRIPES_SEED")
 THREADS = "OMP_NUM_THREADS"
 
 
-def threads_per_worker(workers: int, cores: int | None) -> int:
-    return max(1, (cores or 1) // workers)
-
-
 def pytest_configure(config: pytest.Config) -> None:
     if not hasattr(config, "workerinput"):  # the controller (or a run without workers): workers inherit these
         for name in FRESH_SEEDS:
             os.environ.setdefault(name, str(np.random.SeedSequence().entropy % 2**32))
         workers = config.getoption("numprocesses", default=None)  # an int once xdist resolved "auto"
         if isinstance(workers, int) and workers > 1:
-            os.environ.setdefault(THREADS, str(threads_per_worker(workers, os.cpu_count())))
+            os.environ.setdefault(THREADS, str(max(1, (os.cpu_count() or 1) // workers)))
 
 
 def pytest_terminal_summary(terminalreporter) -> None:

@@ -75,7 +75,7 @@ def frame_lit_rows(
     window = exposure + camera["offset"]
     grid = np.arange(-period, starts[-1] + window + dt, dt)
     # "sampled": the simulator before session 43, kept for the cases found on its tables (pulse_cells says why not)
-    if camera.get("pulses", "mean") == "sampled":
+    if camera["pulses"] == "sampled":
         square = (np.mod(grid - phase, period) < duty * period).astype(float)
     else:
         square = pulse_cells(grid, dt, phase, period, duty * period)
@@ -170,6 +170,7 @@ def draw_camera(rng: np.random.Generator, frames: str) -> dict:
         "spread": int(rng.integers(0, 3)),
         "frames": frames,
         "dt": 2e-6,
+        "pulses": "mean",  # each time step holds the pulse train's exact mean (pulse_cells)
         "frequencies": np.round(np.geomspace(rng.uniform(20, 50), rng.uniform(800, 2500), 5), 1),
         "exposures_us": np.round(np.geomspace(rng.uniform(20, 50), rng.uniform(1000, 3000), 5)),
     }
@@ -277,16 +278,24 @@ def truth_started_fit(problem: StripeProblem, camera: dict, items: np.ndarray, f
     return Fit(effects, params, {"frames": frames})
 
 
+def drawn_camera_table(
+    path: Path, seed: int, frames: str, style: str = "exposure_us", pulses: str = "mean"
+) -> dict:
+    """The camera drawn for ``seed`` (and ``frames``), its 60-row stripe table written to ``path``;
+    ``pulses="sampled"`` writes the table of the simulator before session 43 (for a case found on it)."""
+    rng = np.random.default_rng([seed, 2, len(frames)])
+    camera = draw_camera(rng, frames) | {"pulses": pulses}
+    write_table(path, camera, rng, n_rows=60, frames=60, style=style)
+    return camera
+
+
 def calibrate_drawn_camera(
     tmp_path, seed: int, frames: str, style: str, calibration_seed: int, pulses: str = "mean", **options
 ) -> tuple[dict, dict]:
-    """(camera, report.json) of ``lerobot-phantom-calibrate`` on a 60-row table of the camera drawn for ``seed``;
-    ``style="exposure"`` leaves the unit off the table, so it is given as a flag; ``pulses="sampled"`` writes the
-    table of the simulator before session 43 (a case found on it); ``options`` are further flags."""
-    rng = np.random.default_rng([seed, 2, len(frames)])
-    camera = draw_camera(rng, frames) | {"pulses": pulses}
+    """(camera, report.json) of ``lerobot-phantom-calibrate`` on the table of ``drawn_camera_table``;
+    ``style="exposure"`` leaves the unit off the table, so it is given as a flag; ``options`` are further flags."""
     table = tmp_path / "second_camera.csv"
-    write_table(table, camera, rng, n_rows=60, frames=60, style=style)
+    camera = drawn_camera_table(table, seed, frames, style, pulses)
     unit = {"exposure_unit_s": 1e-6} if style == "exposure" else {}
     return camera, calibrate_stripes(
         tmp_path, table, camera["height"], seed=calibration_seed, **unit, **options
@@ -460,10 +469,8 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
     in another threshold regime, on the far side of a pulse's on-time (seed 24 interior once the interior rule's
     edges were right: 7.4 rows against 1.3; seed 22 interior: 3.3 against 0.8): the fit must reach the minimum the
     truth reaches."""
-    rng = np.random.default_rng([seed, 2, len(frames)])
-    camera = draw_camera(rng, frames)
     table = tmp_path / "table.csv"
-    write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    camera = drawn_camera_table(table, seed, frames)
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
     items = np.arange(problem.n_items)
     from_truth = truth_started_fit(problem, camera, items, frames)
@@ -508,10 +515,8 @@ def test_rows_that_fix_no_row_time_do_not_leave_it_at_a_bound(tmp_path):
     at 0.37 us, within 0.1% of the range's low bound. Identification then rejected exposure_overlap for it and the
     base model was written (178 rows held-out, against 3.0). Among equal fits none at a bound is kept."""
     seed, frames = 1095341462, "lit"
-    rng = np.random.default_rng([seed, 2, len(frames)])
-    camera = draw_camera(rng, frames)
     table = tmp_path / "table.csv"
-    write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    camera = drawn_camera_table(table, seed, frames)
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
     fit_items, _ = seeded_split(problem.n_items, 0.2, seed % 1000)
     effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold", "detection_noise"})

@@ -15,20 +15,17 @@ from pathlib import Path
 
 import numpy as np
 
-os.environ.setdefault(
-    "STRIPES_SEED", "0"
-)  # the test module reads it at import; this script names its own seed
+# the test module reads it at import; this script names its own seed
+os.environ.setdefault("STRIPES_SEED", "0")
 sys.path.insert(0, str(Path("tests/calibration").resolve()))
 import test_stripes
 
 from lerobot_phantom.calibration.stripes import StripeProblem
 
 seed, frames = int(sys.argv[1]), sys.argv[2]
-rng = np.random.default_rng([seed, 2, len(frames)])  # the test's draw
-camera = test_stripes.draw_camera(rng, frames)
 with tempfile.TemporaryDirectory() as tmp:
     table = Path(tmp) / "table.csv"
-    test_stripes.write_table(table, camera, rng, n_rows=60, frames=60, style="exposure_us")
+    camera = test_stripes.drawn_camera_table(table, seed, frames)  # the test's table
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
 items = np.arange(problem.n_items)
 

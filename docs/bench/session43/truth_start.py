@@ -23,12 +23,10 @@ import test_stripes  # noqa: E402
 from lerobot_phantom.calibration.core import Fit, seeded_split  # noqa: E402
 from lerobot_phantom.calibration.stripes import StripeProblem  # noqa: E402
 
-rng = np.random.default_rng([seed, 2, len(frames)])  # calibrate_drawn_camera's draw
-camera = test_stripes.draw_camera(rng, frames)
 style, unit = ("exposure_us", None) if frames == "lit" else ("exposure", 1e-6)
 with tempfile.TemporaryDirectory() as tmp:
     table = Path(tmp) / "second_camera.csv"
-    test_stripes.write_table(table, camera, rng, n_rows=60, frames=60, style=style)
+    camera = test_stripes.drawn_camera_table(table, seed, frames, style)  # calibrate_drawn_camera's table
     problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=unit, frames="auto")
 fit_items, heldout = seeded_split(problem.n_items, 0.2, seed % 1000)
 truth = {
