@@ -344,6 +344,18 @@ def test_the_drift_and_its_entry_start_are_offered_only_with_enough_rows_per_rec
 
 
 # -- the physics kernel against the simulator ---------------------------------------------------------------------
+def test_the_simulators_steps_hold_each_pulse_whole_at_any_phase():
+    """A pulse shorter than a few time steps (4.73 us at 2114 Hz and 1% duty, on 2 us steps) carries its whole
+    on-time into the steps it falls in, at every phase; point samples gave it 4 or 6 us (docs/bench/session43.md)."""
+    period, on, dt = 1.0 / 2114.3, 0.01 / 2114.3, 2e-6
+    grid = np.arange(0.0, 3 * period, dt)
+    for phase in np.random.default_rng(SEED).uniform(0.0, period, 20):
+        cells = pulse_cells(grid, dt, phase, period, on)
+        first = grid < period  # one period of steps from the grid's start holds exactly one pulse
+        assert cells[first].sum() * dt == pytest.approx(on, rel=1e-9)
+        assert cells.min() > -1e-9 and cells.max() < 1.0 + 1e-9  # a share of each step, up to rounding
+
+
 @pytest.mark.parametrize("frames", physics.STRIPE_FRAME_RULES)
 def test_phase_averaged_rows_match_the_simulator(frames):
     """Without the unmodelled rise time and noise, the analytic expectation equals the simulated frame mean.
