@@ -158,7 +158,6 @@ def calibrate(cfg: CalibrateConfig) -> dict:
             seed=cfg.seed,
             margin=cfg.margin,
             folds=cfg.folds,
-            draws=cfg.bootstrap,
             withdrawn=withdrawn,
         )
         if isinstance(problem, FrameProblem):

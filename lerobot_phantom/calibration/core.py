@@ -327,10 +327,16 @@ def item_scores(kind: str, squared: np.ndarray, counts: np.ndarray) -> np.ndarra
 
 def selection_value(kind: str, terms: np.ndarray, counts: np.ndarray) -> float:
     """The score from its per-item terms (``item_scores``) and the items' value counts."""
+    return float(score_of_totals(kind, np.sum(terms), np.sum(counts), len(terms)))
+
+
+def score_of_totals(kind: str, term_total, count_total, n_items: int):
+    """The score ``kind`` from the totals of its per-item terms and value counts over ``n_items`` items; totals may
+    be arrays (one score per bootstrap resample, ``identify.resummed_totals``)."""
     _check_score(kind)
     if kind == "rmse":
-        return math.sqrt(float(np.sum(terms)) / max(float(np.sum(counts)), 1.0))
-    return float(np.mean(terms))
+        return np.sqrt(np.asarray(term_total, np.float64) / np.maximum(count_total, 1.0))
+    return np.asarray(term_total, np.float64) / n_items
 
 
 def seeded_split(n_items: int, heldout: float, seed: int) -> tuple[np.ndarray, np.ndarray]:
