@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from lerobot_phantom.calibration.core import bin_index
-from lerobot_phantom.calibration.identify import bootstrap
+from lerobot_phantom.calibration.identify import RESUMMED_DRAWS, percentile_interval, resummed_totals
 
 BINS = 8
 MIN_EXPLAINED = 0.02
@@ -49,7 +49,6 @@ MIN_SHARE_OF_BASE = 0.005
 LAG = 3
 FAMILY_ALPHA = 0.01
 PERMUTATIONS = 2000
-DRAWS = 200
 OUTLIER_FACTOR = 2.0
 OUTLIER_SHARE = 0.5
 MIN_FIT_ITEMS = 5  # a largest fit error over fewer items is no reference
@@ -79,6 +78,44 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
     if len(a) < 3 or np.std(a) == 0 or np.std(b) == 0:
         return 0.0
     return float(np.corrcoef(a, b)[0, 1])
+
+
+# Both statistics of an item resample are functions of sums over its items (per-bin residual sums and counts, sums of
+# squares and products), so their intervals take ``identify.RESUMMED_DRAWS`` weighted re-sums instead of 200 draws.
+
+
+def binned_columns(residual: np.ndarray, bins: np.ndarray, n_bins: int) -> np.ndarray:
+    """One item's terms of eta squared: its residual sum per bin, its value count per bin, its sum of squares."""
+    return np.concatenate(
+        [
+            np.bincount(bins, weights=residual, minlength=n_bins),
+            np.bincount(bins, minlength=n_bins),
+            [np.sum(residual**2)],
+        ]
+    )
+
+
+def explained_share_of_totals(totals: np.ndarray, n_bins: int) -> np.ndarray:
+    """``explained_share`` from the totals of ``binned_columns`` over a resample's items (one per row)."""
+    sums, counts, squares = totals[:, :n_bins], totals[:, n_bins : 2 * n_bins], totals[:, -1]
+    between = np.sum(np.where(counts > 0, sums**2 / np.maximum(counts, 1.0), 0.0), axis=1)
+    return np.where(squares > 0, between / np.maximum(squares, 1e-300), 0.0)
+
+
+def moment_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """One item's terms of a correlation: value count, sums of a, b, a^2, b^2 and a*b."""
+    return np.array([len(a), a.sum(), b.sum(), (a * a).sum(), (b * b).sum(), (a * b).sum()], dtype=np.float64)
+
+
+def correlation_of_totals(totals: np.ndarray) -> np.ndarray:
+    """``_correlation`` from the totals of ``moment_columns`` over a resample's items (one per row); 0 where a side
+    is constant (its centred sum of squares within 1e-12 of its raw one, rounding) or fewer than 3 values."""
+    n, a, b, aa, bb, ab = totals.T
+    safe_n = np.maximum(n, 1.0)
+    var_a, var_b = aa - a * a / safe_n, bb - b * b / safe_n
+    valid = (n >= 3) & (var_a > 1e-12 * aa) & (var_b > 1e-12 * bb)
+    r = (ab - a * b / safe_n) / np.sqrt(np.where(valid, var_a * var_b, 1.0))
+    return np.where(valid, np.clip(r, -1.0, 1.0), 0.0)
 
 
 def _where(values: np.ndarray, residual: np.ndarray, bins: np.ndarray) -> str:
@@ -137,7 +174,6 @@ def dependence_tests(
 ) -> list[dict]:
     """Per covariate: the share of the residual variance its binned mean explains, against the permutation null."""
     residual_all = np.concatenate(sample.residual)
-    index = np.arange(len(sample.residual))
     values = {name: np.concatenate(per_item) for name, per_item in sample.covariates.items()}
     bins = {name: bin_index(v, BINS)[0] for name, v in values.items()}
     # one permutation of the residuals scores every variable: row j of null_shares is one draw of chance for all
@@ -148,21 +184,32 @@ def dependence_tests(
         null_shares[j] = [explained_share(permuted, b, total) for b in bins.values()]
     quantile = 1.0 - FAMILY_ALPHA / max(len(bins), 1)
     starts = np.concatenate([[0], np.cumsum([len(r) for r in sample.residual])])
+    spans = [slice(starts[i], starts[i + 1]) for i in range(len(sample.residual))]
     tests = []
     for column, (name, values_all) in enumerate(values.items()):
         bins_all = bins[name]
-
-        def statistic(chosen, bins_all=bins_all, values_all=values_all):
-            take = np.concatenate([np.arange(starts[i], starts[i + 1]) for i in chosen])
-            return {
-                "eta2": explained_share(residual_all[take], bins_all[take]),
-                "r": _correlation(values_all[take], residual_all[take]),
-            }
-
-        intervals = bootstrap(statistic, index, draws=DRAWS, rng=rng)
+        n_bins = int(bins_all.max()) + 1
+        columns = np.array(
+            [
+                np.concatenate(
+                    [
+                        binned_columns(residual_all[span], bins_all[span], n_bins),
+                        moment_columns(values_all[span], residual_all[span]),
+                    ]
+                )
+                for span in spans
+            ]
+        )
+        totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
+        eta = percentile_interval(
+            explained_share(residual_all, bins_all),
+            explained_share_of_totals(totals[:, : 2 * n_bins + 1], n_bins),
+        )
+        r = percentile_interval(
+            _correlation(values_all, residual_all), correlation_of_totals(totals[:, 2 * n_bins + 1 :])
+        )
         null = null_shares[:, column]
         chance = float(np.quantile(null, quantile))
-        eta = intervals["eta2"]
         significant = (
             eta.low > max(MIN_EXPLAINED, chance) and share_of_base(eta.estimate) >= MIN_SHARE_OF_BASE
         )
@@ -176,7 +223,7 @@ def dependence_tests(
                 "chance_quantile": quantile,
                 "share_of_base_mse": share_of_base(eta.estimate),
                 "p_value": float((1 + np.sum(null >= eta.estimate)) / (1 + PERMUTATIONS)),
-                "r": intervals["r"].as_dict(),
+                "r": r.as_dict(),
                 "significant": bool(significant),
                 "where": _where(values_all, residual_all, bins_all),
             }
@@ -190,13 +237,13 @@ def neighbour_tests(
     """Per direction with neighbour pairs: the correlation of residuals ``LAG`` values apart (smooth structure)."""
     tests = []
     for name, pairs in sample.neighbours.items():
-
-        def lag_statistic(chosen, pairs=pairs):
-            a = np.concatenate([pairs[i][0] for i in chosen])
-            b = np.concatenate([pairs[i][1] for i in chosen])
-            return {"r": _correlation(a, b)}
-
-        r = bootstrap(lag_statistic, np.arange(len(pairs)), draws=DRAWS, rng=rng)["r"]
+        totals = resummed_totals(
+            np.array([moment_columns(a, b) for a, b in pairs]), draws=RESUMMED_DRAWS, rng=rng
+        )
+        r = percentile_interval(
+            _correlation(np.concatenate([a for a, _ in pairs]), np.concatenate([b for _, b in pairs])),
+            correlation_of_totals(totals),
+        )
         tests.append(
             {
                 "variable": name,

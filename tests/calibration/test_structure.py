@@ -8,7 +8,16 @@ from calibration_testkit import projection_pairs_with_spread_light
 
 from lerobot_phantom.calibration.core import Fit, binned_rmse
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
-from lerobot_phantom.calibration.structure import ResidualSample, residual_structure
+from lerobot_phantom.calibration.structure import (
+    ResidualSample,
+    _correlation,
+    binned_columns,
+    correlation_of_totals,
+    explained_share,
+    explained_share_of_totals,
+    moment_columns,
+    residual_structure,
+)
 
 
 class FakeProblem:
@@ -42,6 +51,39 @@ def run(problem, base_mse=1.0):
     return residual_structure(
         problem, None, np.arange(len(problem.maps)), base_mse=base_mse, rng=np.random.default_rng(0)
     )
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_resummed_statistics_are_those_of_the_resampled_values(seed):
+    # items of unequal size; a resample repeats some and drops others; one item is constant (a correlation of 0)
+    rng = np.random.default_rng(seed)
+    residual = [rng.normal(0.3, 1.0, size) for size in (5, 17, 2, 30, 9)]
+    covariate = [rng.uniform(0.0, 4.0, len(r)) + 0.2 * r for r in residual]
+    bins = [np.minimum((c * 2).astype(int), 7) for c in covariate]
+    columns = np.array(
+        [
+            np.concatenate([binned_columns(r, b, 8), moment_columns(c, r)])
+            for r, b, c in zip(residual, bins, covariate, strict=True)
+        ]
+    )
+    for chosen in (
+        np.arange(5),
+        np.array([0, 0, 3, 4, 4]),
+        np.array([2, 2, 2, 2, 1]),
+        np.array([2, 2, 2, 2, 2]),
+    ):
+        totals = columns[chosen].sum(axis=0, keepdims=True)
+        residual_chosen = np.concatenate([residual[i] for i in chosen])
+        covariate_chosen = np.concatenate([covariate[i] for i in chosen])
+        bins_chosen = np.concatenate([bins[i] for i in chosen])
+        assert explained_share_of_totals(totals[:, :17], 8)[0] == pytest.approx(
+            explained_share(residual_chosen, bins_chosen), rel=1e-9, abs=1e-12
+        )
+        assert correlation_of_totals(totals[:, 17:])[0] == pytest.approx(
+            _correlation(covariate_chosen, residual_chosen), rel=1e-9, abs=1e-12
+        )
+    constant = np.array([moment_columns(np.full(6, 2.5), rng.normal(size=6))])
+    assert correlation_of_totals(constant)[0] == 0.0 == _correlation(np.full(6, 2.5), rng.normal(size=6))
 
 
 def test_noise_leaves_no_structure():
