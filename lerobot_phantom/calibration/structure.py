@@ -81,7 +81,8 @@ def _correlation(a: np.ndarray, b: np.ndarray) -> float:
 
 
 # Both statistics of an item resample are functions of sums over its items (per-bin residual sums and counts, sums of
-# squares and products), so their intervals take ``identify.RESUMMED_DRAWS`` weighted re-sums instead of 200 draws.
+# squares and products), so their intervals take ``identify.RESUMMED_DRAWS`` weighted re-sums (200 resampled draws
+# until session 44).
 
 
 def binned_columns(residual: np.ndarray, bins: np.ndarray, n_bins: int) -> np.ndarray:
@@ -109,7 +110,7 @@ def moment_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 def correlation_of_totals(totals: np.ndarray) -> np.ndarray:
     """``_correlation`` from the totals of ``moment_columns`` over a resample's items (one per row); 0 where a side
-    is constant (its centred sum of squares within 1e-12 of its raw one, rounding) or fewer than 3 values."""
+    is constant (its centred sum of squares at most 1e-12 of its raw one: rounding) or has fewer than 3 values."""
     n, a, b, aa, bb, ab = totals.T
     safe_n = np.maximum(n, 1.0)
     var_a, var_b = aa - a * a / safe_n, bb - b * b / safe_n

@@ -782,8 +782,8 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 "the truth 49 us) and held-out rows lie where no fit row is (seen: 145 and 139 rows held-out, "
                 "STRIPES_SEED=16 and 19; of seeds 11-30, 5 of 40 cases fail, 8 before session 11, 13 before "
                 "session 9: docs/bench/second_camera_stripes.md; all on the point-sampled simulator before session "
-                "43). On the exact-pulse simulator: 197676555, 531200696, 3808238891 and 4111198912 at 296, 215, 116 "
-                "and 341 rows, of 40 cases (docs/bench/session43.md)",
+                "43). On the exact-pulse simulator: 197676555, 531200696 and 3808238891 at 296, 215 and 116 rows, of "
+                "40 cases (docs/bench/session44.md; 4111198912 at 341 rows until session 44)",
             ),
         ),
         pytest.param(
@@ -793,8 +793,9 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 strict=False,
                 reason="open (issue 12): the threshold's gain interval can span 1 on the fit rows (seed 26: "
                 "0.96-1.45, 106 rows held-out) or a negative integration offset stands in for it (seed 30: 113 rows; "
-                "both on the point-sampled simulator before session 43). On the exact-pulse simulator: 1222484455 "
-                "and 1211740460 at 34 and 138 rows, of 40 cases (docs/bench/session43.md)",
+                "both on the point-sampled simulator before session 43). On the exact-pulse simulator: 1222484455, "
+                "1211740460 and 2083087881 at 34, 138 and 94 rows, of 40 cases (the last an offset whose gain "
+                "interval ends at 1.001 +- 0.004 over generator streams; docs/bench/session44.md)",
             ),
         ),
     ],

@@ -37,15 +37,26 @@ style = {"lit": "exposure_us", "interior": "exposure"}[frames]
 camera, report = test_stripes.calibrate_drawn_camera(out, seed, frames, style, seed % 1000)
 print(
     f"camera {seed} {frames}: written {sorted(report['extended']['effects'])}, held-out "
-    f"{report['extended']['heldout_rmse']:.2f} rows; withdrawn {[w['effect'] for w in report['selection']['withdrawn']]}"
+    f"{report['extended']['heldout_rmse']:.2f} rows"
 )
+for withdrawal in report["selection"]["withdrawn"]:
+    print(
+        f"withdrawn in pass {withdrawal['pass']}: {withdrawal['effect']}: {'; '.join(withdrawal['reasons'])}"
+    )
+for result in report["identification"]:
+    ratio = result.get("validation_ratio")
+    if ratio:
+        print(
+            f"{result['effect']}: the tool's ratio {ratio['estimate']:.4f}, {ratio['low']:.4f}-{ratio['high']:.4f}"
+        )
 seen = set()
 for before, after, score in recorded:
     key = (before.tobytes(), after.tobytes(), score)
     if key in seen:
         continue
     seen.add(key)
-    line = f"ratio {before.mean() / after.mean() if score == 'mean_item_error' else np.sqrt(before.sum() / after.sum()):.4f} ({score}, {len(before)} items):"
+    estimate = package_error_ratio(before, after, draws=1, rng=np.random.default_rng(0), score=score).estimate
+    line = f"ratio {estimate:.4f} ({score}, {len(before)} items):"
     for draws, streams in ((200, 200), (identify.RESUMMED_DRAWS, 40)):
         lows = np.array(
             [
