@@ -82,7 +82,7 @@ JOINT_NULL_STATISTIC = "largest distance from the null, as a share of each range
 # used was one: offset withdrawn, 341 rows held-out); with 20 000 draws 1.026 +- 0.003 over 40 streams, none at or
 # below 1 (docs/bench/session44/ratio_end_streams_4111198912_lit_104aed2.txt)
 RESUMMED_DRAWS = 20_000
-RESUMMED_CHUNK = 4_000_000  # item counts per chunk of draws (32 MB), so large item sets stay in memory
+RESUMMED_CHUNK = 4_000_000  # drawn indices per chunk of draws (32 MB), so large item sets stay in memory
 
 
 @dataclass(frozen=True)
@@ -146,18 +146,20 @@ def bootstrap(
 def resummed_totals(columns: np.ndarray, *, draws: int, rng: np.random.Generator) -> np.ndarray:
     """Column totals of ``columns`` (items x k) in ``draws`` item bootstrap resamples: an array (draws, k).
 
-    A resample is each item's multinomial count, the law of drawing the items with replacement. The counts come from
-    a child of ``rng`` (``Generator.spawn``, which does not advance ``rng``), so the number of draws one interval
-    takes never shifts the draws of the refits that follow it."""
+    A resample draws the items with replacement; its totals are each item's count in it times the item's row. The
+    draws come from a child of ``rng`` (``Generator.spawn``, which does not advance ``rng``), so the number of draws
+    one interval takes never shifts the draws of the refits that follow it. Counting the drawn indices
+    (``np.bincount``) and multiplying takes a quarter of ``Generator.multinomial``'s time at 3000 items."""
     columns = np.asarray(columns, np.float64)
     n_items = len(columns)
     child = rng.spawn(1)[0]
     totals = np.empty((draws, columns.shape[1]))
     chunk = max(1, RESUMMED_CHUNK // max(n_items, 1))
     for start in range(0, draws, chunk):
-        stop = min(start + chunk, draws)
-        counts = child.multinomial(n_items, np.full(n_items, 1.0 / n_items), size=stop - start)
-        totals[start:stop] = counts @ columns
+        rows = min(chunk, draws - start)
+        drawn = child.integers(0, n_items, size=(rows, n_items)) + n_items * np.arange(rows)[:, None]
+        counts = np.bincount(drawn.ravel(), minlength=rows * n_items).reshape(rows, n_items)
+        totals[start : start + rows] = counts @ columns
     return totals
 
 
