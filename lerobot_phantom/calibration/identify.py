@@ -78,9 +78,9 @@ JOINT_NULL_STATISTIC = "largest distance from the null, as a share of each range
 # draws of the intervals that only re-sum per-item terms (the error ratio of rule 2, the held-out RMSE, the residual
 # structure's statistics): a draw costs a weighted sum, not a refit. With 200 draws (until session 44) the 5% end of
 # a ratio was Monte Carlo noise that decided rule 2: drawn stripe camera 4111198912 (lit frames), integration offset,
-# ratio 1.583, low end over 200 generator streams 1.035 +- 0.033, at or below 1 in 16% of them (the stream the tool
-# used was one: offset withdrawn, 341 rows held-out); with 20 000 draws 1.026 +- 0.003 over 40 streams, none at or
-# below 1 (docs/bench/session44/ratio_end_streams_4111198912_lit_104aed2.txt)
+# ratio 1.583, low end over 200 generator streams 1.029 +- 0.033, at or below 1 in 19% of them (the stream the tool
+# used was one: offset withdrawn, 341 rows held-out); with 20 000 draws 1.026 +- 0.004 over 40 streams, none at or
+# below 1 (docs/bench/session44/ratio_end_streams_4111198912_lit_8864213.txt)
 RESUMMED_DRAWS = 20_000
 RESUMMED_CHUNK = 4_000_000  # drawn indices per chunk of draws (32 MB), so large item sets stay in memory
 
