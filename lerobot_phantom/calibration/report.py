@@ -24,7 +24,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}; the outlying-item test: {variable "items", value, outlying_items,
-  largest_fit_item_error, significant, where}]} (``calibration/structure.py``);
+  largest_fit_item_error, significant, where}]} (``calibration/structure.py``; ``tested_on`` says whether the fit
+  items' cross-fitted residuals joined fewer than ``structure.MIN_TESTED_ITEMS`` held-out items);
 - ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs);
   ``per_capture_heldout_rmse`` (laser captures).
 """
@@ -138,6 +139,8 @@ def build_report(
             base_mse=base_scores["heldout_rmse"] ** 2,
             rng=np.random.default_rng([seed, 4]),
             fit_items=fit_items,
+            folds=folds,
+            seed=seed,
         ),
         "residual_analysis": {
             "base": problem.analyse(base, heldout_items),
@@ -378,7 +381,16 @@ def _cause_lines(report: dict) -> list[str]:
 
 
 def _structure_lines(structure: dict) -> list[str]:
-    return ["", "## Unexplained structure", "", structure["summary"] + ".", "", f"Rule: {structure['rule']}."]
+    return [
+        "",
+        "## Unexplained structure",
+        "",
+        structure["summary"] + ".",
+        "",
+        f"Tested on: {structure['tested_on']}.",
+        "",
+        f"Rule: {structure['rule']}.",
+    ]
 
 
 def _extended_lines(report: dict) -> list[str]:

@@ -9,6 +9,7 @@ from calibration_testkit import projection_pairs_with_spread_light
 from lerobot_phantom.calibration.core import Fit, binned_rmse
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.structure import (
+    MIN_TESTED_ITEMS,
     ResidualSample,
     _correlation,
     binned_columns,
@@ -103,6 +104,70 @@ def test_a_row_ramp_is_reported_with_its_variable_and_place():
 def test_smooth_residual_is_reported_as_neighbour_correlation():
     result = run(FakeProblem(ramp=0.0, smooth=True))
     assert [t["variable"] for t in result["tests"] if t["significant"]] == ["neighbours_along_rows"]
+
+
+class RefitProblem(FakeProblem):
+    """Per-item ramps (``ramps[i]``); fits remember the items they were fitted on, and every residual asked for
+    is checked against them."""
+
+    def __init__(self, ramps: list[float]) -> None:
+        super().__init__(ramp=0.0, items=len(ramps))
+        rows = np.linspace(0.0, 1.0, 40)[:, None] * np.ones((1, 50))
+        self.maps = [m + r * (rows - 0.5) for m, r in zip(self.maps, ramps, strict=True)]
+        self.fitted_on: list[set[int]] = []
+        self.predicted: list[int] = []
+
+    def fit(self, effects, items, start=None):
+        assert start is None, "a cross-fitted refit must not start from the fit that saw every item"
+        self.fitted_on.append({int(i) for i in items})
+        return Fit(effects, {}, {"fitted_on": self.fitted_on[-1]})
+
+    def residual_sample(self, fit, items, rng):
+        seen = fit.extra.get("fitted_on", set()) & {int(i) for i in items}
+        assert not seen, f"items {sorted(seen)} predicted by a fit that saw them"
+        self.predicted += [int(i) for i in items]
+        return super().residual_sample(fit, items, rng)
+
+    def item_squared_errors(
+        self, fit, items
+    ):  # the outlying-item test's reference (the written fit's own items)
+        return np.array([np.sum(self.maps[int(i)] ** 2) for i in items]), np.full(len(items), 2000.0)
+
+
+def structure_of(problem, heldout, folds):
+    fit_items = np.setdiff1d(np.arange(len(problem.maps)), heldout)
+    return residual_structure(
+        problem,
+        Fit(frozenset({"effect"}), {}, {"fitted_on": set(fit_items.tolist())}),
+        np.asarray(heldout),
+        base_mse=1.0,
+        rng=np.random.default_rng(0),
+        fit_items=fit_items,
+        folds=folds,
+        seed=3,
+    )
+
+
+def test_few_heldout_items_are_joined_by_the_fit_items_cross_fitted_residuals():
+    # two held-out items, one of them flat: over two items the bootstrap's 5% end is the flat item's own value
+    ramps = [0.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0, 3.0]
+    alone = structure_of(RefitProblem(ramps), heldout=[0, 1], folds=None)
+    assert not alone["structure_remains"], alone["summary"]
+    problem = RefitProblem(ramps)
+    joined = structure_of(problem, heldout=[0, 1], folds=4)
+    assert joined["structure_remains"] and "depends on row" in joined["summary"], joined["summary"]
+    assert "6 fit items" in joined["tested_on"] and "4 folds" in joined["tested_on"]
+    # every fit item predicted once, by one of four refits that left it out (residual_sample checks that)
+    assert sorted(problem.predicted) == list(range(8)) and len(problem.fitted_on) == 4
+    assert all(len(trained) >= 4 for trained in problem.fitted_on)
+
+
+def test_enough_heldout_items_are_tested_alone():
+    problem = RefitProblem([3.0] * 12)
+    heldout = list(range(MIN_TESTED_ITEMS))
+    result = structure_of(problem, heldout=heldout, folds=4)
+    assert problem.fitted_on == [] and sorted(problem.predicted) == heldout
+    assert result["tested_on"] == "held-out residual of the written model (base + identified effects)"
 
 
 def test_structure_too_small_against_the_base_error_is_not_reported():
