@@ -88,26 +88,9 @@ def cross_fitted_sample(problem, fit: Fit, splits, rng: np.random.Generator) -> 
     return functools.reduce(ResidualSample.joined, parts)
 
 
-def explained_share(residual: np.ndarray, bins: np.ndarray, total: float | None = None) -> float:
-    """eta squared: the share of the residual's variance (about 0) explained by its mean per bin; ``total``: the
-    residual's sum of squares when the caller already has it (a permutation does not change it)."""
-    total = float(np.sum(residual**2)) if total is None else total
-    if total <= 0:
-        return 0.0
-    sums = np.bincount(bins, weights=residual)
-    counts = np.bincount(bins)
-    return float(np.sum(sums[counts > 0] ** 2 / counts[counts > 0]) / total)
-
-
-def _correlation(a: np.ndarray, b: np.ndarray) -> float:
-    if len(a) < 3 or np.std(a) == 0 or np.std(b) == 0:
-        return 0.0
-    return float(np.corrcoef(a, b)[0, 1])
-
-
-# Both statistics of an item resample are functions of sums over its items (per-bin residual sums and counts, sums of
-# squares and products), so their intervals take ``identify.RESUMMED_DRAWS`` weighted re-sums (200 resampled draws
-# until session 44).
+# Both statistics are functions of sums over items (per-bin residual sums and counts, sums of squares and products):
+# the estimate is the statistic of all items' totals, and the intervals re-sum ``identify.RESUMMED_DRAWS`` item
+# resamples (200 resampled draws until session 44).
 
 
 def binned_columns(residual: np.ndarray, bins: np.ndarray, n_bins: int) -> np.ndarray:
@@ -122,7 +105,8 @@ def binned_columns(residual: np.ndarray, bins: np.ndarray, n_bins: int) -> np.nd
 
 
 def explained_share_of_totals(totals: np.ndarray, n_bins: int) -> np.ndarray:
-    """``explained_share`` from the totals of ``binned_columns`` over a resample's items (one per row)."""
+    """eta squared, the share of the residual's variance (about 0) explained by its mean per bin, from the totals of
+    ``binned_columns`` over a sample's items (one sample per row)."""
     sums, counts, squares = totals[:, :n_bins], totals[:, n_bins : 2 * n_bins], totals[:, -1]
     between = np.sum(np.where(counts > 0, sums**2 / np.maximum(counts, 1.0), 0.0), axis=1)
     return np.where(squares > 0, between / np.maximum(squares, 1e-300), 0.0)
@@ -134,7 +118,7 @@ def moment_columns(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def correlation_of_totals(totals: np.ndarray) -> np.ndarray:
-    """``_correlation`` from the totals of ``moment_columns`` over a resample's items (one per row); 0 where a side
+    """Pearson's correlation from the totals of ``moment_columns`` over a sample's items (one per row); 0 where a side
     is constant (its centred sum of squares at most 1e-12 of its raw one: rounding) or has fewer than 3 values."""
     n, a, b, aa, bb, ab = totals.T
     safe_n = np.maximum(n, 1.0)
@@ -218,37 +202,41 @@ def dependence_tests(
     residual_all = np.concatenate(sample.residual)
     values = {name: np.concatenate(per_item) for name, per_item in sample.covariates.items()}
     bins = {name: bin_index(v, BINS)[0] for name, v in values.items()}
+    n_bins = {name: int(b.max()) + 1 for name, b in bins.items()}
     # one permutation of the residuals scores every variable: row j of null_shares is one draw of chance for all
     null_shares = np.empty((PERMUTATIONS, len(bins)))
-    total = float(np.sum(residual_all**2))
     for j in range(PERMUTATIONS if bins else 0):
         permuted = rng.permutation(residual_all)
-        null_shares[j] = [explained_share(permuted, b, total) for b in bins.values()]
+        null_shares[j] = [
+            explained_share_of_totals(binned_columns(permuted, bins[name], n)[None], n)[0]
+            for name, n in n_bins.items()
+        ]
     quantile = 1.0 - FAMILY_ALPHA / max(len(bins), 1)
     starts = np.concatenate([[0], np.cumsum([len(r) for r in sample.residual])])
     spans = [slice(starts[i], starts[i + 1]) for i in range(len(sample.residual))]
     tests = []
     for column, (name, values_all) in enumerate(values.items()):
-        bins_all = bins[name]
-        n_bins = int(bins_all.max()) + 1
+        bins_all, n = bins[name], n_bins[name]
         columns = np.array(
             [
                 np.concatenate(
                     [
-                        binned_columns(residual_all[span], bins_all[span], n_bins),
+                        binned_columns(residual_all[span], bins_all[span], n),
                         moment_columns(values_all[span], residual_all[span]),
                     ]
                 )
                 for span in spans
             ]
         )
+        every_item = columns.sum(axis=0, keepdims=True)
         totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
         eta = percentile_interval(
-            explained_share(residual_all, bins_all),
-            explained_share_of_totals(totals[:, : 2 * n_bins + 1], n_bins),
+            float(explained_share_of_totals(every_item[:, : 2 * n + 1], n)[0]),
+            explained_share_of_totals(totals[:, : 2 * n + 1], n),
         )
         r = percentile_interval(
-            _correlation(values_all, residual_all), correlation_of_totals(totals[:, 2 * n_bins + 1 :])
+            float(correlation_of_totals(every_item[:, 2 * n + 1 :])[0]),
+            correlation_of_totals(totals[:, 2 * n + 1 :]),
         )
         null = null_shares[:, column]
         chance = float(np.quantile(null, quantile))
@@ -279,12 +267,10 @@ def neighbour_tests(
     """Per direction with neighbour pairs: the correlation of residuals ``LAG`` values apart (smooth structure)."""
     tests = []
     for name, pairs in sample.neighbours.items():
-        totals = resummed_totals(
-            np.array([moment_columns(a, b) for a, b in pairs]), draws=RESUMMED_DRAWS, rng=rng
-        )
+        columns = np.array([moment_columns(a, b) for a, b in pairs])
+        totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
         r = percentile_interval(
-            _correlation(np.concatenate([a for a, _ in pairs]), np.concatenate([b for _, b in pairs])),
-            correlation_of_totals(totals),
+            float(correlation_of_totals(columns.sum(axis=0, keepdims=True))[0]), correlation_of_totals(totals)
         )
         tests.append(
             {

@@ -6,15 +6,13 @@ import numpy as np
 import pytest
 from calibration_testkit import projection_pairs_with_spread_light
 
-from lerobot_phantom.calibration.core import Fit, binned_rmse
+from lerobot_phantom.calibration.core import Fit, bin_index, binned_rmse
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.structure import (
     MIN_TESTED_ITEMS,
     ResidualSample,
-    _correlation,
     binned_columns,
     correlation_of_totals,
-    explained_share,
     explained_share_of_totals,
     moment_columns,
     residual_structure,
@@ -54,6 +52,17 @@ def run(problem, base_mse=1.0):
     )
 
 
+def eta_squared(residual: np.ndarray, bins: np.ndarray) -> float:
+    """The textbook form: the squared bin means, weighted by bin size, over the residual's sum of squares."""
+    means = [residual[bins == b].mean() for b in np.unique(bins)]
+    sizes = [np.sum(bins == b) for b in np.unique(bins)]
+    return float(np.dot(sizes, np.square(means)) / np.sum(residual**2))
+
+
+def pearson(a: np.ndarray, b: np.ndarray) -> float:
+    return 0.0 if np.std(a) == 0 or np.std(b) == 0 else float(np.corrcoef(a, b)[0, 1])
+
+
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_the_resummed_statistics_are_those_of_the_resampled_values(seed):
     # items of unequal size; a resample repeats some and drops others; one item is constant (a correlation of 0)
@@ -78,13 +87,13 @@ def test_the_resummed_statistics_are_those_of_the_resampled_values(seed):
         covariate_chosen = np.concatenate([covariate[i] for i in chosen])
         bins_chosen = np.concatenate([bins[i] for i in chosen])
         assert explained_share_of_totals(totals[:, :17], 8)[0] == pytest.approx(
-            explained_share(residual_chosen, bins_chosen), rel=1e-9, abs=1e-12
+            eta_squared(residual_chosen, bins_chosen), rel=1e-9, abs=1e-12
         )
         assert correlation_of_totals(totals[:, 17:])[0] == pytest.approx(
-            _correlation(covariate_chosen, residual_chosen), rel=1e-9, abs=1e-12
+            pearson(covariate_chosen, residual_chosen), rel=1e-9, abs=1e-12
         )
     constant = np.array([moment_columns(np.full(6, 2.5), rng.normal(size=6))])
-    assert correlation_of_totals(constant)[0] == 0.0 == _correlation(np.full(6, 2.5), rng.normal(size=6))
+    assert correlation_of_totals(constant)[0] == 0.0
 
 
 def test_noise_leaves_no_structure():
@@ -99,6 +108,18 @@ def test_a_row_ramp_is_reported_with_its_variable_and_place():
     flagged = {t["variable"] for t in result["tests"] if t["significant"]}
     assert "row" in flagged and "column" not in flagged  # a row ramp also makes neighbours in a row alike
     assert "depends on row" in result["summary"] and "r = +" in result["summary"]
+
+
+def test_the_reported_estimates_are_the_statistics_of_every_item():
+    problem = FakeProblem(ramp=1.0, smooth=True)
+    tests = {t["variable"]: t for t in run(problem)["tests"]}
+    residual = np.concatenate([m.ravel() for m in problem.maps])
+    rows = np.concatenate([(np.mgrid[0:40, 0:50][0] / 39.0).ravel()] * len(problem.maps))
+    assert tests["row"]["value"] == pytest.approx(eta_squared(residual, bin_index(rows, 8)[0]), rel=1e-9)
+    assert tests["row"]["r"]["estimate"] == pytest.approx(pearson(rows, residual), rel=1e-9)
+    left = np.concatenate([m[:, :-3].ravel() for m in problem.maps])
+    right = np.concatenate([m[:, 3:].ravel() for m in problem.maps])
+    assert tests["neighbours_along_rows"]["value"] == pytest.approx(pearson(left, right), rel=1e-9)
 
 
 def test_smooth_residual_is_reported_as_neighbour_correlation():
