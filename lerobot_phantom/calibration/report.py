@@ -41,7 +41,7 @@ import numpy as np
 
 from lerobot_phantom.calibration.core import SELECTION_SCORES, TIE_SHARE, Fit, Problem, Step
 from lerobot_phantom.calibration.identify import Interval, Selection, Withdrawal, error_ratio, rmse_interval
-from lerobot_phantom.calibration.structure import residual_structure
+from lerobot_phantom.calibration.structure import MIN_TESTED_ITEMS, residual_structure
 
 CALIBRATED_FILE = "calibrated.json"
 CALIBRATED_FORMAT = 1
@@ -334,7 +334,14 @@ def _problem_lines(report: dict) -> list[str]:
         f"# Calibration of `{report['attack']}` against measured data",
         "",
         f"Input: `{report['input']['path']}` ({report['input']['kind']}); {report['n_fit']} {report['split']['items']} "
-        f"fitted, {report['n_heldout']} held out (seed {report['split']['seed']}). Errors are RMSE in {units}.",
+        f"fitted, {report['n_heldout']} held out (seed {report['split']['seed']}). Errors are RMSE in {units}."
+        + (
+            f" Over only {report['n_heldout']} held-out items, the held-out intervals below are item bootstraps"
+            " whose ends lie at or near single items' values, not confidence intervals; the evidence for each"
+            " effect is its validation ratio over the fit items."
+            if report["n_heldout"] < MIN_TESTED_ITEMS
+            else ""
+        ),
         "",
         "## What the simulation gets wrong",
         "",

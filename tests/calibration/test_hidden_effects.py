@@ -13,6 +13,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.calibration.structure import MIN_TESTED_ITEMS
 from lerobot_phantom.transforms.registry import make_attack
 
 SLOW = pytest.mark.slow  # > 10 s each on 2 cores
@@ -113,4 +114,12 @@ def test_shot_noise_is_found_by_likelihood_and_changes_no_prediction(tmp_path):
     # gain 2 * shot * 255 linear grey levels^2 per grey level
     assert noise["shot_noise"]["shot_gain_grey"] == pytest.approx(2 * shot * 255, rel=0.35)
     assert "shot_noise" not in json.loads((tmp_path / "out" / "calibrated.json").read_text())["effects"]
-    assert "Noise model" in (tmp_path / "out" / "report.md").read_text()
+    markdown = (tmp_path / "out" / "report.md").read_text()
+    assert "Noise model" in markdown
+    # two of eight pairs held out: report.md says what their intervals are, and the structure test's sample
+    assert report["n_heldout"] < MIN_TESTED_ITEMS
+    assert f"Over only {report['n_heldout']} held-out items" in markdown
+    assert f"Tested on: {report['unexplained_structure']['tested_on']}." in markdown
+    assert (
+        "fit items' residuals under the same model refitted" in report["unexplained_structure"]["tested_on"]
+    )
