@@ -32,7 +32,9 @@ An item bootstrap over a few held-out items is no interval: over two, its 5% end
 (a quarter of the draws hold it twice). With fewer than ``MIN_TESTED_ITEMS`` held-out items (two of eight frame
 pairs), the fit items join the sample with their cross-fitted residuals: the written model refitted on the fit
 items without each of the selection's folds predicts the fold it left out, so no residual comes from a fit that saw
-its item. The outlying-item test and the base model's mean squared error stay held-out figures.
+its item. The fit items did inform which effects were selected, so their residuals lean toward the written model:
+a conservative sample for finding what it misses, never a generous one. The outlying-item test and the base model's
+mean squared error stay held-out figures.
 
 A problem supplies its residuals through ``Problem.residual_sample`` (None: not tested). The finding names what
 structure is left and where; it never names a library effect.
