@@ -33,7 +33,7 @@ for size in [int(a) for a in sys.argv[1:]] or [1000, 8000, 32000]:
     total = float(np.sum(residual**2))
     timings = {}
     for name, share in (
-        ("scalar", lambda r, b, n: scalar_share(r, b, total)),
+        ("scalar", lambda r, b, n, total=total: scalar_share(r, b, total)),
         ("totals", totals_share),
     ):
         draws = np.random.default_rng(1)
