@@ -5,7 +5,10 @@ parameters and their intervals, reasons).
 Usage: ``PYTHONPATH=. python docs/bench/session45/falloff_detail.py MASTER_SEED`` from a checkout's root.
 """
 
-import importlib, os, sys, tempfile
+import importlib
+import os
+import sys
+import tempfile
 
 sys.path.insert(0, "tests/calibration")
 os.environ["CAMSIM_SEED"] = sys.argv[1]
