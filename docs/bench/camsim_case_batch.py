@@ -27,6 +27,13 @@ def cases_per_master_seed(name: str, seeds: list[str]) -> Iterator[tuple[str, Mo
         yield seed, sim, sim.CASE_BY_NAME[name]
 
 
+def run_on_master_seed(name: str, seed: str) -> tuple[ModuleType, dict]:
+    """The test module drawn for master ``seed`` and its ``run_case(name)`` result (report, case seed, camera)."""
+    ((_, sim, _case),) = cases_per_master_seed(name, [seed])
+    with tempfile.TemporaryDirectory() as root:
+        return sim, sim.run_case(name, root)
+
+
 def main() -> None:
     name, seeds = sys.argv[1], sys.argv[2:]
     for seed, sim, case in cases_per_master_seed(name, seeds):

@@ -5,16 +5,12 @@ parameters and their intervals, reasons).
 Usage: ``PYTHONPATH=. python docs/bench/session45/falloff_detail.py MASTER_SEED`` from a checkout's root.
 """
 
-import importlib
-import os
 import sys
-import tempfile
 
-sys.path.insert(0, "tests/calibration")
-os.environ["CAMSIM_SEED"] = sys.argv[1]
-sim = importlib.import_module("test_independent_sim")
-with tempfile.TemporaryDirectory() as root:
-    result = sim.run_case("projection_falloff_unnamed", root)
+sys.path.insert(0, "docs/bench")
+from camsim_case_batch import run_on_master_seed
+
+sim, result = run_on_master_seed("projection_falloff_unnamed", sys.argv[1])
 r = result["report"]
 print("camera", result["camera"])
 print(

@@ -4,17 +4,13 @@ Usage: ``PYTHONPATH=. python docs/bench/session45/rotation_case_report.py MASTER
 package is the one tested). Session 45 ran it at d0f238e and 8354629 on CAMSIM_SEED=3875164730.
 """
 
-import importlib
 import json
-import os
 import sys
-import tempfile
 
-sys.path.insert(0, "tests/calibration")
-os.environ["CAMSIM_SEED"] = sys.argv[1]
-sim = importlib.import_module("test_independent_sim")
-with tempfile.TemporaryDirectory() as root:
-    result = sim.run_case("blur_rotation_unnamed", root)
+sys.path.insert(0, "docs/bench")
+from camsim_case_batch import run_on_master_seed
+
+sim, result = run_on_master_seed("blur_rotation_unnamed", sys.argv[1])
 report = result["report"]
 print("seed", result["seed"], "named", sorted(sim.named_causes(report)))
 print(

@@ -6,18 +6,13 @@ checkout's root (its package is the one tested). Renders the case exactly as
 ``tests/calibration/test_independent_sim.py`` does for each master seed; one line per seed.
 """
 
-import importlib
-import os
 import sys
-import tempfile
 
-sys.path.insert(0, "tests/calibration")
+sys.path.insert(0, "docs/bench")
+from camsim_case_batch import run_on_master_seed
 
 for seed in sys.argv[1:]:
-    os.environ["CAMSIM_SEED"] = seed
-    sim = importlib.reload(importlib.import_module("test_independent_sim"))
-    with tempfile.TemporaryDirectory() as root:
-        result = sim.run_case("blur_rotation_unnamed", root)
+    sim, result = run_on_master_seed("blur_rotation_unnamed", seed)
     report = result["report"]
     tests = report["unexplained_structure"]["tests"]
     clean_level = next(t for t in tests if t["variable"] == "clean_level")

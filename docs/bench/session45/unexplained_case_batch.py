@@ -6,19 +6,14 @@ checkout's root (its package is the one tested). Renders the case as ``tests/cal
 does for each master seed; one line per seed.
 """
 
-import importlib
-import os
 import sys
-import tempfile
 
-sys.path.insert(0, "tests/calibration")
+sys.path.insert(0, "docs/bench")
+from camsim_case_batch import run_on_master_seed
 
 name, seeds = sys.argv[1], sys.argv[2:]
 for seed in seeds:
-    os.environ["CAMSIM_SEED"] = seed
-    sim = importlib.reload(importlib.import_module("test_independent_sim"))
-    with tempfile.TemporaryDirectory() as root:
-        result = sim.run_case(name, root)
+    sim, result = run_on_master_seed(name, seed)
     report = result["report"]
     flagged = [
         f"{t['variable']} {t['value']:.3f} (low {t['interval']['low']:.3f})"
