@@ -149,7 +149,8 @@ def resummed_totals(columns: np.ndarray, *, draws: int, rng: np.random.Generator
     A resample draws the items with replacement; its totals are each item's count in it times the item's row. The
     draws come from a child of ``rng`` (``Generator.spawn``, which does not advance ``rng``), so the number of draws
     one interval takes never shifts the draws of the refits that follow it. Counting the drawn indices
-    (``np.bincount``) and multiplying takes a quarter of ``Generator.multinomial``'s time at 3000 items."""
+    (``np.bincount``) and multiplying takes a fifth of ``Generator.multinomial``'s time at 3000 items
+    (docs/bench/session44/resummed_draw_cost_8864213.txt)."""
     columns = np.asarray(columns, np.float64)
     n_items = len(columns)
     child = rng.spawn(1)[0]
