@@ -304,6 +304,23 @@ def laser_spot(
     return profile[..., None] * colour
 
 
+def speckle(rng: np.random.Generator, height: int, width: int, *, grain_px: float, looks: int) -> np.ndarray:
+    """A laser speckle intensity field of mean 1 (HxW): coherent light scattered by a rough surface interferes
+    into grains whose size is set by the aperture (a complex Gaussian field low-passed to ``grain_px``, its squared
+    magnitude exponential with contrast 1); ``looks`` independent patterns (polarisation, laser modes, motion
+    within the exposure) add, lowering the contrast to 1/sqrt(looks). Any micro-motion of laser, surface or camera
+    draws a new pattern, so a frame's speckle is not the one of a pattern recorded at another time."""
+    total = np.zeros((height, width))
+    for _ in range(looks):
+        field = rng.normal(size=(height, width)) + 1j * rng.normal(size=(height, width))
+        field = ndimage.gaussian_filter(field.real, grain_px) + 1j * ndimage.gaussian_filter(
+            field.imag, grain_px
+        )
+        intensity = np.abs(field) ** 2
+        total += intensity / intensity.mean()
+    return total / looks
+
+
 LASER_COLOURS = {
     "red": np.array([1.0, 0.10, 0.04]),
     "green": np.array([0.12, 1.0, 0.22]),
@@ -318,6 +335,7 @@ def laser_blinding_pairs(
     *,
     halo: bool = False,
     digital_alpha: float | None = None,
+    speckle_looks: int | None = None,
 ) -> list[FramePair]:
     """Laser blinding frame pairs and the laser pattern recorded without a scene.
 
@@ -333,8 +351,13 @@ def laser_blinding_pairs(
     hold. (A capture at a few percent of the attack's power still saturates its core and keeps the tail where the
     attack shows it.)
     ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha * intensity, in 8-bit
-    output space (the null case)."""
+    output space (the null case). ``speckle_looks`` (with ``digital_alpha``): the blended laser light carries a fresh
+    speckle pattern per frame (``speckle``, grains of 1-2 px), which the recorded pattern does not hold: an effect
+    the library has no name for."""
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))]
+    grain_px = (
+        rng.uniform(1.0, 2.0) if speckle_looks else None
+    )  # drawn only then: other cases keep their draws
     centre = (rng.uniform(0.3, 0.7) * cam.height, rng.uniform(0.3, 0.7) * cam.width)
     halo_params = None
     if halo:
@@ -366,7 +389,14 @@ def laser_blinding_pairs(
         if digital_alpha is not None:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             a = digital_alpha * intensity
-            attacked_u8 = encode((1 - a) * quantised(attacked) + a * pattern_u8 / 255.0, cam)
+            laser = pattern_u8 / 255.0
+            if speckle_looks:
+                # a saturated pattern pixel records light at or far above the clip, which speckle leaves above it
+                grains = speckle(rng, cam.height, cam.width, grain_px=grain_px, looks=speckle_looks)[
+                    ..., None
+                ]
+                laser = np.where(pattern_u8 == 255, 1.0, laser * grains)
+            attacked_u8 = encode((1 - a) * quantised(attacked) + a * np.clip(laser, 0.0, 1.0), cam)
         else:
             irradiance = refl * light + intensity * peak_power * spot
             attacked, _ = capture(irradiance, cam, rng, exposure=None if cam.auto_exposure else exposure)
@@ -478,6 +508,7 @@ def laser_strip_pairs(
     multi_stripe: bool = False,
     paper_band: float | None = None,
     band_profile: np.ndarray | None = None,
+    speckle_looks: int | None = None,
 ) -> list[FramePair]:
     """Rolling-shutter laser stripes. Row i integrates laser light for the overlap of its exposure with the pulse
     train (energy = power * overlap, added to the scene's exposure in linear electrons, then clipped at the well).
@@ -485,8 +516,13 @@ def laser_strip_pairs(
     of the frame so 2-3 stripes show. The phase is random per frame (laser and camera are not synchronised).
     ``paper_band``: the paper's Gaussian-weighted band over rows h/3 .. 2h/3, strength paper_band * intensity,
     added in output space (null); ``band_profile`` (HxW, peak 1) replaces the paper's Gaussian when the null must
-    use another implementation's unstated constants (the paper gives no sigmas or centre)."""
+    use another implementation's unstated constants (the paper gives no sigmas or centre). ``speckle_looks`` (with
+    ``paper_band``): the band's laser light carries a fresh speckle pattern per frame (``speckle``, grains of 1-2
+    px): an effect the library has no name for."""
     h = cam.height
+    grain_px = (
+        rng.uniform(1.0, 2.0) if speckle_looks else None
+    )  # drawn only then: other cases keep their draws
     profile = paper_band_profile(cam) if band_profile is None else band_profile[..., None]
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))] * rng.uniform(0.8, 1.0)
     exposure_rows = rng.uniform(2, 8)
@@ -504,7 +540,10 @@ def laser_strip_pairs(
         clean, exposure = session.clean(refl * light, rng)
         if paper_band is not None:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
-            attacked_u8 = encode(quantised(attacked) + paper_band * intensity * profile * colour, cam)
+            band = paper_band * intensity * profile * colour
+            if speckle_looks:
+                band = band * speckle(rng, h, cam.width, grain_px=grain_px, looks=speckle_looks)[..., None]
+            attacked_u8 = encode(quantised(attacked) + band, cam)
         else:
             phase = rng.uniform(0, period_rows) if multi_stripe else rng.uniform(-0.2 * h, 0.9 * h)
             lit = pulse_overlap(h, exposure_rows, period_rows, on_rows, phase) * intensity * power
@@ -550,6 +589,7 @@ def em_strip_pairs(
     *,
     paper_map: bool = False,
     lost_lines: str = "banded",
+    pixel_slip: int = 0,
 ) -> list[FramePair]:
     """EM colour strip: rows demosaiced with the wrong Bayer phase because lines were lost on the bus.
 
@@ -558,7 +598,9 @@ def em_strip_pairs(
     second lost line at the band end restores it. ``"single"``: the interference hits once per frame, at a
     uniformly random row; one lost line shifts every later raw row by one, so the wrong phase runs to the frame's
     end (nothing restores it before the next frame's sync). ``paper_map``: the paper's fixed colour map on the
-    bands in output space (null)."""
+    bands in output space (null). ``pixel_slip`` (with ``paper_map``): the interference also drops pixel clocks on
+    the parallel bus, so each corrupted row arrives up to this many pixels early (a slip drawn per row, the row's
+    end filled from its last pixel): an effect the library has no name for."""
     if lost_lines not in ("banded", "single"):
         raise ValueError(f"lost_lines {lost_lines!r}; valid: banded, single")
     h = cam.height
@@ -576,6 +618,12 @@ def em_strip_pairs(
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             attacked = quantised(attacked)
             attacked[band] = paper_colour_map(attacked[band])
+            if pixel_slip:
+                for row in np.flatnonzero(band):
+                    slip = int(rng.integers(0, pixel_slip + 1))
+                    if slip:
+                        attacked[row, :-slip] = attacked[row, slip:].copy()
+                        attacked[row, -slip:] = attacked[row, -slip - 1]
         else:
 
             def flip(raw, band=band):

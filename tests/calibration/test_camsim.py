@@ -60,3 +60,49 @@ def test_projection_pairs_of_a_manual_camera_share_one_exposure(monkeypatch):
     cs.light_projection_pairs(np.random.default_rng(5), cs.Camera(), 3)
     assert len(exposures) == 9  # clean, pattern and attacked frame per pair
     assert len(set(exposures)) == 1
+
+
+@pytest.mark.parametrize("looks", [1, 4])
+def test_speckle_has_mean_one_and_the_contrast_of_its_looks(looks):
+    # fully developed speckle is exponential (contrast 1); the sum of `looks` independent patterns has 1/sqrt(looks)
+    field = cs.speckle(np.random.default_rng(7), 256, 256, grain_px=1.5, looks=looks)
+    assert field.min() >= 0.0
+    assert field.mean() == pytest.approx(1.0, abs=1e-9)
+    assert field.std() == pytest.approx(1.0 / np.sqrt(looks), rel=0.1)
+    # grains, not white noise: neighbours one pixel apart correlate, ten apart do not
+    centred = field - field.mean()
+    near = np.mean(centred[:, 1:] * centred[:, :-1]) / centred.var()
+    far = np.mean(centred[:, 10:] * centred[:, :-10]) / centred.var()
+    assert near > 0.5 and abs(far) < 0.05
+
+
+def blend_miss(pair, digital_alpha: float, where: np.ndarray) -> np.ndarray:
+    """The attacked frame against the paper's blend of its clean frame and pattern, at the pixels ``where``."""
+    a = digital_alpha * pair.intensity
+    return pair.attacked[where] - ((1 - a) * pair.clean[where] + a * pair.pattern[where].astype(float))
+
+
+def test_blinding_speckle_leaves_a_saturated_pattern_saturated_and_draws_nothing_without_it():
+    cam = cs.Camera(jpeg_quality=97)
+    plain = cs.laser_blinding_pairs(np.random.default_rng(11), cam, 3, digital_alpha=0.6)
+    again = cs.laser_blinding_pairs(np.random.default_rng(11), cam, 3, digital_alpha=0.6, speckle_looks=None)
+    assert all(np.array_equal(a.attacked, b.attacked) for a, b in zip(plain, again, strict=True))
+    speckled = cs.laser_blinding_pairs(np.random.default_rng(11), cam, 3, digital_alpha=0.6, speckle_looks=3)
+    for pair, reference in zip(speckled, plain, strict=True):
+        saturated = pair.pattern == 255
+        lit = (pair.pattern > 60) & ~saturated
+        assert saturated.any() and lit.any()
+        # clean and attacked are separate captures (noise) and compressed after the blend: a few grey levels
+        assert np.median(np.abs(blend_miss(pair, 0.6, saturated))) < 8.0
+        noise = np.std(blend_miss(reference, 0.6, reference.pattern > 60))
+        assert noise < 8.0
+        assert np.std(blend_miss(pair, 0.6, lit)) > 1.5 * noise
+
+
+def test_pixel_slip_moves_only_the_corrupted_rows_left():
+    cam = cs.Camera(jpeg_quality=97)
+    plain = cs.em_strip_pairs(np.random.default_rng(2), cam, 2, paper_map=True)
+    slipped = cs.em_strip_pairs(np.random.default_rng(2), cam, 2, paper_map=True, pixel_slip=3)
+    # the slip draws after each frame's band: the first frame's scene and band are shared, its rows differ
+    changed = np.abs(plain[0].attacked.astype(float) - slipped[0].attacked).mean(axis=(1, 2)) > 2.0
+    assert changed.any() and not changed.all()

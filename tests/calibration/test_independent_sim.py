@@ -293,6 +293,37 @@ CASES = [
         "null",
         lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS, lost_lines="banded"),
     ),
+    # an effect the library lacks for the three attacks that had none (session 46): the paper's digital forms (the
+    # nulls) with a physical effect on top, so all that is left to find is the unnamed one
+    Case(
+        "blinding_speckle_unnamed",
+        "laser_blinding",
+        "unexplained",
+        lambda rng, cam: cs.laser_blinding_pairs(
+            rng, cam, N_PAIRS, digital_alpha=rng.uniform(0.4, 0.8), speckle_looks=int(rng.integers(3, 7))
+        ),
+    ),
+    Case(
+        "strip_speckle_unnamed",
+        "laser_color_strip",
+        "unexplained",
+        lambda rng, cam: cs.laser_strip_pairs(
+            rng,
+            cam,
+            N_PAIRS,
+            paper_band=rng.uniform(0.3, 0.6),
+            band_profile=library_band_profile(cam),
+            speckle_looks=int(rng.integers(3, 7)),
+        ),
+    ),
+    Case(
+        "em_strip_pixel_slip_unnamed",
+        "em_color_strip",
+        "unexplained",
+        lambda rng, cam: cs.em_strip_pairs(
+            rng, cam, N_PAIRS, paper_map=True, pixel_slip=int(rng.integers(1, 4))
+        ),
+    ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
 # every named frame-pair effect of the library, all six nulls and two unnamed effects run every time; one of the
@@ -422,7 +453,10 @@ def test_case(name, root):
         assert not invented, f"an effect the library lacks was reported as {sorted(invented)}: {where}"
         if not unexplained_structure(report):
             # open (issue 12): the residual-structure rule misses the unnamed effect on some fresh draws (seen:
-            # blur_rotation_unnamed); reported as an expected failure with its seed, not hidden
+            # blur_rotation_unnamed), and a zero-mean one on every draw (strip_speckle_unnamed and
+            # em_strip_pixel_slip_unnamed: 0 of 8 fresh master seeds each, docs/bench/session46.md), since its
+            # tests read the residual's mean and its lag-3 correlation, not its magnitude; reported as an expected
+            # failure with its seed, not hidden
             pytest.xfail(f"no unexplained structure reported: {where}")
     else:
         assert len(unplanted) <= 1, (
