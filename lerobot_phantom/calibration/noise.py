@@ -143,22 +143,32 @@ def residual_samples(problem, fit: Fit, items: np.ndarray, seed: int) -> dict[in
     curve = tone_curve(fit)
     out = {}
     for i in items:
-        pair = problem.pairs[int(i)]
         with torch.no_grad():
             image = 255.0 * problem.predict_pair(fit, int(i)).numpy()
-        predicted, detail = image.ravel(), local_detail(image).ravel()
-        measured = 255.0 * pair.attacked.numpy().ravel()
-        usable = np.flatnonzero(
-            (predicted > CLIP_GUARD)
-            & (predicted < 255.0 - CLIP_GUARD)
-            & (measured > 0.5)
-            & (measured < 254.5)
-        )
+        measured = 255.0 * problem.pairs[int(i)].attacked.numpy()
+        usable = np.flatnonzero(unclipped(image, measured))
         if len(usable) > SAMPLES_PER_PAIR:
             usable = np.sort(rng.choice(usable, SAMPLES_PER_PAIR, replace=False))
-        signal, slope = linearise(predicted[usable], curve)
-        out[int(i)] = NoiseSample(signal, slope, detail[usable], measured[usable] - predicted[usable])
+        out[int(i)] = noise_sample(image, measured, usable, curve)
     return out
+
+
+def unclipped(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
+    """Where noise can be read (grey levels): clipped pixels have none, so a value is kept when its prediction is
+    ``CLIP_GUARD`` from either end and the measured value is not at one."""
+    return (predicted > CLIP_GUARD) & (predicted < 255.0 - CLIP_GUARD) & (measured > 0.5) & (measured < 254.5)
+
+
+def noise_sample(
+    predicted: np.ndarray, measured: np.ndarray, index: np.ndarray, curve: float | dict | None
+) -> NoiseSample:
+    """The values at flat ``index`` of a predicted and a measured frame (grey levels, CHW) with their signal in
+    linear light through ``curve``, its slope and the predicted frame's local detail."""
+    values = predicted.ravel()[index]
+    signal, slope = linearise(values, curve)
+    return NoiseSample(
+        signal, slope, local_detail(predicted).ravel()[index], measured.ravel()[index] - values
+    )
 
 
 def model_variance(sample: NoiseSample, coef: dict[str, float]) -> np.ndarray:

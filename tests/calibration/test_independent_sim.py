@@ -453,9 +453,9 @@ def test_case(name, root):
         assert not invented, f"an effect the library lacks was reported as {sorted(invented)}: {where}"
         if not unexplained_structure(report):
             # open (issue 12): the residual-structure rule misses the unnamed effect on some fresh draws (seen:
-            # blur_rotation_unnamed), and a zero-mean one on every draw (strip_speckle_unnamed and
-            # em_strip_pixel_slip_unnamed: 0 of 8 fresh master seeds each, docs/bench/session46.md), since its
-            # tests read the residual's mean and its lag-3 correlation, not its magnitude; reported as an expected
+            # blur_rotation_unnamed) and em_strip_pixel_slip_unnamed on every draw (0 of 8 fresh master seeds:
+            # a zero-mean error at edges in the corrupted rows, which move from frame to frame, so neither the
+            # residual's mean nor its variance by row shows it; docs/bench/session46.md); reported as an expected
             # failure with its seed, not hidden
             pytest.xfail(f"no unexplained structure reported: {where}")
     else:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+import torch
 from calibration_testkit import projection_pairs_with_spread_light
 
 from lerobot_phantom.calibration.core import Fit, bin_index, binned_rmse
@@ -321,3 +322,28 @@ def test_light_spread_across_the_pattern_edges_is_reported_as_dependence_on_patt
         # predicted minus measured: the sharp pattern's light, too much on the bright side of an edge
         assert detail["significant"] and detail["r"]["estimate"] > 0.5, detail
         assert "depends on pattern_detail" in result["summary"]
+
+
+@pytest.mark.parametrize("band_noise", [0.0, 0.016])
+def test_zero_mean_noise_in_a_band_of_rows_is_reported_as_variance_by_row(band_noise):
+    # speckle-like: noise of zero mean on rows 10-19 only, four times the frames' own; the mean tests cannot see it
+    pairs = projection_pairs_with_spread_light(0.0)
+    rng = np.random.default_rng(5)
+    for pair in pairs:
+        extra = np.zeros(pair.attacked.shape)
+        extra[:, 10:20] = rng.normal(0.0, band_noise, (3, 10, 50)) if band_noise else 0.0
+        pair.attacked = (pair.attacked + torch.from_numpy(extra)).clamp(0, 1)
+    problem = ProjectionFrames(pairs, seed=0)
+    fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
+    result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
+    tests = {t["variable"]: t for t in result["tests"]}
+    assert not tests["row"]["significant"] and not tests["column"]["significant"], result["summary"]
+    assert not tests["variance_by_column"]["significant"], tests["variance_by_column"]
+    if not band_noise:
+        assert not result["structure_remains"], result["summary"]
+    else:
+        by_row = tests["variance_by_row"]
+        assert by_row["significant"] and by_row["interval"]["low"] > 0.1, by_row
+        # rows 10-19 of 40 are 0.26-0.49 of the frame's height
+        assert "for values 0.2" in by_row["where"] or "for values 0.3" in by_row["where"], by_row["where"]
+        assert "variance beyond sensor noise depends on row" in result["summary"]

@@ -29,6 +29,7 @@ from lerobot_phantom.calibration.core import (
     fit_least_squares,
     further_starts,
 )
+from lerobot_phantom.calibration.noise import NoiseSample, noise_sample, tone_curve, unclipped
 from lerobot_phantom.calibration.structure import LAG, ResidualSample
 from lerobot_phantom.transforms.physics import gaussian_spread
 
@@ -204,6 +205,10 @@ class FrameProblem(Problem):
             sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
             if with_pattern:
                 sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
+            noise_sample, noise_position = self.noise_terms(fit, int(i), residual, (c, y, x))
+            sample.noise.append(noise_sample)
+            for name, values in noise_position.items():
+                sample.noise_position.setdefault(name, []).append(values)
             mean = residual.mean(0)
             for name, (a, b) in {
                 "neighbours_along_rows": (mean[:, :-LAG], mean[:, LAG:]),
@@ -212,6 +217,21 @@ class FrameProblem(Problem):
                 pick = rng.choice(a.size, min(self.structure_values_per_pair, a.size), replace=False)
                 sample.neighbours[name].append((a.ravel()[pick], b.ravel()[pick]))
         return sample
+
+    def noise_terms(
+        self, fit: Fit, index: int, residual: np.ndarray, where: tuple[np.ndarray, np.ndarray, np.ndarray]
+    ) -> tuple[NoiseSample, dict[str, np.ndarray]]:
+        """The sensor-noise terms (``noise.NoiseSample``) of the sampled values ``where`` (channel, row, column) of
+        pair ``index``'s ``residual`` (predicted - measured, grey levels) that are not clipped, and their row and
+        column (0-1)."""
+        measured = 255.0 * self.pairs[index].attacked.numpy()
+        predicted = measured + residual
+        flat = np.ravel_multi_index(where, residual.shape)
+        flat = flat[unclipped(predicted.ravel()[flat], measured.ravel()[flat])]
+        _, y, x = np.unravel_index(flat, residual.shape)
+        _, height, width = residual.shape
+        sample = noise_sample(predicted, measured, flat, tone_curve(fit))
+        return sample, {"row": y / max(height - 1, 1), "column": x / max(width - 1, 1)}
 
     @property
     def n_items(self) -> int:
