@@ -140,12 +140,12 @@ def correlation_of_totals(totals: np.ndarray) -> np.ndarray:
     return np.where(valid, np.clip(r, -1.0, 1.0), 0.0)
 
 
-def _where(values: np.ndarray, residual: np.ndarray, bins: np.ndarray) -> str:
+def _where(values: np.ndarray, residual: np.ndarray, bins: np.ndarray, tested: str = "mean residual") -> str:
     sums, counts = np.bincount(bins, weights=residual), np.bincount(bins)
     means = np.where(counts > 0, sums / np.maximum(counts, 1), 0.0)
     worst = int(np.argmax(np.abs(means)))
     inside = values[bins == worst]
-    return f"largest mean residual {means[worst]:+.3g} for values {inside.min():.3g}-{inside.max():.3g}"
+    return f"largest {tested} {means[worst]:+.3g} for values {inside.min():.3g}-{inside.max():.3g}"
 
 
 def residual_structure(
@@ -218,9 +218,11 @@ def dependence_tests(
     share_of_base: Callable[[float], float],
     rng: np.random.Generator,
     family: int | None = None,
+    tested: str = "mean residual",
 ) -> list[dict]:
     """Per covariate: the share of the residual variance its binned mean explains, against the permutation null
-    (its quantile corrected for ``family`` variables tested in all, by default this sample's covariates)."""
+    (its quantile corrected for ``family`` variables tested in all, by default this sample's covariates);
+    ``tested`` names a bin's mean in ``where``."""
     residual_all = np.concatenate(sample.residual)
     values = {name: np.concatenate(per_item) for name, per_item in sample.covariates.items()}
     bins = {name: bin_index(v, BINS)[0] for name, v in values.items()}
@@ -277,7 +279,7 @@ def dependence_tests(
                 "p_value": float((1 + np.sum(null >= eta.estimate)) / (1 + PERMUTATIONS)),
                 "r": r.as_dict(),
                 "significant": bool(significant),
-                "where": _where(values_all, residual_all, bins_all),
+                "where": _where(values_all, residual_all, bins_all, tested),
             }
         )
     return tests
@@ -298,9 +300,9 @@ def variance_tests(
     variance times the mean modelled variance (grey levels^2).
     An ISP's lens-shading correction (a digital gain rising toward the corners) also makes noise grow with position
     at a given output level; the test reports that as well, as what it is: variance the noise model does not place."""
-    if not sample.noise:
+    joined = NoiseSample.join(sample.noise) if sample.noise else None
+    if joined is None or len(joined.residual) < 2 * BINS:  # no frame pairs, or (nearly) every value clipped
         return []
-    joined = NoiseSample.join(sample.noise)
     variance = model_variance(joined, fit_variance(joined, True))
     modelled = np.split(variance, np.cumsum([len(part.residual) for part in sample.noise])[:-1])
     excess = [part.residual**2 / v - 1.0 for part, v in zip(sample.noise, modelled, strict=True)]
@@ -313,13 +315,16 @@ def variance_tests(
             / max(base_mse, 1e-300)
         )
 
-    tests = dependence_tests(ResidualSample(excess, sample.noise_position), share_of_base, rng, family=family)
+    tests = dependence_tests(
+        ResidualSample(excess, sample.noise_position),
+        share_of_base,
+        rng,
+        family=family,
+        tested="variance excess (measured / modelled - 1)",
+    )
     for test in tests:
         test["variable"] = f"variance_by_{test['variable']}"
         test["statistic"] = "eta2 of the variance excess"
-        test["where"] = test["where"].replace(
-            "largest mean residual", "largest variance excess (measured / modelled - 1)"
-        )
     return tests
 
 

@@ -347,3 +347,15 @@ def test_zero_mean_noise_in_a_band_of_rows_is_reported_as_variance_by_row(band_n
         # rows 10-19 of 40 are 0.26-0.49 of the frame's height
         assert "for values 0.2" in by_row["where"] or "for values 0.3" in by_row["where"], by_row["where"]
         assert "variance beyond sensor noise depends on row" in result["summary"]
+
+
+def test_frames_clipped_everywhere_leave_no_variance_to_test():
+    # every attacked value at the white level: sensor noise cannot be read, and the test says nothing, not crash
+    pairs = projection_pairs_with_spread_light(0.0)
+    for pair in pairs:
+        pair.attacked = torch.ones_like(pair.attacked)
+    problem = ProjectionFrames(pairs, seed=0)
+    fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
+    result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
+    assert not any(t["variable"].startswith("variance_by_") for t in result["tests"])
+    assert any(t["variable"] == "row" for t in result["tests"])
