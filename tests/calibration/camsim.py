@@ -355,9 +355,8 @@ def laser_blinding_pairs(
     speckle pattern per frame (``speckle``, grains of 1-2 px), which the recorded pattern does not hold: an effect
     the library has no name for."""
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))]
-    grain_px = (
-        rng.uniform(1.0, 2.0) if speckle_looks else None
-    )  # drawn only then: other cases keep their draws
+    # drawn only with speckle, so every other case keeps its draws
+    grain_px = rng.uniform(1.0, 2.0) if speckle_looks else None
     centre = (rng.uniform(0.3, 0.7) * cam.height, rng.uniform(0.3, 0.7) * cam.width)
     halo_params = None
     if halo:
@@ -392,10 +391,8 @@ def laser_blinding_pairs(
             laser = pattern_u8 / 255.0
             if speckle_looks:
                 # a saturated pattern pixel records light at or far above the clip, which speckle leaves above it
-                grains = speckle(rng, cam.height, cam.width, grain_px=grain_px, looks=speckle_looks)[
-                    ..., None
-                ]
-                laser = np.where(pattern_u8 == 255, 1.0, laser * grains)
+                grains = speckle(rng, cam.height, cam.width, grain_px=grain_px, looks=speckle_looks)
+                laser = np.where(pattern_u8 == 255, 1.0, laser * grains[..., None])
             attacked_u8 = encode((1 - a) * quantised(attacked) + a * np.clip(laser, 0.0, 1.0), cam)
         else:
             irradiance = refl * light + intensity * peak_power * spot
@@ -520,9 +517,8 @@ def laser_strip_pairs(
     ``paper_band``): the band's laser light carries a fresh speckle pattern per frame (``speckle``, grains of 1-2
     px): an effect the library has no name for."""
     h = cam.height
-    grain_px = (
-        rng.uniform(1.0, 2.0) if speckle_looks else None
-    )  # drawn only then: other cases keep their draws
+    # drawn only with speckle, so every other case keeps its draws
+    grain_px = rng.uniform(1.0, 2.0) if speckle_looks else None
     profile = paper_band_profile(cam) if band_profile is None else band_profile[..., None]
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))] * rng.uniform(0.8, 1.0)
     exposure_rows = rng.uniform(2, 8)
