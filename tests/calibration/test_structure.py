@@ -10,6 +10,7 @@ from calibration_testkit import projection_pairs_with_spread_light
 from lerobot_phantom.calibration.core import Fit, bin_index, binned_rmse
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.structure import (
+    FAMILY_ALPHA,
     MIN_TESTED_ITEMS,
     ResidualSample,
     binned_columns,
@@ -337,6 +338,10 @@ def test_zero_mean_noise_in_a_band_of_rows_is_reported_as_variance_by_row(band_n
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     tests = {t["variable"]: t for t in result["tests"]}
+    # chance is judged over the family of all eight variables: six of the mean, two of the variance
+    assert (
+        tests["row"]["chance_quantile"] == tests["variance_by_row"]["chance_quantile"] == 1 - FAMILY_ALPHA / 8
+    )
     assert not tests["row"]["significant"] and not tests["column"]["significant"], result["summary"]
     assert not tests["variance_by_column"]["significant"], tests["variance_by_column"]
     if not band_noise:
