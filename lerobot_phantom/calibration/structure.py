@@ -16,6 +16,10 @@ Run on the held-out residual of the model that is written (base + identified eff
 - **dependence of the variance on position** (frame pairs): the same test on the residual's squared size over what
   the sensor-noise model of ``noise.py`` gives at its signal, minus 1 (``variance_tests``): a zero-mean effect the
   model lacks (laser speckle, a blur growing from a centre) leaves the mean alone and shows in the variance;
+- **a displaced frame** (frame pairs): the share of the residual's variance explained by its linear regression on
+  the predicted frame's gradient along rows or along columns (``displacement_tests``): a measured frame that holds
+  the predicted content moved by a fraction of a pixel or more leaves a residual of zero mean everywhere, largest at
+  edges, which binned means dilute among the flat values;
 - **correlation between neighbours** ``LAG`` values apart along rows and along columns of a frame (a residual
   that is a smooth image, not noise): structure remains when the interval's lower end exceeds ``MIN_LAG_CORR``.
   Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
@@ -79,6 +83,8 @@ class ResidualSample:
     # frame pairs: per item, its unclipped values' sensor-noise terms (``noise.NoiseSample``) and their position
     noise: list[NoiseSample] = field(default_factory=list)
     noise_position: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    # frame pairs: per direction ("rows", "columns"), the predicted frame's gradient at each residual's value
+    gradients: dict[str, list[np.ndarray]] = field(default_factory=dict)
 
     def joined(self, other: ResidualSample) -> ResidualSample:
         """This sample's items followed by ``other``'s (the same variables)."""
@@ -88,6 +94,7 @@ class ResidualSample:
             {name: pairs + other.neighbours[name] for name, pairs in self.neighbours.items()},
             self.noise + other.noise,
             {name: values + other.noise_position[name] for name, values in self.noise_position.items()},
+            {name: values + other.gradients[name] for name, values in self.gradients.items()},
         )
 
 
@@ -182,7 +189,8 @@ def residual_structure(
         "rule": f"a variable's binned mean explains > max({MIN_EXPLAINED}, the permutation null's 1 - "
         f"{FAMILY_ALPHA}/k quantile, k the variables tested) of the residual variance at the low end of a 90% "
         f"item-bootstrap interval (frame pairs: also the squared residual over the sensor-noise model's variance, "
-        f"minus 1, by row and column); neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
+        f"minus 1, by row and column; and the residual's r squared on the predicted frame's gradient along rows and "
+        f"along columns); neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
         f"whose error exceeds {OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the "
         f"held-out squared error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
         "held-out mean squared error",
@@ -199,11 +207,13 @@ def residual_structure(
     def share_of_base(statistic: float) -> float:
         return statistic * mean_square / max(base_mse, 1e-300)
 
-    family = len(sample.covariates) + len(sample.noise_position)
+    family = len(sample.covariates) + len(sample.noise_position) + len(sample.gradients)
     out["tests"] = (
         dependence_tests(sample, share_of_base, rng, family=family)
         + variance_tests(sample, base_mse, rng, family=family)
         + neighbour_tests(sample, share_of_base, rng)
+        # last of the tests that draw from rng: the others' draws are those of a sample without gradients
+        + displacement_tests(sample, share_of_base, rng, family=family)
     )
     if fit_items is not None:
         out["tests"] += outlying_item_tests(problem, fit, items, fit_items, share_of_base)
@@ -328,6 +338,79 @@ def variance_tests(
     return tests
 
 
+def displacement_tests(
+    sample: ResidualSample,
+    share_of_base: Callable[[float], float],
+    rng: np.random.Generator,
+    family: int | None = None,
+) -> list[dict]:
+    """Frame pairs: does the residual follow the predicted frame's gradient ``g`` along a direction? A measured frame
+    that holds the predicted content displaced by ``d`` pixels reads ``predicted(x + d)`` where the model put
+    ``predicted(x)``, so the residual (predicted - measured) is about ``-d g`` (camsim's pixel slip, EMI dropping
+    pixel clocks so that corrupted rows arrive early: r = -0.32 to -0.38 along rows, 0.00 on its null;
+    docs/bench/session47/registration_probe.txt). Its mean is zero in every bin of position or level, and at
+    edges, where it is large, values are too few to move a bin's mean among the flat ones: a dependence test's eta
+    squared by gradient bins gave 0.045 on a frame whose r squared is 0.49 (0.7 px slips, ``tests/calibration/
+    test_structure.py``). The statistic is therefore r squared, the share of the residual's variance explained by
+    its linear regression on ``g``, judged as the dependence tests judge eta squared (item-bootstrap interval,
+    permutation null at the family's quantile, share of the base error); the slope gives ``d = -cov(r, g) /
+    var(g)`` in pixels, an average over the frame (displaced rows among still ones give a fraction of their
+    shift)."""
+    if not sample.gradients:
+        return []
+    residual_all = np.concatenate(sample.residual)
+    gradients = {name: np.concatenate(per_item) for name, per_item in sample.gradients.items()}
+    null = np.empty((PERMUTATIONS, len(gradients)))
+    for j in range(PERMUTATIONS):
+        permuted = rng.permutation(residual_all)
+        null[j] = [
+            correlation_of_totals(moment_columns(g, permuted)[None])[0] ** 2 for g in gradients.values()
+        ]
+    quantile = 1.0 - FAMILY_ALPHA / max(family or len(gradients), 1)
+    tests = []
+    for column, (direction, per_item) in enumerate(sample.gradients.items()):
+        columns = np.array([moment_columns(g, r) for g, r in zip(per_item, sample.residual, strict=True)])
+        every_item = columns.sum(axis=0, keepdims=True)
+        totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
+        r2 = percentile_interval(
+            float(correlation_of_totals(every_item)[0] ** 2), correlation_of_totals(totals) ** 2
+        )
+        shift = percentile_interval(
+            float(displacement_of_totals(every_item)[0]), displacement_of_totals(totals)
+        )
+        chance = float(np.quantile(null[:, column], quantile))
+        r = float(correlation_of_totals(every_item)[0])
+        tests.append(
+            {
+                "variable": f"displacement_along_{direction}",
+                "statistic": "r2 on the predicted frame's gradient",
+                "value": r2.estimate,
+                "interval": r2.as_dict(),
+                "chance": chance,
+                "chance_quantile": quantile,
+                "share_of_base_mse": share_of_base(r2.estimate),
+                "p_value": float((1 + np.sum(null[:, column] >= r2.estimate)) / (1 + PERMUTATIONS)),
+                "r": r,
+                "displacement_px": shift.as_dict(),
+                "significant": bool(
+                    r2.low > max(MIN_EXPLAINED, chance) and share_of_base(r2.estimate) >= MIN_SHARE_OF_BASE
+                ),
+                "where": f"measured(x) ~ predicted(x + d) along {direction}, d {shift.estimate:+.2f} px (90% "
+                f"interval {shift.low:+.2f} to {shift.high:+.2f}), r = {r:+.2f}",
+            }
+        )
+    return tests
+
+
+def displacement_of_totals(totals: np.ndarray) -> np.ndarray:
+    """``-cov(residual, gradient) / var(gradient)`` (pixels) from the totals of ``moment_columns(gradient,
+    residual)`` (one sample per row); 0 where the gradient is constant."""
+    n, g, r, gg, _, gr = totals.T
+    safe_n = np.maximum(n, 1.0)
+    var_g = gg - g * g / safe_n
+    return np.where(var_g > 1e-12 * gg, -(gr - g * r / safe_n) / np.maximum(var_g, 1e-300), 0.0)
+
+
 def neighbour_tests(
     sample: ResidualSample, share_of_base: Callable[[float], float], rng: np.random.Generator
 ) -> list[dict]:
@@ -404,6 +487,12 @@ def structure_summary(found: list[dict], residual: str = "held-out residual") ->
                 f"residual's variance beyond sensor noise depends on {t['variable'].removeprefix('variance_by_')} "
                 f"(eta2 {t['value']:.3f}, 90% interval {t['interval']['low']:.3f}-{t['interval']['high']:.3f}; "
                 f"{t['where']})"
+            )
+        if t["statistic"] == "r2 on the predicted frame's gradient":
+            direction = t["variable"].removeprefix("displacement_along_")
+            return (
+                f"residual follows the predicted frame's gradient along {direction}, as in a displaced frame (r2 "
+                f"{t['value']:.3f}, 90% interval {t['interval']['low']:.3f}-{t['interval']['high']:.3f}; {t['where']})"
             )
         if t["statistic"] == "eta2":
             return (

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 import torch
 from calibration_testkit import projection_pairs_with_spread_light
+from scipy import ndimage
 
 from lerobot_phantom.calibration.core import Fit, bin_index, binned_rmse
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
@@ -338,9 +339,11 @@ def test_zero_mean_noise_in_a_band_of_rows_is_reported_as_variance_by_row(band_n
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     tests = {t["variable"]: t for t in result["tests"]}
-    # chance is judged over the family of all eight variables: six of the mean, two of the variance
+    # chance is judged over the family of all ten variables: six of the mean, two of the variance, two gradients
     assert (
-        tests["row"]["chance_quantile"] == tests["variance_by_row"]["chance_quantile"] == 1 - FAMILY_ALPHA / 8
+        tests["row"]["chance_quantile"]
+        == tests["variance_by_row"]["chance_quantile"]
+        == 1 - FAMILY_ALPHA / 10
     )
     assert not tests["row"]["significant"] and not tests["column"]["significant"], result["summary"]
     assert not tests["variance_by_column"]["significant"], tests["variance_by_column"]
@@ -364,3 +367,29 @@ def test_frames_clipped_everywhere_leave_no_variance_to_test():
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     assert not any(t["variable"].startswith("variance_by_") for t in result["tests"])
     assert any(t["variable"] == "row" for t in result["tests"])
+
+
+@pytest.mark.parametrize("slip_px", [0.0, 0.7, -0.7])
+def test_rows_arriving_displaced_are_reported_with_their_displacement(slip_px):
+    # rows 8-31 of each attacked frame hold the content slip_px further along the row (scipy's spline shift, not
+    # the package's): predicted - measured ~ -slip * the prediction's gradient, a mean of zero in every row
+    pairs = projection_pairs_with_spread_light(0.0)
+    for pair in pairs:
+        attacked = pair.attacked.numpy().copy()
+        attacked[:, 8:32] = ndimage.shift(attacked[:, 8:32], (0, 0, -slip_px), order=3, mode="nearest")
+        pair.attacked = torch.from_numpy(attacked)
+    problem = ProjectionFrames(pairs, seed=0)
+    fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
+    result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
+    tests = {t["variable"]: t for t in result["tests"]}
+    along_rows, along_columns = tests["displacement_along_rows"], tests["displacement_along_columns"]
+    assert along_rows["chance_quantile"] == tests["row"]["chance_quantile"] == 1 - FAMILY_ALPHA / 10
+    assert not along_columns["significant"], along_columns
+    if not slip_px:
+        assert not result["structure_remains"], result["summary"]
+        assert abs(along_rows["displacement_px"]["estimate"]) < 0.02, along_rows
+    else:
+        assert along_rows["significant"] and along_rows["interval"]["low"] > 0.2, along_rows
+        # the pattern's edges, where the gradient is, lie mostly in the displaced rows: d is most of the slip
+        assert 0.6 < along_rows["displacement_px"]["estimate"] / slip_px < 1.1, along_rows["displacement_px"]
+        assert "residual follows the predicted frame's gradient along rows" in result["summary"]

@@ -180,18 +180,21 @@ class FrameProblem(Problem):
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         """Held-out residuals (grey levels) on a seeded sample of values per pair, against row and column
         position, the clean pixel's level, the channel, the pair's intensity and, when the pairs record the attack's
-        pattern, the pattern's local detail (:func:`pattern_detail`); neighbours ``LAG`` pixels apart along rows and
-        columns of the channel-mean residual."""
+        pattern, the pattern's local detail (:func:`pattern_detail`); the predicted frame's gradient along rows and
+        along columns (grey levels per pixel, ``np.gradient``) at the same values; neighbours ``LAG`` pixels apart
+        along rows and columns of the channel-mean residual."""
         variables = ("row", "column", "clean_level", "channel", "intensity")
         with_pattern = all(p.pattern is not None for p in self.pairs)
         sample = ResidualSample(
             [], {k: [] for k in variables + (("pattern_detail",) if with_pattern else ())}
         )
         sample.neighbours = {"neighbours_along_rows": [], "neighbours_along_columns": []}
+        sample.gradients = {"rows": [], "columns": []}
         for i in items:
             pair = self.pairs[int(i)]
             with torch.no_grad():
-                residual = (255.0 * (self.predict_pair(fit, int(i)) - pair.attacked)).numpy()
+                prediction = self.predict_pair(fit, int(i))
+            residual = (255.0 * (prediction - pair.attacked)).numpy()
             _, height, width = residual.shape
             take = rng.choice(
                 residual.size, min(self.structure_values_per_pair, residual.size), replace=False
@@ -205,6 +208,9 @@ class FrameProblem(Problem):
             sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
             if with_pattern:
                 sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
+            predicted = 255.0 * prediction.numpy()
+            sample.gradients["rows"].append(np.gradient(predicted, axis=2)[c, y, x])
+            sample.gradients["columns"].append(np.gradient(predicted, axis=1)[c, y, x])
             noise_sample, noise_position = self.noise_terms(fit, int(i), residual, (c, y, x))
             sample.noise.append(noise_sample)
             for name, values in noise_position.items():
