@@ -30,7 +30,7 @@ from lerobot_phantom.calibration.core import (
     further_starts,
 )
 from lerobot_phantom.calibration.noise import NoiseSample, noise_sample, tone_curve, unclipped
-from lerobot_phantom.calibration.structure import LAG, ResidualSample
+from lerobot_phantom.calibration.structure import LAG, ResidualSample, line_terms
 from lerobot_phantom.transforms.physics import gaussian_spread
 
 REFERENCE_SIZE = 256
@@ -180,16 +180,16 @@ class FrameProblem(Problem):
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         """Held-out residuals (grey levels) on a seeded sample of values per pair, against row and column
         position, the clean pixel's level, the channel, the pair's intensity and, when the pairs record the attack's
-        pattern, the pattern's local detail (:func:`pattern_detail`); the predicted frame's gradient along rows and
-        along columns (grey levels per pixel, ``np.gradient``) at the same values; neighbours ``LAG`` pixels apart
-        along rows and columns of the channel-mean residual."""
+        pattern, the pattern's local detail (:func:`pattern_detail`); neighbours ``LAG`` pixels apart along rows and
+        columns of the channel-mean residual; and every row's and column's displacement terms
+        (``structure.line_terms``, the whole frame)."""
         variables = ("row", "column", "clean_level", "channel", "intensity")
         with_pattern = all(p.pattern is not None for p in self.pairs)
         sample = ResidualSample(
             [], {k: [] for k in variables + (("pattern_detail",) if with_pattern else ())}
         )
         sample.neighbours = {"neighbours_along_rows": [], "neighbours_along_columns": []}
-        sample.gradients = {"rows": [], "columns": []}
+        sample.lines = {"rows": [], "columns": []}
         for i in items:
             pair = self.pairs[int(i)]
             with torch.no_grad():
@@ -208,9 +208,8 @@ class FrameProblem(Problem):
             sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
             if with_pattern:
                 sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
-            predicted = 255.0 * prediction.numpy()
-            sample.gradients["rows"].append(np.gradient(predicted, axis=2)[c, y, x])
-            sample.gradients["columns"].append(np.gradient(predicted, axis=1)[c, y, x])
+            for direction, terms in line_terms(residual, 255.0 * prediction.numpy()).items():
+                sample.lines[direction].append(terms)
             noise_sample, noise_position = self.noise_terms(fit, int(i), residual, (c, y, x))
             sample.noise.append(noise_sample)
             for name, values in noise_position.items():
