@@ -24,7 +24,9 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}; frame pairs' ``variance_by_row`` / ``variance_by_column``: the variance beyond
-  the sensor-noise model by position (structure.variance_tests); the outlying-item test: {variable "items", value,
+  the sensor-noise model by position (structure.variance_tests); ``displacement_along_rows`` / ``_columns``: the
+  share of the residual a displacement per line explains (read in each half of the line), ``displacement_px``
+  (structure.displacement_tests); the outlying-item test: {variable "items", value,
   outlying_items, largest_fit_item_error, significant, where}]} (``calibration/structure.py``; ``tested_on`` says
   whether the fit items' cross-fitted residuals joined fewer than ``structure.MIN_TESTED_ITEMS`` held-out items);
 - ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs);

@@ -17,9 +17,9 @@ Run on the held-out residual of the model that is written (base + identified eff
   the sensor-noise model of ``noise.py`` gives at its signal, minus 1 (``variance_tests``): a zero-mean effect the
   model lacks (laser speckle, a blur growing from a centre) leaves the mean alone and shows in the variance;
 - **displaced lines** (frame pairs): how much of the residual a displacement of each row along the row (of each
-  column along the column) explains out of sample (``displacement_tests``). A measured frame whose lines hold the
-  predicted content moved by a fraction of a pixel or more leaves a residual of zero mean in every bin, largest at
-  edges, which binned means dilute among the flat values;
+  column along the column) explains, as read independently in each half of the line (``displacement_tests``). A
+  measured frame whose lines hold the predicted content moved by a fraction of a pixel or more leaves a residual of
+  zero mean in every bin, largest at edges, which binned means dilute among the flat values;
 - **correlation between neighbours** ``LAG`` values apart along rows and along columns of a frame (a residual
   that is a smooth image, not noise): structure remains when the interval's lower end exceeds ``MIN_LAG_CORR``.
   Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
@@ -70,7 +70,7 @@ PERMUTATIONS = 2000
 OUTLIER_FACTOR = 2.0
 OUTLIER_SHARE = 0.5
 MIN_FIT_ITEMS = 5  # a largest fit error over fewer items is no reference
-LINE_BLOCK = 8  # pixels: a line's halves for the displacement test alternate in blocks this long
+LINE_BLOCK = 8  # pixels: a line's two halves for the displacement test alternate in blocks this long
 MIN_TESTED_ITEMS = 5  # fewer held-out items than this are joined by the fit items' cross-fitted residuals
 
 
@@ -190,8 +190,8 @@ def residual_structure(
         "rule": f"a variable's binned mean explains > max({MIN_EXPLAINED}, the permutation null's 1 - "
         f"{FAMILY_ALPHA}/k quantile, k the variables tested) of the residual variance at the low end of a 90% "
         f"item-bootstrap interval (frame pairs: also the squared residual over the sensor-noise model's variance, "
-        f"minus 1, by row and column; and, out of sample, the share of the residual a displacement of each row along "
-        f"the row, or column along the column, removes); neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
+        f"minus 1, by row and column; and the share of the residual a displacement of each row along the row, or "
+        f"column along the column, explains as read in each half of the line); neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
         f"whose error exceeds {OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the "
         f"held-out squared error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
         "held-out mean squared error",
@@ -349,8 +349,7 @@ def line_terms(residual: np.ndarray, predicted: np.ndarray) -> dict[str, np.ndar
     for direction, axis in (("rows", 2), ("columns", 1)):
         gradient = np.gradient(predicted, axis=axis)
         r, g = (np.moveaxis(a, axis, 2) for a in (residual, gradient))  # lines along the last axis
-        # interleaved blocks, not the line's two ends: each half then holds about as much of the line's gradient
-        # (an edge in one end left a coefficient fitted on the flat end free to be any size)
+        # interleaved blocks, not the line's two ends: an edge in one end only leaves the other end nothing to read
         second = (np.arange(r.shape[2]) // LINE_BLOCK) % 2 == 1
         halves = [
             [np.sum(a[:, :, part] * b[:, :, part], axis=(0, 2)) for a, b in ((r, g), (g, g))]
@@ -361,18 +360,24 @@ def line_terms(residual: np.ndarray, predicted: np.ndarray) -> dict[str, np.ndar
 
 
 def displacement_columns(terms: np.ndarray) -> np.ndarray:
-    """One item's terms of the displacement test from its ``line_terms`` of one direction: the squared residual
-    that a coefficient per line, fitted on one half of the line, removes from the other half (both ways round); the
-    item's sum of squared residuals; and per ``BINS`` line position bins, the sums of ``residual * g`` and ``g^2``."""
+    """One item's terms of the displacement test from its ``line_terms`` of one direction: the squared residual a
+    displacement per line explains, estimated from the two halves' independent readings of it (below); the item's
+    sum of squared residuals; and per ``BINS`` line position bins, the sums of ``residual * g`` and ``g^2``.
+
+    A line displaced by ``d`` has ``sum(r g) = -d G_a + noise`` in one half and ``-d G_b + noise`` in the other
+    (``G`` the halves' ``sum(g^2)``), so ``2 rg_a rg_b / sqrt(G_a G_b)`` has the expectation ``2 d^2 sqrt(G_a G_b)``:
+    the squared residual the displacement explains, ``d^2 (G_a + G_b)``, for halves of equal gradient, less for
+    unequal ones, and 0 when the residual does not follow the gradient (the halves' noise is independent). It
+    never exceeds the line's own sum of squared residuals (Cauchy-Schwarz), where a coefficient fitted on one half
+    and scored on the other costs up to ``(rg_a / G_a)^2 G_b``, unbounded when ``G_a`` is small: on camsim's pixel
+    slip one pair's such score was -0.69 of its residual (master seed 2885439120, at 11bf7c7), and the draw's share
+    -0.005 with an interval of -0.36 to 0.35."""
     rg_a, gg_a, rg_b, gg_b, rr = terms.T
-    removed = 0.0
-    for rg_fit, gg_fit, rg_test, gg_test in ((rg_a, gg_a, rg_b, gg_b), (rg_b, gg_b, rg_a, gg_a)):
-        coefficient = rg_fit / np.maximum(gg_fit, 1e-12)
-        removed += float(np.sum(2.0 * coefficient * rg_test - coefficient**2 * gg_test))
+    explained = float(np.sum(2.0 * rg_a * rg_b / np.sqrt(np.maximum(gg_a * gg_b, 1e-300))))
     bins = np.arange(len(terms)) * BINS // len(terms)
     return np.concatenate(
         [
-            [removed, rr.sum()],
+            [explained, rr.sum()],
             np.bincount(bins, weights=rg_a + rg_b, minlength=BINS),
             np.bincount(bins, weights=gg_a + gg_b, minlength=BINS),
         ]
@@ -388,16 +393,20 @@ def displacement_tests(
     along themselves when EMI drops pixel clocks (camsim's pixel slip: each corrupted row a few pixels early), in a
     rolling-shutter skew, or by a rotation about the centre (constant along each row, growing with its distance).
 
-    Per frame and line, ``d`` is fitted on half the line and scored on the other half: the statistic is the share of
-    the residual's sum of squares so removed out of sample (both halves, every line, all items' totals). A residual
-    that does not follow the gradient gives about 0 or less, however its neighbours correlate (the halves meet
-    only at block borders), where one coefficient per line in sample explains about lines / values by chance, and
-    more when neighbours correlate: 0.005-0.031 of the residual in 47 of camsim's 48 case runs without a
-    displacement and 0.063 on one halo case, against 0.19 and 0.41 of the pixel slip's and 0.17-0.18 of the
-    rotation blur's; pooled over the frame, r squared on the slip was only 0.023 and 0.13, since the displaced
-    rows move from frame to frame (docs/bench/session47/registration_probe.txt). No permutation null, hence no
-    place in the family: structure remains when the share's item-bootstrap interval has its low end above
-    ``MIN_EXPLAINED`` and the share times the residual's mean square is ``MIN_SHARE_OF_BASE`` of the base error.
+    Per frame and line, each half of the line reads ``d`` independently, and the statistic is the share of the
+    residual's sum of squares that the two readings agree a displacement explains (``displacement_columns``; all
+    lines, all items' totals). A residual that does not follow the gradient gives about 0, where one coefficient
+    per line in sample explains about lines / values by chance, and more when neighbours correlate: 0.005-0.031 of
+    the residual in 47 of camsim's 48 case runs without a displacement and 0.063 on one halo case, against 0.19 and
+    0.41 of the pixel slip's and 0.17-0.18 of the rotation blur's; pooled over the frame, r squared on the slip was
+    only 0.023 and 0.13, since the displaced rows move from frame to frame (docs/bench/session47/
+    registration_probe.txt). It also finds a displacement nobody planted: on camsim's blur null (master seed
+    2885439120) the share along columns is 0.030 (0.026-0.034), every pair displaced +0.03 to +0.10 px down the
+    whole frame (docs/bench/session47/blur_null_bands.txt). Both sides blur with replicated borders; a candidate
+    cause, not tested: camsim's path samples include both ends (24 from 0 to d) and the library's sit at bin
+    centres (17), so one fitted length trades the blur's width against its mean shift. No permutation null, hence no place in the family: structure remains when
+    the share's item-bootstrap interval has its low end above ``MIN_EXPLAINED`` and the share times the residual's
+    mean square is ``MIN_SHARE_OF_BASE`` of the base error.
     ``where`` gives the displacement over all lines
     (``-sum(r g) / sum(g^2)``, pixels) and the line-position bin where it is largest."""
     tests = []
@@ -419,7 +428,7 @@ def displacement_tests(
         tests.append(
             {
                 "variable": f"displacement_along_{direction}",
-                "statistic": "out-of-sample share removed by a displacement per line",
+                "statistic": "share explained by a displacement per line, read in each half",
                 "value": share.estimate,
                 "interval": share.as_dict(),
                 "share_of_base_mse": share_of_base(share.estimate),
@@ -514,9 +523,9 @@ def structure_summary(found: list[dict], residual: str = "held-out residual") ->
             )
         if t["variable"].startswith("displacement_along_"):
             return (
-                f"the {t['variable'].removeprefix('displacement_along_')} are displaced from the prediction (a "
-                f"displacement per line removes {100 * t['value']:.1f}% of the residual out of sample, 90% interval "
-                f"{100 * t['interval']['low']:.1f}-{100 * t['interval']['high']:.1f}%; {t['where']})"
+                f"the {t['variable'].removeprefix('displacement_along_')} are displaced from the prediction (read in "
+                f"each half of a line, a displacement per line explains {100 * t['value']:.1f}% of the residual, 90% "
+                f"interval {100 * t['interval']['low']:.1f}-{100 * t['interval']['high']:.1f}%; {t['where']})"
             )
         if t["statistic"] == "eta2":
             return (
