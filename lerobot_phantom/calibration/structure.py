@@ -191,9 +191,10 @@ def residual_structure(
         f"{FAMILY_ALPHA}/k quantile, k the variables tested) of the residual variance at the low end of a 90% "
         f"item-bootstrap interval (frame pairs: also the squared residual over the sensor-noise model's variance, "
         f"minus 1, by row and column; and the share of the residual a displacement of each row along the row, or "
-        f"column along the column, explains as read in each half of the line); neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items "
-        f"whose error exceeds {OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the "
-        f"held-out squared error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
+        f"column along the column, explains as read in each half of the line, > {MIN_EXPLAINED} at the low end); "
+        f"neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items whose error exceeds "
+        f"{OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the held-out squared "
+        f"error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
         "held-out mean squared error",
         "tests": [],
         "structure_remains": False,
@@ -404,11 +405,12 @@ def displacement_tests(
     2885439120) the share along columns is 0.030 (0.026-0.034), every pair displaced +0.03 to +0.10 px down the
     whole frame (docs/bench/session47/blur_null_bands.txt). Both sides blur with replicated borders; a candidate
     cause, not tested: camsim's path samples include both ends (24 from 0 to d) and the library's sit at bin
-    centres (17), so one fitted length trades the blur's width against its mean shift. No permutation null, hence no place in the family: structure remains when
-    the share's item-bootstrap interval has its low end above ``MIN_EXPLAINED`` and the share times the residual's
-    mean square is ``MIN_SHARE_OF_BASE`` of the base error.
-    ``where`` gives the displacement over all lines
-    (``-sum(r g) / sum(g^2)``, pixels) and the line-position bin where it is largest."""
+    centres (17), so one fitted length trades the blur's width against its mean shift.
+
+    No permutation null, hence no place in the family: structure remains when the share's item-bootstrap interval
+    has its low end above ``MIN_EXPLAINED`` and the share times the residual's mean square is ``MIN_SHARE_OF_BASE``
+    of the base error. ``where`` gives the displacement over all lines (``-sum(r g) / sum(g^2)``, pixels) and the
+    line-position bin where it is largest."""
     tests = []
     for direction, per_item in sample.lines.items():
         columns = np.array([displacement_columns(terms) for terms in per_item])
