@@ -106,3 +106,11 @@ def test_pixel_slip_moves_only_the_corrupted_rows_left():
     # the slip draws after each frame's band: the first frame's scene and band are shared, its rows differ
     changed = np.abs(plain[0].attacked.astype(float) - slipped[0].attacked).mean(axis=(1, 2)) > 2.0
     assert changed.any() and not changed.all()
+
+
+def test_the_paper_blur_path_spreads_as_a_constant_speed_path():
+    # the time average of a path from 0 to d at constant speed: mean d/2, standard deviation d/sqrt(12)
+    path = cs.uniform_path(10.0)
+    assert abs(path.mean() - 5.0) < 1e-12
+    assert abs(path.std() / (10.0 / np.sqrt(12.0)) - 1.0) < 1e-3
+    assert path.min() > 0.0 and path.max() < 10.0
