@@ -401,11 +401,11 @@ def displacement_tests(
     the residual in 47 of camsim's 48 case runs without a displacement and 0.063 on one halo case, against 0.19 and
     0.41 of the pixel slip's and 0.17-0.18 of the rotation blur's; pooled over the frame, r squared on the slip was
     only 0.023 and 0.13, since the displaced rows move from frame to frame (docs/bench/session47/
-    registration_probe.txt). It also finds a displacement nobody planted: on camsim's blur null (master seed
-    2885439120) the share along columns is 0.030 (0.026-0.034), every pair displaced +0.03 to +0.10 px down the
-    whole frame (docs/bench/session47/blur_null_bands.txt). Both sides blur with replicated borders; a candidate
-    cause, not tested: camsim's path samples include both ends (24 from 0 to d) and the library's sit at bin
-    centres (17), so one fitted length trades the blur's width against its mean shift.
+    registration_probe.txt). It also found a displacement nobody meant to plant: camsim's blur null (master seed
+    2885439120) had a share along columns of 0.030 (0.026-0.034), every pair displaced +0.03 to +0.10 px. camsim's
+    paper path sampled both of its ends, a spread 4.3% wider than a constant-speed path's; with samples at step
+    centres the share is 0.012, and the blur nulls of 10 master seeds report no structure, where 4 did
+    (docs/bench/session47.md).
 
     No permutation null, hence no place in the family: structure remains when the share's item-bootstrap interval
     has its low end above ``MIN_EXPLAINED`` and the share times the residual's mean square is ``MIN_SHARE_OF_BASE``
