@@ -195,6 +195,7 @@ class FrameProblem(Problem):
             with torch.no_grad():
                 prediction = self.predict_pair(fit, int(i))
             residual = (255.0 * (prediction - pair.attacked)).numpy()
+            predicted, measured = 255.0 * prediction.numpy(), 255.0 * pair.attacked.numpy()
             _, height, width = residual.shape
             take = rng.choice(
                 residual.size, min(self.structure_values_per_pair, residual.size), replace=False
@@ -208,9 +209,9 @@ class FrameProblem(Problem):
             sample.covariates["intensity"].append(np.full(len(take), pair.intensity))
             if with_pattern:
                 sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
-            for direction, terms in line_terms(residual, 255.0 * prediction.numpy()).items():
+            for direction, terms in line_terms(residual, predicted).items():
                 sample.lines[direction].append(terms)
-            noise_sample, noise_position = self.noise_terms(fit, int(i), residual, (c, y, x))
+            noise_sample, noise_position = self.noise_terms(fit, predicted, measured, (c, y, x))
             sample.noise.append(noise_sample)
             for name, values in noise_position.items():
                 sample.noise_position.setdefault(name, []).append(values)
@@ -223,18 +224,19 @@ class FrameProblem(Problem):
                 sample.neighbours[name].append((a.ravel()[pick], b.ravel()[pick]))
         return sample
 
+    @staticmethod
     def noise_terms(
-        self, fit: Fit, index: int, residual: np.ndarray, where: tuple[np.ndarray, np.ndarray, np.ndarray]
+        fit: Fit,
+        predicted: np.ndarray,
+        measured: np.ndarray,
+        where: tuple[np.ndarray, np.ndarray, np.ndarray],
     ) -> tuple[NoiseSample, dict[str, np.ndarray]]:
-        """The sensor-noise terms (``noise.NoiseSample``) of the sampled values ``where`` (channel, row, column) of
-        pair ``index``'s ``residual`` (predicted - measured, grey levels) that are not clipped, and their row and
-        column (0-1)."""
-        measured = 255.0 * self.pairs[index].attacked.numpy()
-        predicted = measured + residual
-        flat = np.ravel_multi_index(where, residual.shape)
+        """The sensor-noise terms (``noise.NoiseSample``) of the sampled values ``where`` (channel, row, column) of a
+        pair's predicted and measured frames (grey levels) that are not clipped, and their row and column (0-1)."""
+        flat = np.ravel_multi_index(where, predicted.shape)
         flat = flat[unclipped(predicted.ravel()[flat], measured.ravel()[flat])]
-        _, y, x = np.unravel_index(flat, residual.shape)
-        _, height, width = residual.shape
+        _, y, x = np.unravel_index(flat, predicted.shape)
+        _, height, width = predicted.shape
         sample = noise_sample(predicted, measured, flat, tone_curve(fit))
         return sample, {"row": y / max(height - 1, 1), "column": x / max(width - 1, 1)}
 
