@@ -226,9 +226,8 @@ class Problem:
     # what inner cross-validation compares models by (``SELECTION_SCORES``); held-out figures are RMSE either way
     selection_score: str = "rmse"
     selection_score_reason: str = ""  # why, when it is not the RMSE (the report says it)
-    # which effects a selection step prefers over a lower score that beats theirs by less than the selection margin
-    # (a difference selection counts as no gain; ``lowest_scoring``), earliest first, and why (the report says it);
-    # otherwise the lowest
+    # which effects a selection step prefers among groups whose scores tie within ``TIE_SHARE`` (the fit items do
+    # not tell them apart; ``lowest_scoring``), earliest first, and why (the report says it); otherwise the lowest
     tie_preference: tuple[str, ...] = ()
     tie_preference_reason: str = ""
 
@@ -380,9 +379,8 @@ class Step:
     paired: bool = False
     # scored groups this step could not take, with the reason (groups_set_aside)
     set_aside: dict[str, str] = field(default_factory=dict)
-    # scored groups whose score tied with the group the next step took (``lowest_scoring``): within TIE_SHARE, or
-    # lower than a preferred group's by less than the margin; the fit items did not tell them apart, and the
-    # problem's tie preference decided
+    # scored groups whose score tied with the group the next step took (``lowest_scoring``): the fit items did not
+    # tell them apart, and the problem's tie preference decided
     tied: list[str] = field(default_factory=list)
     # per scored group (by its label in ``tried``): its per-item terms, like ``item_errors``; what a simpler form
     # that lost this step to a richer one is judged by if the richer one is not identified (identify.py)
@@ -582,10 +580,8 @@ def forward_select(
                 )
             taken = joint
         else:
-            # only singles that earn the step compete: a preferred one must earn it too
-            earning = {g: v for g, v in eligible.items() if len(g) == 1 and v <= (1.0 - margin) * current}
-            best_single, tied = lowest_scoring(problem, earning, margin)
-            if best_single is None:
+            best_single, tied = lowest_scoring(problem, {g: v for g, v in eligible.items() if len(g) == 1})
+            if best_single is None or eligible[best_single] > (1.0 - margin) * current:
                 break
             taken = best_single
             steps[-1].tied = [labels[g] for g in tied]
@@ -636,38 +632,30 @@ def joint_group_taken(
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
     larger group under its need has already beaten every smaller one by the margin."""
     needed = group_needs(requirements(problem), eligible, current, margin)
-    return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]}, margin)
+    return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]})
 
 
 def lowest_scoring(
-    problem: Problem, scores: dict[frozenset[str], float], margin: float = 0.0
+    problem: Problem, scores: dict[frozenset[str], float]
 ) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
-    """The group a step takes (None when there is none) and the other groups it tied with. Tied: within
-    ``TIE_SHARE`` of the lowest score, and groups holding an effect of ``problem.tie_preference`` that the lowest
-    beats by less than ``margin``, the gain selection asks of any step (less is no evidence that either model is
-    better). Among tied groups the one with the effect earliest in ``problem.tie_preference`` is taken, then the
-    lowest.
-
-    A tie is the fit items not telling two models apart. Drawn stripe camera 1804228398, lit frames: a detection
-    threshold and a negative integration offset scored 0.852099314 and 0.852099313 rows, the order flipped by a
-    rounding fix in the overlap kernel, and the two predict the held-out rows to 10.0 and 116 rows. On a finer
-    row-time grid (session 48) they scored 0.786 and 0.757: three folds alike, and one where the threshold fitted
-    its training rows better (1.04 against 1.14 rows) and validated worse (0.95 against 0.84)."""
+    """The group with the lowest score (None when there is none), and the other groups within ``TIE_SHARE`` of it.
+    Among tied groups the one with the effect earliest in ``problem.tie_preference`` is taken, then the lowest: a
+    tie is the fit items not telling two models apart, and which one won it was rounding (drawn stripe camera
+    1804228398, lit frames: a detection threshold and a negative integration offset scored 0.852099314 and
+    0.852099313 rows, the order flipped by a rounding fix in the overlap kernel, and the two predict the held-out
+    rows to 10.0 and 116 rows)."""
     if not scores:
         return None, []
     lowest = min(scores.values())
+    tied = [g for g, v in scores.items() if ties_lowest(v, lowest)]
     preference = {name: rank for rank, name in enumerate(problem.tie_preference)}
 
-    def preferred(group: frozenset[str]) -> int:
-        return min((preference.get(e, len(preference)) for e in group), default=len(preference))
+    def rank(group: frozenset[str]) -> tuple[int, float]:
+        preferred = min((preference.get(e, len(preference)) for e in group), default=len(preference))
+        return preferred, scores[group]
 
-    tied = [
-        g
-        for g, v in scores.items()
-        if ties_lowest(v, lowest) or (preferred(g) < len(preference) and lowest > (1.0 - margin) * v)
-    ]
-    taken = min(tied, key=lambda g: (preferred(g), scores[g]))
-    return taken, sorted((g for g in tied if g != taken), key=lambda g: (preferred(g), scores[g]))
+    taken = min(tied, key=rank)
+    return taken, sorted((g for g in tied if g != taken), key=rank)
 
 
 def group_needs(

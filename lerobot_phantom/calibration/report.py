@@ -217,9 +217,8 @@ def selection_section(
         f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one; among groups whose "
         f"scores agree within a share of {TIE_SHARE:g}, which the fit items do not tell apart, "
         + (
-            f"or a group holding {', '.join(problem.tie_preference)} and one that scores less by under "
-            f"{100 * margin:.0f}% (no gain by the rule above), the one holding the earliest of "
-            f"{', '.join(problem.tie_preference)} ({problem.tie_preference_reason}), then the lowest"
+            f"the one holding the earliest of {', '.join(problem.tie_preference)} ({problem.tie_preference_reason}), "
+            "then the lowest"
             if problem.tie_preference
             else "the lowest"
         )

@@ -119,14 +119,6 @@ DRIFT_JACOBIAN = "2-point"
 # lock: the 5% critical value of the likelihood ratio for one parameter at its bound (a 50:50 mixture of 0 and
 # chi-square with one degree of freedom; Self & Liang 1987)
 DRIFT_EVIDENCE = 2.706
-# row times on the start grid, log-spaced over the 0.1 ms .. 200 ms frame readouts (ends excluded): 13.7% apart. At
-# 49% apart (18 row times, until session 48) a start could lie two stripe-count regimes from the camera's: on the suite
-# draw STRIPES_SEED=3503845322 three of four folds' interior fits stopped at 20.0-20.7 us (34-38 rows RMSE) where
-# 22.2 us fits within 4-8 rows (tests/calibration/test_stripes.py, test_every_fold_fit_reaches_the_cameras_readout)
-ROW_TIME_STARTS = 58
-# the least ratio between the row times of two regimes a fit starts from (``StripeProblem.regime_starts``): the coarse
-# grid's step before session 48
-REGIME_SEPARATION = 1.49
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:
@@ -497,12 +489,12 @@ class StripeProblem(Problem):
             with torch.no_grad():
                 batched = {k: torch.as_tensor(v).reshape(-1, 1) for k, v in grid.items()}
                 sse = ((self.predict(effects, batched, items, rule) - target) ** 2).sum(-1)
-            starts = self.regime_starts(grid, torch.nan_to_num(sse, nan=float("inf")).numpy(), n_grid)
+            order = torch.argsort(torch.nan_to_num(sse, nan=float("inf"))).tolist()
             # a refit also starts where a first fit does: its starts hold every start of a first fit under its rule
             tries = (
                 [first]
                 + ([{p.name: p.init for p in specs}] if refit else [])
-                + [{k: float(v[i]) for k, v in grid.items()} for i in starts]
+                + [{k: float(v[i]) for k, v in grid.items()} for i in self.regime_starts(grid, order, n_grid)]
             )
             fits = [self.fit_from(effects, specs, items, rule, initial) for initial in tries]
             error, params = preferred_fit(specs, fits)
@@ -644,31 +636,19 @@ class StripeProblem(Problem):
 
     @staticmethod
     def regime_starts(
-        grid: dict[str, np.ndarray], sse: np.ndarray, n: int, per_row_time: int = 2
+        grid: dict[str, np.ndarray], order: list[int], n: int, per_row_time: int = 2
     ) -> list[int]:
-        """Grid points to start from: the ``per_row_time`` best points (squared error ``sse``) at each of ``n`` row
-        times. The row times are local minima of the grid's error profile over row time (its least error at each),
-        best first, each at least ``REGIME_SEPARATION`` times longer or shorter than those taken before it; then the
-        best other row times, as far apart, if there are fewer such minima. A local minimum is a stripe-count
-        regime, and the fine grid places it; the separation keeps the starts spread over readouts as the coarse grid
-        of 49% steps did (a row time and its double are separate regimes, and on a table that fixes no row time the
-        profile's many shallow minima would crowd into one). Within a regime the offset and threshold still have
-        separate minima (a grid's best point can lead to 4x the error its second-best reaches)."""
-        row_times, index = np.unique(grid["row_time_s"], return_inverse=True)
-        profile = np.full(len(row_times), np.inf)
-        np.minimum.at(profile, index, sse)
-        left = np.r_[np.inf, profile[:-1]]
-        right = np.r_[profile[1:], np.inf]
-        is_minimum = (profile < left) & (profile <= right)
-        by_profile = np.argsort(profile, kind="stable")
-        taken: list[int] = []
-        for candidates in (by_profile[is_minimum[by_profile]], by_profile[~is_minimum[by_profile]]):
-            for j in candidates:
-                far = np.abs(np.log(row_times[j] / row_times[taken])) >= np.log(REGIME_SEPARATION)
-                if len(taken) < n and np.all(far):
-                    taken.append(int(j))
-        order = np.argsort(sse, kind="stable")
-        return [int(i) for j in taken for i in order[index[order] == j][:per_row_time]]
+        """The best grid points (``order``: best first) of the ``n`` best distinct row times, ``per_row_time`` of
+        each: within one stripe-count regime the offset and threshold still have separate minima (a grid's best
+        point can lead to 4x the error its second-best reaches)."""
+        chosen: dict[float, list[int]] = {}
+        for i in order:
+            row_time = float(grid["row_time_s"][i])
+            if row_time not in chosen and len(chosen) < n:
+                chosen[row_time] = []
+            if row_time in chosen and len(chosen[row_time]) < per_row_time:
+                chosen[row_time].append(i)
+        return [i for points in chosen.values() for i in points]
 
     def start_grid(self, specs: list[Param], first: dict[str, float]) -> dict[str, np.ndarray]:
         """Starting points: frame readouts 0.1 ms .. 200 ms (log grid) x offsets and thresholds in proportion to
@@ -676,7 +656,7 @@ class StripeProblem(Problem):
         exposure = float(np.median(self.exposure_s))
         shorter = float(np.median(np.minimum(self.exposure_s, self.duty / self.frequency_hz)))
         axes = {
-            "row_time_s": np.geomspace(specs[0].low, specs[0].high, ROW_TIME_STARTS + 2)[1:-1],
+            "row_time_s": np.geomspace(specs[0].low, specs[0].high, 20)[1:-1],
             "integration_offset_s": exposure * np.array([0.0, 0.1, 0.3, 0.6, 1.0]),
             "threshold_s": shorter * np.array([0.01, 0.03, 0.1, 0.2, 0.4, 0.7, 1.0]),
             "noise_s": shorter * np.array([0.03, 0.3]),

@@ -26,12 +26,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.core import Fit, at_bound, fit_least_squares, kfold, seeded_split
-from lerobot_phantom.calibration.stripes import (
-    DRIFT_EFFECTS,
-    REGIME_SEPARATION,
-    StripeProblem,
-    read_stripe_table,
-)
+from lerobot_phantom.calibration.stripes import DRIFT_EFFECTS, StripeProblem, read_stripe_table
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
 
@@ -466,7 +461,17 @@ def test_lit_time_is_the_overlap_minus_twice_the_threshold():
         (3, "lit"),
         (2677795359, "lit"),
         (2, "interior"),
-        (6, "interior"),
+        pytest.param(
+            6,
+            "interior",
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="open (issue 12): on the table of the simulator that holds each step's exact pulse mean "
+                "(session 43) the fit stops at a row time of 43.1 us (4.08 rows) where the truth's start reaches "
+                "44.6 us (1.69 rows); six grid starts per row time instead of two find it, at 2.3x the first "
+                "fit's CPU time (docs/bench/session43/grid_starts_6_interior_0b32ffc.txt)",
+            ),
+        ),
         (22, "lit"),
         (24, "interior"),
         (22, "interior"),
@@ -477,9 +482,7 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
     the one reached from the camera's own parameters; seeds 3, 2677795359, 2, 6) or, at the right row time, in
     another offset/threshold minimum because it started from one grid point per row time (seeds 22, 24: 3-8x), or
     in another threshold regime, on the far side of a pulse's on-time (seed 24 interior once the interior rule's
-    edges were right: 7.4 rows against 1.3; seed 22 interior: 3.3 against 0.8), or, on the exact-pulse simulator's
-    table, at a row time 3% short (seed 6 interior: 43.1 us and 4.08 rows against 44.6 us and 1.69, until the row-time
-    starts were the error profile's local minima on a finer grid, session 48): the fit must reach the minimum the
+    edges were right: 7.4 rows against 1.3; seed 22 interior: 3.3 against 0.8): the fit must reach the minimum the
     truth reaches."""
     table = tmp_path / "table.csv"
     camera = drawn_camera_table(table, seed, frames)
@@ -497,30 +500,20 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
     )
 
 
-def test_row_time_starts_are_the_profiles_best_local_minima_spread_over_readouts():
-    """Two grid points per row time, the error profile over row time (its least error at each) with its lowest
-    minimum at 5 us and another at 7 us, 1.4x longer (closer than ``REGIME_SEPARATION``): two regimes start at 5
-    and 8 us (the best row time far enough from 5 us), not at 5 us and its neighbours, and the better point of each
-    row time comes first; a third regime starts at 3 us."""
-    assert 1.4 < REGIME_SEPARATION < 1.6
-    row_times = np.repeat(np.arange(1.0, 11.0), 2) * 1e-6
-    profile = np.array([9.0, 8.0, 6.0, 2.0, 1.0, 2.5, 2.0, 3.0, 5.0, 7.0])
-    sse = np.repeat(profile, 2) + np.tile([0.5, 0.0], 10)
-    grid = {"row_time_s": row_times, "integration_offset_s": np.tile([0.0, 1e-5], 10)}
-    starts = StripeProblem.regime_starts(grid, sse, 2)
-    assert list(row_times[starts] * 1e6) == pytest.approx([5, 5, 8, 8])
-    assert list(sse[starts]) == [1.0, 1.5, 3.0, 3.5]
-    more = StripeProblem.regime_starts(grid, sse, 3, per_row_time=1)
-    assert list(row_times[more] * 1e6) == pytest.approx([5, 8, 3])
-
-
+@pytest.mark.xfail(
+    strict=True,
+    reason="open (issue 12): row-time starts 49% apart leave three of four folds a stripe-count regime off. 58 starts "
+    "at the error profile's local minima, at least 1.49x apart, fixed every fold (CV 15.8 -> 4.0 rows) and seed 6 "
+    "interior above, but over 42 drawn cases the 30-row bar went from 6 to 8 misses (4111198912 lit: 2.86 -> 341 "
+    "rows), an edge minimum at the grid's low bound took a small table's row time to its bound, and the suite took "
+    "1655 s against 1378: taken back in session 48 (docs/bench/session48.md)",
+)
 def test_every_fold_fit_reaches_the_cameras_readout(tmp_path):
     """The suite's draw of session 47 (STRIPES_SEED=3503845322, interior frames): on the training rows of each of
-    the selection's four folds the offset model reaches the camera's row time under its frame rule. With row-time
-    starts 49% apart, the interior rule's search stopped at 20.0-20.7 us (34-38 rows RMSE) on three folds, which took
-    the "lit" rule at 12.9-14.4 us (29-34 rows) where 22.2 us fits within 4-8 rows. In the selection two folds did
-    so: cross-validation scored every extension on their misfit, the threshold was not selected, and a held-out row
-    it governs was predicted 591 rows off (186.9 rows held-out; docs/bench/session48.md)."""
+    the selection's four folds the offset model should reach the camera's row time under its frame rule. The
+    interior rule's search stops at 20.1-20.7 us (34-38 rows RMSE) on three folds, which take the "lit" rule at
+    12.9-14.4 us (29-34 rows), where 22.2 us fits within 4-8 rows. In the selection two folds do so:
+    cross-validation scores every extension on their misfit (docs/bench/session48.md)."""
     seed, frames = 3503845322, "interior"
     table = tmp_path / "table.csv"
     camera = drawn_camera_table(table, seed, frames)
@@ -817,8 +810,7 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 "STRIPES_SEED=16 and 19; of seeds 11-30, 5 of 40 cases fail, 8 before session 11, 13 before "
                 "session 9: docs/bench/second_camera_stripes.md; all on the point-sampled simulator before session "
                 "43). On the exact-pulse simulator: 197676555, 531200696 and 3808238891 at 296, 215 and 116 rows, of "
-                "40 cases (docs/bench/session44.md; 4111198912 at 341 rows until session 44, and again since session 48's "
-                "row-time starts: docs/bench/session48.md)",
+                "40 cases (docs/bench/session44.md; 4111198912 at 341 rows until session 44)",
             ),
         ),
         pytest.param(
@@ -830,10 +822,7 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 "0.96-1.45, 106 rows held-out) or a negative integration offset stands in for it (seed 30: 113 rows; "
                 "both on the point-sampled simulator before session 43). On the exact-pulse simulator: 1222484455 "
                 "and 1211740460 at 34 and 138 rows, of 40 cases; 2083087881 (14 or 94 rows) has an offset whose gain "
-                "interval ends at 1.001 +- 0.004 over generator streams (docs/bench/session44.md; 118 rows since "
-                "session 48's row-time starts). 3503845322 (186.9 rows): the fit rows fix the threshold only below a "
-                "22.6 us pulse, and whether a held-out row's two 9.9 us pulses light it depends on where below "
-                "(docs/bench/session48.md)",
+                "interval ends at 1.001 +- 0.004 over generator streams (docs/bench/session44.md)",
             ),
         ),
     ],
@@ -882,11 +871,9 @@ def test_an_overlap_of_no_use_alone_is_named_with_the_threshold_it_hosts(tmp_pat
 @pytest.mark.slow
 def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as_the_threshold(tmp_path):
     """A drawn camera (seed 1804228398, lit frames) whose fit rows hold no pulse or window shorter than its
-    threshold: the threshold and a negative integration offset scored the same to 1e-12, and which one won was
+    threshold: the threshold and a negative integration offset score the same to 1e-12, and which one won was
     rounding (at 02c74c0 the offset, 116 rows held-out: a window longer than the laser period then lights every
-    row). Since session 48's row-time starts they score 0.798 and 0.768 (one fold's threshold fit its training rows
-    better and validated worse), less apart than selection's 5% margin. The tie is recorded and the threshold, which
-    every table's detection rule implies, is taken."""
+    row). The tie is recorded and the threshold, which every table's detection rule implies, is taken."""
     # the table of the simulator the case was found on: the tie is the table's, the rule under test the package's
     _, report = calibrate_drawn_camera(
         tmp_path, 1804228398, "lit", "exposure_us", calibration_seed=398, pulses="sampled"
@@ -894,10 +881,9 @@ def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as
     steps = report["selection"]["steps"]
     assert steps[0]["tied"] == ["exposure_overlap+integration_offset"], steps[0]
     tried = steps[0]["tried"]
-    # no gain by selection's rule: the offset does not score 5% under the threshold
-    assert (
-        tried["exposure_overlap+integration_offset"] > 0.95 * tried["exposure_overlap+detection_threshold"]
-    ), tried
+    assert tried["exposure_overlap+integration_offset"] == pytest.approx(
+        tried["exposure_overlap+detection_threshold"], rel=1e-6
+    )
     assert set(report["extended"]["effects"]) == {"exposure_overlap", "detection_threshold"}
     assert report["extended"]["heldout_rmse"] <= 30.0
 
