@@ -505,8 +505,8 @@ def test_the_first_fit_finds_the_stripe_count_regime_of_the_camera(tmp_path, see
     reason="open (issue 12): row-time starts 49% apart leave three of four folds a stripe-count regime off. 58 starts "
     "at the error profile's local minima, at least 1.49x apart, fixed every fold (CV 15.8 -> 4.0 rows) and seed 6 "
     "interior above, but over 42 drawn cases the 30-row bar went from 6 to 8 misses (4111198912 lit: 2.86 -> 341 "
-    "rows), an edge minimum at the grid's low bound took a small table's row time to its bound, and the suite took "
-    "1655 s against 1378: taken back in session 48 (docs/bench/session48.md)",
+    "rows), and an edge minimum at the grid's low bound took a small table's row time to its bound: taken back in "
+    "session 48 (docs/bench/session48.md)",
 )
 def test_every_fold_fit_reaches_the_cameras_readout(tmp_path):
     """The suite's draw of session 47 (STRIPES_SEED=3503845322, interior frames): on the training rows of each of
