@@ -1,11 +1,13 @@
 """Two runs of ``docs/bench/second_camera_sweep.py`` side by side, case by case (seed x frame rule): the written
 model's held-out RMSE, its fitted row time against the camera's, and the named effects; then the counts of cases
-above the issue's 30-row bar and of row times within 5% of the camera's, over the cases both runs hold.
+above the issue's 30-row bar, of row times within 5% of the camera's and of held-out errors at or under 10 rows, the
+median held-out error, and how many cases got better or worse by more than 0.05 rows, over the cases both runs hold.
 
 Usage: ``python docs/bench/session48/compare_sweeps.py BEFORE.txt [BEFORE.txt ...] -- AFTER.txt [AFTER.txt ...]``
 """
 
 import re
+import statistics
 import sys
 
 LINE = re.compile(
@@ -43,11 +45,17 @@ def main(argv: list[str]) -> None:
         print(
             f"{case[0]:>10} {case[1]:8s} camera {before[case][2]:5.1f} us | {cells[0]} -> {cells[1]}{changed}"
         )
-    for name in ("before", "after"):
+    for name, run in (("before", before), ("after", after)):
         above, near = counts[name]
+        heldout = [run[case][0] for case in common]
         print(
-            f"{name}: above 30 rows {above} of {len(common)}; row time within 5% of the camera's {near} of {len(common)}"
+            f"{name}: above 30 rows {above} of {len(common)}; row time within 5% of the camera's {near} of "
+            f"{len(common)}; at or under 10 rows {sum(h <= 10.0 for h in heldout)} of {len(common)}; median held-out "
+            f"{statistics.median(heldout):.2f} rows"
         )
+    better = sum(after[case][0] < before[case][0] - 0.05 for case in common)
+    worse = sum(after[case][0] > before[case][0] + 0.05 for case in common)
+    print(f"better by more than 0.05 rows: {better}; worse: {worse}")
     print("(* marks a row time more than 5% from the camera's)")
 
 
