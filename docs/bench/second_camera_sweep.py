@@ -6,6 +6,8 @@ model and of the base, the named effects, the fitted row time against the camera
 checkout to measure (session 29):
 
     OMP_NUM_THREADS=1 HF_HUB_OFFLINE=1 PYTHONPATH=. python docs/bench/second_camera_sweep.py SEED [SEED ...]
+
+``--frames lit`` or ``--frames interior`` (before the seeds) runs one frame rule's cases only.
 """
 
 import importlib
@@ -19,7 +21,7 @@ sys.path.insert(0, str(Path("tests/calibration").resolve()))
 CASES = (("lit", "exposure_us"), ("interior", "exposure"))
 
 
-def main(seeds: list[int]) -> None:
+def main(seeds: list[int], cases_run=CASES) -> None:
     above, cases = 0, 0
     for seed in seeds:
         # the test module draws its seed at import: reload it per seed
@@ -27,7 +29,7 @@ def main(seeds: list[int]) -> None:
         import test_stripes
 
         sim = importlib.reload(test_stripes)
-        for frames, style in CASES:
+        for frames, style in cases_run:
             with TemporaryDirectory() as tmp:
                 camera, report = sim.calibrate_drawn_camera(Path(tmp), seed, frames, style, seed % 1000)
             extended, base = report["extended"]["heldout_rmse"], report["base"]["heldout_rmse"]
@@ -44,4 +46,11 @@ def main(seeds: list[int]) -> None:
 
 
 if __name__ == "__main__":
-    main([int(s) for s in sys.argv[1:]])
+    arguments = sys.argv[1:]
+    chosen = CASES
+    if arguments[:1] == ["--frames"]:
+        rules = {frames: (frames, style) for frames, style in CASES}
+        if len(arguments) < 2 or arguments[1] not in rules:
+            raise SystemExit(f"--frames takes one of {', '.join(rules)}")
+        chosen, arguments = (rules[arguments[1]],), arguments[2:]
+    main([int(s) for s in arguments], chosen)
