@@ -392,8 +392,10 @@ def rolling_shutter_rows_lit(
       ``frames="all"`` every frame (``rows * lit share``); ``"lit"`` frames with at least one lit row (a frame
       catches a pulse with probability ``((rows - 1) min(lit, row_time) + lit) / period``, capped at 1);
       ``"interior"`` only frames whose first and last rows are dark (cameras with dead lines: every stripe fully
-      visible; the count is the stripe width times the mean number of whole stripes that fit). The last row starts
-      H - 1 row times after the first, and blooming reaches an edge row from inside the frame only.
+      visible; the count is the stripe width times the mean number of whole stripes that fit; where the parameters
+      leave no whole-stripe placement though a stripe fits, the placement nearest to one stands for them:
+      ``_nearest_closed_placement``). The last row starts H - 1 row times after the first, and blooming reaches
+      an edge row from inside the frame only.
     - phase drift within a recording (``drift``, per condition, a share of the laser period; ``"interior"`` only):
       a laser whose frequency is close to a multiple of the frame rate beats with it slowly, so one recording
       does not see a random phase per frame: its stripes start where they were placed whole in view and the phase
