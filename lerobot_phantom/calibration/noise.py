@@ -33,7 +33,10 @@ term is *there*; how *much* it matters is its share of the modelled residual var
 only if (1) the inner k-fold validation on the fit pairs shows a ratio above 1 (it predicts the variance of pairs
 it was not fitted on better than without it), (2) the bootstrap interval (over fit pairs) of ``shot`` excludes its
 null value 0, and (3) photon noise is the main part of the residual: at least ``SHOT_SHARE`` of its modelled
-variance, averaged over the fit pairs' residuals, and (4) the model follows the residual's variance across the
+variance, averaged over the fit pairs' residuals, both in the model above and beside a multiplicative term
+``J^2 gain^2 x^2`` (variance growing with the square of the light: a light that itself fluctuates by a share of
+its level, as laser speckle does, or a mean model whose error is a share of the light; under the sRGB curve
+``J^2 x`` is nearly flat while ``J^2 x^2`` rises with the signal, so the two are told apart), and (4) the model follows the residual's variance across the
 signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
 not above ``TREND_FACTOR``; read noise is the steepest fall any sensor noise has under a curve, so a faster one
 means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
@@ -69,7 +72,7 @@ SHOT_SHARE = 0.5  # photon noise must be at least this share of the residual's m
 # Measured on the independent simulator's EM truncation frames (docs/bench/camsim_session13.md): 0.75-1.02 under
 # sRGB and power-law cameras, 2.1-4.5 under a filmic shoulder read as sRGB
 TREND_FACTOR = 1.5
-TERMS = ("detail", "read_var", "shot")
+TERMS = ("detail", "read_var", "shot", "gain_var")
 
 
 @dataclass
@@ -90,9 +93,12 @@ class NoiseSample:
             )
         )
 
-    def design(self, shot: bool) -> np.ndarray:
-        """Columns of the variance model above quantisation: detail, read (J^2) and, with ``shot``, J^2 x."""
-        columns = [self.detail, self.slope**2] + ([self.slope**2 * self.signal] if shot else [])
+    def design(self, shot: bool, gain: bool = False) -> np.ndarray:
+        """Columns of the variance model above quantisation: detail, read (J^2), with ``shot`` J^2 x, with
+        ``gain`` J^2 x^2."""
+        columns = [self.detail, self.slope**2]
+        columns += [self.slope**2 * self.signal] if shot else []
+        columns += [self.slope**2 * self.signal**2] if gain else []
         return np.stack(columns, axis=1)
 
 
@@ -174,21 +180,23 @@ def noise_sample(
 def model_variance(sample: NoiseSample, coef: dict[str, float]) -> np.ndarray:
     """Output-unit variance of every residual under the noise model with terms ``coef`` (missing terms = 0)."""
     terms = np.array([coef.get(k, 0.0) for k in TERMS])
-    return np.maximum(QUANTISATION_VARIANCE + sample.design(True) @ terms, 1e-6)
+    return np.maximum(QUANTISATION_VARIANCE + sample.design(True, True) @ terms, 1e-6)
 
 
-def fit_variance(sample: NoiseSample, shot: bool) -> dict[str, float]:
-    """Non-negative terms {detail, read_var, shot} (read and shot in linear light, full scale 1) maximising the
-    Gaussian likelihood: iteratively reweighted non-negative least squares of ``residual^2 - quantisation`` on the
-    model's columns (the weights follow var(r^2) = 2 sigma^4). Without ``shot`` that term is 0."""
+def fit_variance(sample: NoiseSample, shot: bool, gain: bool = False) -> dict[str, float]:
+    """Non-negative terms {detail, read_var, shot, gain_var} (read, shot and gain in linear light, full scale 1)
+    maximising the Gaussian likelihood: iteratively reweighted non-negative least squares of ``residual^2 -
+    quantisation`` on the model's columns (the weights follow var(r^2) = 2 sigma^4). Without ``shot`` or ``gain``
+    that term is 0."""
     squared = sample.residual**2 - QUANTISATION_VARIANCE
-    design = sample.design(shot)
+    design = sample.design(shot, gain)
+    names = [k for k in TERMS if (k != "shot" or shot) and (k != "gain_var" or gain)]
     coef = {k: 0.0 for k in TERMS}
     variance = np.full(len(squared), max(float(np.mean(sample.residual**2)), 1e-6))
     for _ in range(6):
         weight = 1.0 / variance
         values, _ = nnls(design * weight[:, None], squared * weight)
-        coef.update(zip(TERMS, values.tolist(), strict=False))
+        coef.update(zip(names, values.tolist(), strict=True))
         variance = model_variance(sample, coef)
     return coef
 
@@ -251,12 +259,20 @@ def select_shot_noise(
     def statistic(items: np.ndarray) -> dict[str, float]:
         sample = joined(items)
         coef = fit_variance(sample, True)
-        return {**coef, "share": shot_share(sample, coef), "trend": variance_trend(sample, coef)}
+        beside_gain = fit_variance(sample, True, gain=True)
+        return {
+            **coef,
+            "share": shot_share(sample, coef),
+            "trend": variance_trend(sample, coef),
+            "share_beside_gain": shot_share(sample, beside_gain),
+            "gain_contrast": math.sqrt(beside_gain["gain_var"]),
+        }
 
     intervals: dict[str, Interval] = bootstrap(
         statistic, np.asarray(fit_items), draws=draws, rng=np.random.default_rng([seed, 4])
     )
     reasons, curve_fails = shot_noise_reasons(validation_ratio, intervals, curve)
+    beside_gain = fit_variance(fitted, True, gain=True)
     return {
         "kept": not reasons,
         "status": "identified" if not reasons else "not identifiable" if curve_fails else "not identified",
@@ -265,11 +281,13 @@ def select_shot_noise(
         f"shot x) in linear light (J: tone-curve slope, D: local 3x3 variance) vs shot = 0, {folds}-fold "
         "validation on the fit pairs; named if the validation noise-scale ratio exp(NLL gain) is above 1, the "
         f"{100 * intervals['shot'].level:.0f}% bootstrap interval of shot (over fit pairs) excludes 0 and photon "
-        f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance",
+        f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance, also beside a multiplicative "
+        "term (variance gain^2 x^2)",
         "tone_curve": tone_curve_name(curve),
         "validation_noise_scale_ratio": validation_ratio,
         "heldout_noise_scale_ratio": heldout_ratio,
         "shot_share": intervals["share"].as_dict(),
+        "shot_share_beside_gain": intervals["share_beside_gain"].as_dict(),
         "variance_trend": intervals["trend"].as_dict(),
         "constant": {"read_noise_grey": 255.0 * math.sqrt(without["read_var"])},
         # linear-light grey levels (linear light x 255): read noise sd, shot variance per grey level of signal
@@ -277,6 +295,11 @@ def select_shot_noise(
             "read_noise_grey": 255.0 * math.sqrt(with_shot["read_var"]),
             "shot_gain_grey": 255.0 * with_shot["shot"],
             "detail_gain": with_shot["detail"],
+        },
+        # the relative sd of the light that a multiplicative term fits beside photon noise (residual of two frames)
+        "multiplicative": {
+            "contrast": math.sqrt(beside_gain["gain_var"]),
+            "interval": intervals["gain_contrast"].as_dict(),
         },
         "intervals": {
             "read_noise_grey": _scaled(intervals["read_var"], lambda v: 255.0 * math.sqrt(max(v, 0.0))),
@@ -339,6 +362,16 @@ def shot_noise_reasons(
         reasons.append(
             f"photon noise is {intervals['share'].estimate:.0%} of the residual's modelled variance (named from "
             f"{SHOT_SHARE:.0%}): present, but not what the residual mostly is"
+        )
+    elif intervals["share_beside_gain"].estimate < SHOT_SHARE:
+        contrast = intervals["gain_contrast"]
+        reasons.append(
+            f"the residual's variance grows with the square of the light, not in proportion to it: offered a "
+            f"multiplicative term beside it (relative sd {contrast.estimate:.3g}, {100 * contrast.level:.0f}% "
+            f"interval {contrast.low:.3g}-{contrast.high:.3g}), photon noise is "
+            f"{intervals['share_beside_gain'].estimate:.0%} of the modelled variance (named from {SHOT_SHARE:.0%}): "
+            "the light itself fluctuates from frame to frame (laser speckle, flicker) or the mean model errs in "
+            "proportion to it, which is not a sensor's noise"
         )
     return reasons, curve_fails
 

@@ -453,7 +453,11 @@ def _noise_lines(noise: dict) -> list[str]:
         + f". Tone curve that linearises the frames: {noise['tone_curve']}. Fitted, in linear-light grey "
         "levels (linear light x 255, before the tone curve): read noise "
         f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
-        "(variance per unit of signal). Held-out residual RMSE (output grey levels) vs predicted signal "
+        "(variance per unit of signal); beside a multiplicative term, the light's relative sd "
+        f"{noise['multiplicative']['contrast']:.3g} ({100 * noise['multiplicative']['interval']['level']:.0f}% "
+        f"interval {noise['multiplicative']['interval']['low']:.3g}-"
+        f"{noise['multiplicative']['interval']['high']:.3g}). Held-out residual RMSE (output grey levels) vs "
+        "predicted signal "
         "(linear-light grey levels): "
         + ", ".join(
             f"{x:.0f}: {r:.2f}"

@@ -264,6 +264,10 @@ CASES = [
         "em_truncation",
         "unexplained",
         lambda rng, cam: cs.em_truncation_pairs(rng, cam, N_PAIRS, hum_bars=rng.uniform(0.1, 0.15)),
+        # not even photon noise: the bars modulate the light, so the residual's variance grows with its square
+        # (named shot_noise on 10 of 10 master seeds until the multiplicative term of session 50, 0 of 10 since:
+        # docs/bench/session50.md)
+        tolerated=frozenset(),
     ),
     # ultrasound blur
     Case(
@@ -302,6 +306,7 @@ CASES = [
         lambda rng, cam: cs.laser_blinding_pairs(
             rng, cam, N_PAIRS, digital_alpha=rng.uniform(0.4, 0.8), speckle_looks=int(rng.integers(3, 7))
         ),
+        tolerated=frozenset(),  # speckle is the light's own fluctuation (session 50: shot_noise 9 -> 0 of 10)
     ),
     Case(
         "strip_speckle_unnamed",
@@ -323,6 +328,7 @@ CASES = [
         lambda rng, cam: cs.em_strip_pairs(
             rng, cam, N_PAIRS, paper_map=True, pixel_slip=int(rng.integers(1, 4))
         ),
+        tolerated=frozenset(),  # displaced edges err in proportion to the light (session 50: shot_noise 9 -> 0 of 10)
     ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}

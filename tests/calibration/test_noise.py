@@ -54,10 +54,19 @@ def filmic(linear: np.ndarray) -> np.ndarray:
 
 
 def capture(
-    linear: np.ndarray, rng: np.random.Generator, *, shot: bool, read: float, tone: str = "srgb"
+    linear: np.ndarray,
+    rng: np.random.Generator,
+    *,
+    shot: bool,
+    read: float,
+    tone: str = "srgb",
+    speckle: float = 0.0,
 ) -> torch.Tensor:
     """Linear light -> noisy linear (Poisson photons + Gaussian read noise, in full-well units) -> the tone curve
-    (sRGB or ``filmic``), 8 bits."""
+    (sRGB or ``filmic``), 8 bits. ``speckle``: the light itself fluctuates before the sensor counts it, by that
+    relative sd per pixel and frame (a laser's speckle grains at pixel size: multiplicative, not a sensor's noise)."""
+    if speckle:
+        linear = linear * np.clip(1.0 + speckle * rng.standard_normal(linear.shape), 0.0, None)
     if shot:
         linear = rng.poisson(linear * FULL_WELL) / FULL_WELL
     linear = np.clip(linear + rng.normal(0.0, read, linear.shape), 0.0, 1.0)
@@ -68,15 +77,17 @@ def capture(
     return torch.round(255.0 * encoded) / 255.0
 
 
-def frame_pairs(seed: int, *, shot: bool, read: float, n_pairs: int = 8, tone: str = "srgb") -> list[Frames]:
+def frame_pairs(
+    seed: int, *, shot: bool, read: float, n_pairs: int = 8, tone: str = "srgb", speckle: float = 0.0
+) -> list[Frames]:
     """Scenes of flat 8x8 blocks (levels 0.02-0.9 of full scale, linear), captured twice."""
     rng = np.random.default_rng(seed)
     pairs = []
     for _ in range(n_pairs):
         blocks = rng.uniform(0.02, 0.9, (3, 6, 8))
         scene = np.kron(blocks, np.ones((8, 8)))
-        clean = capture(scene, rng, shot=shot, read=read, tone=tone)
-        pairs.append(Frames(capture(scene, rng, shot=shot, read=read, tone=tone), clean))
+        clean = capture(scene, rng, shot=shot, read=read, tone=tone, speckle=speckle)
+        pairs.append(Frames(capture(scene, rng, shot=shot, read=read, tone=tone, speckle=speckle), clean))
     return pairs
 
 
@@ -128,6 +139,8 @@ def test_photon_noise_is_named_although_flat_in_output_units():
     assert noise["shot_noise"]["shot_gain_grey"] == pytest.approx(2 * 255.0 / FULL_WELL, rel=0.25)
     assert noise["intervals"]["shot_gain_grey"]["low"] > 0.0
     assert noise["shot_share"]["estimate"] >= 0.5
+    # offered a variance growing with the square of the light beside it, photon noise keeps the residual
+    assert noise["shot_share_beside_gain"]["estimate"] >= 0.5
     assert noise["status"] == "identified"
     trend = noise["variance_trend"]
     assert trend["low"] <= trend["high"] < TREND_FACTOR
@@ -148,3 +161,19 @@ def test_no_photon_noise_is_not_named(read):
     noise = select(frame_pairs(2, shot=False, read=read))
     assert not noise["kept"]
     assert noise["reasons"]
+
+
+@pytest.mark.parametrize("shot", [False, True], ids=["speckle only", "speckle over photon noise"])
+def test_light_that_fluctuates_in_proportion_to_its_level_is_not_named_photon_noise(shot):
+    """Speckle of relative sd 0.1 per frame: in linear light the residual's variance grows with the square of the
+    light. Without the multiplicative term photon noise takes it (its share above 0.5 in both draws); beside it,
+    the term fits the speckle's relative sd and photon noise is not named."""
+    noise = select(frame_pairs(5, shot=shot, read=1.5 / FULL_WELL, speckle=0.1))
+    assert noise["shot_share"]["estimate"] >= 0.5
+    assert not noise["kept"]
+    assert noise["status"] == "not identified"
+    assert any(r.startswith("the residual's variance grows with the square") for r in noise["reasons"])
+    # the residual of two frames carries the speckle of both: relative sd 0.1 x sqrt(2)
+    contrast = noise["multiplicative"]
+    assert contrast["interval"]["low"] <= contrast["contrast"] <= contrast["interval"]["high"]
+    assert contrast["contrast"] == pytest.approx(0.1 * np.sqrt(2.0), rel=0.2)
