@@ -36,8 +36,8 @@ null value 0, and (3) photon noise is the main part of the residual: at least ``
 variance, averaged over the fit pairs' residuals, both in the model above and beside a multiplicative term
 ``J^2 gain^2 x^2`` (variance growing with the square of the light: a light that itself fluctuates by a share of
 its level, as laser speckle does, or a mean model whose error is a share of the light; under the sRGB curve
-``J^2 x`` is nearly flat while ``J^2 x^2`` rises with the signal, so the two are told apart), and (4) the model follows the residual's variance across the
-signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
+``J^2 x`` is nearly flat while ``J^2 x^2`` rises with the signal, so the two are told apart), and (4) the model
+follows the residual's variance across the signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
 not above ``TREND_FACTOR``; read noise is the steepest fall any sensor noise has under a curve, so a faster one
 means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
 is named as a cause of the residual only where it is what the residual mostly is. When (4) fails, the curve the
@@ -272,7 +272,6 @@ def select_shot_noise(
         statistic, np.asarray(fit_items), draws=draws, rng=np.random.default_rng([seed, 4])
     )
     reasons, curve_fails = shot_noise_reasons(validation_ratio, intervals, curve)
-    beside_gain = fit_variance(fitted, True, gain=True)
     return {
         "kept": not reasons,
         "status": "identified" if not reasons else "not identifiable" if curve_fails else "not identified",
@@ -297,10 +296,7 @@ def select_shot_noise(
             "detail_gain": with_shot["detail"],
         },
         # the relative sd of the light that a multiplicative term fits beside photon noise (residual of two frames)
-        "multiplicative": {
-            "contrast": math.sqrt(beside_gain["gain_var"]),
-            "interval": intervals["gain_contrast"].as_dict(),
-        },
+        "multiplicative_relative_sd": intervals["gain_contrast"].as_dict(),
         "intervals": {
             "read_noise_grey": _scaled(intervals["read_var"], lambda v: 255.0 * math.sqrt(max(v, 0.0))),
             "shot_gain_grey": _scaled(intervals["shot"], lambda v: 255.0 * v),

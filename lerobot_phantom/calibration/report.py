@@ -441,6 +441,7 @@ def _extended_lines(report: dict) -> list[str]:
 
 def _noise_lines(noise: dict) -> list[str]:
     """The noise model's verdict and fit (noise.py)."""
+    relative_sd = noise["multiplicative_relative_sd"]
     return [
         "",
         "## Noise model (`shot_noise`)",
@@ -454,9 +455,8 @@ def _noise_lines(noise: dict) -> list[str]:
         "levels (linear light x 255, before the tone curve): read noise "
         f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
         "(variance per unit of signal); beside a multiplicative term, the light's relative sd "
-        f"{noise['multiplicative']['contrast']:.3g} ({100 * noise['multiplicative']['interval']['level']:.0f}% "
-        f"interval {noise['multiplicative']['interval']['low']:.3g}-"
-        f"{noise['multiplicative']['interval']['high']:.3g}). Held-out residual RMSE (output grey levels) vs "
+        f"{relative_sd['estimate']:.3g} ({100 * relative_sd['level']:.0f}% interval {relative_sd['low']:.3g}-"
+        f"{relative_sd['high']:.3g}). Held-out residual RMSE (output grey levels) vs "
         "predicted signal "
         "(linear-light grey levels): "
         + ", ".join(

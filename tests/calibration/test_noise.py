@@ -174,6 +174,6 @@ def test_light_that_fluctuates_in_proportion_to_its_level_is_not_named_photon_no
     assert noise["status"] == "not identified"
     assert any(r.startswith("the residual's variance grows with the square") for r in noise["reasons"])
     # the residual of two frames carries the speckle of both: relative sd 0.1 x sqrt(2)
-    contrast = noise["multiplicative"]
-    assert contrast["interval"]["low"] <= contrast["contrast"] <= contrast["interval"]["high"]
-    assert contrast["contrast"] == pytest.approx(0.1 * np.sqrt(2.0), rel=0.2)
+    relative_sd = noise["multiplicative_relative_sd"]
+    assert relative_sd["low"] <= relative_sd["estimate"] <= relative_sd["high"]
+    assert relative_sd["estimate"] == pytest.approx(0.1 * np.sqrt(2.0), rel=0.2)

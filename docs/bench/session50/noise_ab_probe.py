@@ -39,7 +39,7 @@ def main() -> None:
                 before = after or (len(reasons) == 1 and reasons[0].startswith(MULTIPLICATIVE_REASON))
                 share = noise.get("shot_share", {}).get("estimate", float("nan"))
                 beside = noise.get("shot_share_beside_gain", {}).get("estimate", float("nan"))
-                gain = noise.get("multiplicative", {}).get("interval", {})
+                gain = noise.get("multiplicative_relative_sd", {})
                 others = sorted(sim.named_causes(report) - {"shot_noise"})
                 print(
                     f"{master} {case.name:30s} {case.kind:11s} before {'named' if before else '-':5s} after "
