@@ -320,6 +320,7 @@ CASES = [
             band_profile=library_band_profile(cam),
             speckle_looks=int(rng.integers(3, 7)),
         ),
+        tolerated=frozenset(),  # speckle is the light's own fluctuation (sessions 50-51: shot_noise 8 -> 0 of 16)
     ),
     Case(
         "em_strip_pixel_slip_unnamed",
