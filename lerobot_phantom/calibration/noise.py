@@ -37,9 +37,9 @@ variance, averaged over the fit pairs' residuals, both in the model above and be
 ``J^2 gain^2 x^2`` (variance growing with the square of the light: a light that itself fluctuates by a share of
 its level, as laser speckle does, or a mean model whose error is a share of the light; under the sRGB curve
 ``J^2 x`` is nearly flat while ``J^2 x^2`` rises with the signal, so the two are told apart), and (4) the model
-follows the residual's variance across the signal (measured over modelled variance in the darkest quarter of the signal against the brightest: its interval
-not above ``TREND_FACTOR``; read noise is the steepest fall any sensor noise has under a curve, so a faster one
-means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
+follows the residual's variance across the signal (measured over modelled variance in the darkest quarter of the
+signal against the brightest: its interval not above ``TREND_FACTOR``; read noise is the steepest fall any sensor
+noise has under a curve, so a faster one means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
 is named as a cause of the residual only where it is what the residual mostly is. When (4) fails, the curve the
 residuals were read through is not the camera's, and the report says "not identifiable" with why, instead of
 dividing the variance between two terms that the frames cannot tell apart. It runs after the mean model is

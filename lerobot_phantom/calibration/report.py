@@ -456,8 +456,7 @@ def _noise_lines(noise: dict) -> list[str]:
         f"{noise['shot_noise']['read_noise_grey']:.3g}, shot gain {noise['shot_noise']['shot_gain_grey']:.3g} "
         "(variance per unit of signal); beside a multiplicative term, the light's relative sd "
         f"{relative_sd['estimate']:.3g} ({100 * relative_sd['level']:.0f}% interval {relative_sd['low']:.3g}-"
-        f"{relative_sd['high']:.3g}). Held-out residual RMSE (output grey levels) vs "
-        "predicted signal "
+        f"{relative_sd['high']:.3g}). Held-out residual RMSE (output grey levels) vs predicted signal "
         "(linear-light grey levels): "
         + ", ".join(
             f"{x:.0f}: {r:.2f}"

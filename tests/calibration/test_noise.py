@@ -22,6 +22,7 @@ from lerobot_phantom.calibration.noise import (
     mean_nll,
     select_shot_noise,
 )
+from lerobot_phantom.calibration.report import _noise_lines
 from lerobot_phantom.transforms import physics
 
 FULL_WELL = 400.0  # electrons at saturation: photon noise of several grey levels
@@ -177,3 +178,6 @@ def test_light_that_fluctuates_in_proportion_to_its_level_is_not_named_photon_no
     relative_sd = noise["multiplicative_relative_sd"]
     assert relative_sd["low"] <= relative_sd["estimate"] <= relative_sd["high"]
     assert relative_sd["estimate"] == pytest.approx(0.1 * np.sqrt(2.0), rel=0.2)
+    # report.md's noise section gives the same figure
+    section = "\n".join(_noise_lines(noise))
+    assert f"the light's relative sd {relative_sd['estimate']:.3g}" in section
