@@ -31,6 +31,7 @@ import pandas as pd
 import torch
 
 from lerobot_phantom.calibration.core import (
+    TIE_SHARE,
     Effect,
     Fit,
     Param,
@@ -38,6 +39,7 @@ from lerobot_phantom.calibration.core import (
     binned_rmse,
     fit_least_squares,
     preferred_fit,
+    ties_lowest,
 )
 from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutter_rows_lit
@@ -119,6 +121,10 @@ DRIFT_JACOBIAN = "2-point"
 # lock: the 5% critical value of the likelihood ratio for one parameter at its bound (a 50:50 mixture of 0 and
 # chi-square with one degree of freedom; Self & Liang 1987)
 DRIFT_EVIDENCE = 2.706
+# a threshold's flat (StripeProblem.threshold_at_flat_floor) is traced on this log grid over its range, from this
+# share of the range's top: its steps are found to 1.6% of the threshold, and a flat reaching below is not bracketed
+THRESHOLD_FLAT_GRID = 600
+THRESHOLD_FLAT_RANGE = 1e-4
 
 
 def _value_and_unit(value, what: str) -> tuple[float, str]:
@@ -502,7 +508,8 @@ class StripeProblem(Problem):
                 self.fit_from(effects, specs, items, rule, s)
                 for s in self.threshold_regimes_beside(effects, params, items)
             ]
-            per_rule.append((*preferred_fit(specs, [(error, params), *beside]), rule))
+            error, params = preferred_fit(specs, [(error, params), *beside])
+            per_rule.append((*self.threshold_at_flat_floor(effects, specs, items, rule, error, params), rule))
         _, params, rule = preferred_fit(specs, per_rule)
         return Fit(effects, params, {"frames": rule})
 
@@ -551,6 +558,73 @@ class StripeProblem(Problem):
             nearest, next_one = above[0], above[1] if len(above) > 1 else np.inf
             starts.append(min(1.05 * nearest, 0.5 * (nearest + next_one)))
         return [{**params, "threshold_s": float(start)} for start in starts]
+
+    def threshold_at_flat_floor(
+        self,
+        effects: frozenset[str],
+        specs: list[Param],
+        items: np.ndarray,
+        rule: str,
+        error: float,
+        params: dict[str, float],
+    ) -> tuple[float, dict[str, float]]:
+        """(squared error, parameters) with the threshold moved to the floor of its flat, when the fit rows bracket
+        it; else the fit as it is. Without read noise a threshold between two steps (the most light a row shown dark
+        collects and the least a row shown lit collects) gives every fit row the same count, and a threshold moved
+        by ``d`` with the offset moved by ``2 d`` keeps every stripe's width (``on + window + offset - 2
+        threshold``): the error is exactly flat along that line, and where a fit stops on it is where its start
+        left it, so folds of one table stop at different thresholds for no reason in their rows. The floor is the
+        least light lost that the fit rows call for (the threshold nearest its null, as selection prefers no effect
+        the data do not call for); it is found on a log grid, so to within its step (1.6%) above the step
+        below. Seen on drawn camera 531200696 (lit frames, ``docs/bench/session52.md``): a selection fold whose fit
+        rows show an 18.8 us pulse dark and a 48.1 us pulse lit stopped at 46.5 us and darkened the 36.6 us pulses
+        it validates (61.8 rows against 3.5 for any threshold under 36.6; the camera's is 26.8), and selection wrote
+        the overlap alone (215 rows held-out against 9.4). A flat reaching either end of the threshold's range is
+        not bracketed, and the fit stays; so does a fit with read noise, whose error has a slope everywhere."""
+        if "detection_threshold" not in effects or "detection_noise" in effects:
+            return error, params
+        spec = next(p for p in specs if p.name == "threshold_s")
+        current = params["threshold_s"]
+        grid = np.unique(
+            np.r_[np.geomspace(spec.high * THRESHOLD_FLAT_RANGE, spec.high, THRESHOLD_FLAT_GRID), current]
+        )
+        moved = {"threshold_s": grid}
+        if "integration_offset_s" in params:
+            moved["integration_offset_s"] = params["integration_offset_s"] + 2.0 * (grid - current)
+        offset_spec = {p.name: p for p in specs}.get("integration_offset_s")
+        inside = np.ones(len(grid), bool)
+        if offset_spec is not None:
+            inside = (moved["integration_offset_s"] >= offset_spec.low) & (
+                moved["integration_offset_s"] <= offset_spec.high
+            )
+        target = torch.as_tensor(self.rows[items])
+        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+        values |= {k: torch.as_tensor(v).reshape(-1, 1) for k, v in moved.items()}
+        with torch.no_grad():
+            sse = ((self.predict(effects, values, items, rule) - target) ** 2).sum(-1).numpy()
+        flat = inside & (np.abs(sse - error) <= abs(error) * TIE_SHARE)
+        at = int(np.searchsorted(grid, current))
+        if not flat[at]:
+            return error, params
+        low, high = at, at
+        while low > 0 and flat[low - 1]:
+            low -= 1
+        while high < len(grid) - 1 and flat[high + 1]:
+            high += 1
+        if low == 0 or high == len(grid) - 1:
+            return error, params
+        floor = grid[low]
+        moved_to_floor = {**params, "threshold_s": float(floor)}
+        if "integration_offset_s" in params:
+            moved_to_floor["integration_offset_s"] = float(
+                params["integration_offset_s"] + 2.0 * (floor - current)
+            )
+        with torch.no_grad():
+            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in moved_to_floor.items()}
+            floor_error = float(torch.sum((self.predict(effects, values, items, rule) - target) ** 2))
+        if not ties_lowest(floor_error, error):
+            return error, params
+        return floor_error, moved_to_floor
 
     def fit_drift(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
         """The model with ``phase_drift``: the locked model (every drift 0) fitted under the interior rule, whose

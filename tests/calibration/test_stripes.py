@@ -567,6 +567,61 @@ def test_rows_that_fix_no_row_time_do_not_leave_it_at_a_bound(tmp_path):
     assert not at_bounds, f"{camera_summary(camera)}\n{fit.params} {fit.extra}: {at_bounds} at a bound"
 
 
+def bracketed_threshold_table(path: Path, rng: np.random.Generator) -> dict[str, float]:
+    """A lit-frames table whose pulses bracket the camera's threshold: 18.75 us pulses (533.2 Hz, 1%) collect less
+    than it, 48.05 us ones (208.1 Hz, 1%) more, and no window collects an amount between (none is that short, and
+    none holds two of the short pulses). Rows from the package's own kernel plus Gaussian noise: what is tested is
+    the fit, not the model."""
+    truth = {"row_time_s": 15e-6, "integration_offset_s": 10e-6, "threshold_s": 30e-6}
+    conditions = [
+        (frequency, duty, exposure)
+        for frequency in (31.7, 208.1, 533.2, 1040.0)
+        for duty in (1, 5, 20, 50)
+        for exposure in (79, 246, 765)
+    ]
+    frequency, duty, exposure = (torch.tensor(c, dtype=torch.float64) for c in zip(*conditions, strict=True))
+    rows = physics.rolling_shutter_rows_lit(
+        frequency,
+        duty / 100,
+        exposure * 1e-6,
+        truth["row_time_s"],
+        image_rows=1080,
+        integration_offset_s=truth["integration_offset_s"],
+        threshold_s=truth["threshold_s"],
+        frames="lit",
+    ).numpy()
+    rows = rows + rng.normal(0.0, 3.0, len(rows))
+    lines = ["frequency,exposure_us,duty_cycle,image_height,affected_rows_mean"]
+    lines += [f"{f},{e},{d},1080,{r:.3f}" for (f, d, e), r in zip(conditions, rows, strict=True)]
+    path.write_text("\n".join(lines) + "\n")
+    return truth
+
+
+@pytest.mark.parametrize("start_threshold_us", [20.0, 46.0])
+def test_a_threshold_the_fit_rows_bracket_is_fitted_to_its_floor_whatever_the_start(
+    tmp_path, start_threshold_us
+):
+    """The fit rows show the 18.75 us pulses dark and the 48.05 us ones lit: every threshold between gives every row
+    the same count, with the offset moving twice as far to keep the widths. A fit must not stop where its start left
+    it (a selection fold of drawn camera 531200696 stopped at 46.5 us and darkened the 36.6 us pulses it validated,
+    61.8 rows against 3.5): from a start near either end it ends at the flat's floor, just above 18.75 us (within
+    the flat's grid step), and keeps the widths the rows measure."""
+    truth = bracketed_threshold_table(tmp_path / "table.csv", np.random.default_rng([SEED, 52]))
+    problem = StripeProblem(tmp_path / "table.csv", image_height=None, exposure_unit_s=None)
+    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
+    items = np.arange(problem.n_items)
+    moved = start_threshold_us * 1e-6 - truth["threshold_s"]
+    start = {**truth, "threshold_s": truth["threshold_s"] + moved}
+    start["integration_offset_s"] = truth["integration_offset_s"] + 2 * moved
+    fit = problem.fit(effects, items, Fit(effects, start, {"frames": "lit"}))
+    darkest_lit, brightest_dark = 0.01 / 208.1, 0.01 / 533.2
+    about = f"STRIPES_SEED={SEED} start {start_threshold_us} us: {fit.params} {fit.extra}"
+    assert fit.extra["frames"] == "lit", about
+    assert brightest_dark < fit.params["threshold_s"] <= 1.02 * brightest_dark < darkest_lit, about
+    width = fit.params["integration_offset_s"] - 2 * fit.params["threshold_s"]
+    assert width == pytest.approx(truth["integration_offset_s"] - 2 * truth["threshold_s"], abs=2e-6), about
+
+
 @pytest.mark.parametrize("start_at", ["placement", "entry"])
 @pytest.mark.parametrize("drift", [0.1, 0.4])
 def test_a_drifting_recording_matches_the_simulator(drift, start_at):
