@@ -567,17 +567,19 @@ def test_rows_that_fix_no_row_time_do_not_leave_it_at_a_bound(tmp_path):
     assert not at_bounds, f"{camera_summary(camera)}\n{fit.params} {fit.extra}: {at_bounds} at a bound"
 
 
-def bracketed_threshold_table(path: Path, rng: np.random.Generator) -> dict[str, float]:
+def bracketed_threshold_table(
+    path: Path, rng: np.random.Generator, exposures_us: tuple[float, ...] = (79, 246, 765)
+) -> dict[str, float]:
     """A lit-frames table whose pulses bracket the camera's threshold: 18.75 us pulses (533.2 Hz, 1%) collect less
     than it, 48.05 us ones (208.1 Hz, 1%) more, and no window collects an amount between (none is that short, and
-    none holds two of the short pulses). Rows from the package's own kernel plus Gaussian noise: what is tested is
-    the fit, not the model."""
+    none holds two of the short pulses; a longer exposure in ``exposures_us`` adds such steps). Rows from the
+    package's own kernel plus Gaussian noise: what is tested is the fit, not the model."""
     truth = {"row_time_s": 15e-6, "integration_offset_s": 10e-6, "threshold_s": 30e-6}
     conditions = [
         (frequency, duty, exposure)
         for frequency in (31.7, 208.1, 533.2, 1040.0)
         for duty in (1, 5, 20, 50)
-        for exposure in (79, 246, 765)
+        for exposure in exposures_us
     ]
     frequency, duty, exposure = (torch.tensor(c, dtype=torch.float64) for c in zip(*conditions, strict=True))
     rows = physics.rolling_shutter_rows_lit(
