@@ -39,7 +39,6 @@ from lerobot_phantom.calibration.core import (
     binned_rmse,
     fit_least_squares,
     preferred_fit,
-    ties_lowest,
 )
 from lerobot_phantom.calibration.structure import ResidualSample
 from lerobot_phantom.transforms.physics import STRIPE_FRAME_RULES, rolling_shutter_rows_lit
@@ -613,18 +612,8 @@ class StripeProblem(Problem):
             high += 1
         if low == 0 or high == len(grid) - 1:
             return error, params
-        floor = grid[low]
-        moved_to_floor = {**params, "threshold_s": float(floor)}
-        if "integration_offset_s" in params:
-            moved_to_floor["integration_offset_s"] = float(
-                params["integration_offset_s"] + 2.0 * (floor - current)
-            )
-        with torch.no_grad():
-            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in moved_to_floor.items()}
-            floor_error = float(torch.sum((self.predict(effects, values, items, rule) - target) ** 2))
-        if not ties_lowest(floor_error, error):
-            return error, params
-        return floor_error, moved_to_floor
+        # the floor's point of the traced line: its error ties the fit's (it is on the flat)
+        return float(sse[low]), {**params, **{k: float(v[low]) for k, v in moved.items()}}
 
     def fit_drift(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
         """The model with ``phase_drift``: the locked model (every drift 0) fitted under the interior rule, whose
