@@ -624,6 +624,28 @@ def test_a_threshold_the_fit_rows_bracket_is_fitted_to_its_floor_whatever_the_st
     assert width == pytest.approx(truth["integration_offset_s"] - 2 * truth["threshold_s"], abs=2e-6), about
 
 
+def test_a_threshold_beyond_a_step_of_several_pulses_in_one_window_is_reached(tmp_path):
+    """A 2375 us exposure added to the bracketed table: its windows hold two 18.75 us pulses (37.5 us of light) and
+    three 9.62 us ones (28.85 us), steps that no single pulse makes. A fit started at 46 us stops on the 37.5-48.05 us
+    flat, where the long window's rows lose light the camera's 30 us threshold keeps; it must cross to the 28.85-37.5
+    us flat, whose error is far lower, and end at that flat's floor."""
+    truth = bracketed_threshold_table(
+        tmp_path / "table.csv", np.random.default_rng([SEED, 53]), exposures_us=(79, 246, 765, 2375)
+    )
+    problem = StripeProblem(tmp_path / "table.csv", image_height=None, exposure_unit_s=None)
+    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
+    items = np.arange(problem.n_items)
+    moved = 46e-6 - truth["threshold_s"]
+    start = {**truth, "threshold_s": 46e-6, "integration_offset_s": truth["integration_offset_s"] + 2 * moved}
+    fit = problem.fit(effects, items, Fit(effects, start, {"frames": "lit"}))
+    three_short_pulses = 3 * 0.01 / 1040.0
+    about = f"STRIPES_SEED={SEED}: {fit.params} {fit.extra}"
+    assert fit.extra["frames"] == "lit", about
+    assert three_short_pulses < fit.params["threshold_s"] <= 1.02 * three_short_pulses, about
+    truth_error = float(np.sum(problem.residual(Fit(effects, truth, {"frames": "lit"}), items) ** 2))
+    assert float(np.sum(problem.residual(fit, items) ** 2)) <= 1.5 * truth_error, about
+
+
 @pytest.mark.parametrize("start_at", ["placement", "entry"])
 @pytest.mark.parametrize("drift", [0.1, 0.4])
 def test_a_drifting_recording_matches_the_simulator(drift, start_at):
