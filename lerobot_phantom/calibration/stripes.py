@@ -579,24 +579,30 @@ class StripeProblem(Problem):
         rows show an 18.8 us pulse dark and a 48.1 us pulse lit stopped at 46.5 us and darkened the 36.6 us pulses
         it validates (61.8 rows against 3.5 for any threshold under 36.6; the camera's is 26.8), and selection wrote
         the overlap alone (215 rows held-out against 9.4). A flat reaching either end of the threshold's range is
-        not bracketed, and the fit stays; so does a fit with read noise, whose error has a slope everywhere.
-
-        Before the floor, the fit moves to the lowest error the line reaches, when that is below the fit's: a fit
-        cannot cross a step with no slope before it, and the starts ``threshold_regimes_beside`` gives lie beside
-        the steps of windows holding one pulse, where a window holding ``k`` pulses collects ``k`` on-times, a step
-        too (``docs/bench/session52/multi_pulse_steps_probe.py``: a fit stopped at 37.7 us on a 37.5-48.1 us
-        flat, squared error 86722, where the line reaches 520 on the 28.8-37.5 us flat beside it)."""
+        not bracketed, and the fit stays; so does a fit with read noise, whose error has a slope everywhere."""
         if "detection_threshold" not in effects or "detection_noise" in effects:
             return error, params
-        grid, moved, sse, inside = self.threshold_line(effects, specs, items, rule, params)
-        lowest = int(np.argmin(np.where(inside, sse, np.inf)))
-        if inside[lowest] and sse[lowest] < error - abs(error) * TIE_SHARE:
-            reached = {**params, **{k: float(v[lowest]) for k, v in moved.items()}}
-            refit = self.fit_from(effects, specs, items, rule, reached)
-            error, params = preferred_fit(specs, [(float(sse[lowest]), reached), refit])
-            grid, moved, sse, inside = self.threshold_line(effects, specs, items, rule, params)
+        spec = next(p for p in specs if p.name == "threshold_s")
+        current = params["threshold_s"]
+        grid = np.unique(
+            np.r_[np.geomspace(spec.high * THRESHOLD_FLAT_RANGE, spec.high, THRESHOLD_FLAT_GRID), current]
+        )
+        moved = {"threshold_s": grid}
+        if "integration_offset_s" in params:
+            moved["integration_offset_s"] = params["integration_offset_s"] + 2.0 * (grid - current)
+        offset_spec = {p.name: p for p in specs}.get("integration_offset_s")
+        inside = np.ones(len(grid), bool)
+        if offset_spec is not None:
+            inside = (moved["integration_offset_s"] >= offset_spec.low) & (
+                moved["integration_offset_s"] <= offset_spec.high
+            )
+        target = torch.as_tensor(self.rows[items])
+        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+        values |= {k: torch.as_tensor(v).reshape(-1, 1) for k, v in moved.items()}
+        with torch.no_grad():
+            sse = ((self.predict(effects, values, items, rule) - target) ** 2).sum(-1).numpy()
         flat = inside & (np.abs(sse - error) <= abs(error) * TIE_SHARE)
-        at = int(np.searchsorted(grid, params["threshold_s"]))
+        at = int(np.searchsorted(grid, current))
         if not flat[at]:
             return error, params
         low, high = at, at
@@ -608,38 +614,6 @@ class StripeProblem(Problem):
             return error, params
         # the floor's point of the traced line: its error ties the fit's (it is on the flat)
         return float(sse[low]), {**params, **{k: float(v[low]) for k, v in moved.items()}}
-
-    def threshold_line(
-        self,
-        effects: frozenset[str],
-        specs: list[Param],
-        items: np.ndarray,
-        rule: str,
-        params: dict[str, float],
-    ) -> tuple[np.ndarray, dict[str, np.ndarray], np.ndarray, np.ndarray]:
-        """The line ``threshold + d, offset + 2 d`` through ``params`` (along which every stripe keeps its width),
-        traced on ``THRESHOLD_FLAT_GRID`` log-spaced thresholds over the threshold's range and ``params``' own:
-        (thresholds, the moved parameters at each, the fit rows' squared error at each, whether the offset stays
-        inside its range)."""
-        spec = next(p for p in specs if p.name == "threshold_s")
-        current = params["threshold_s"]
-        grid = np.unique(
-            np.r_[np.geomspace(spec.high * THRESHOLD_FLAT_RANGE, spec.high, THRESHOLD_FLAT_GRID), current]
-        )
-        moved = {"threshold_s": grid}
-        inside = np.ones(len(grid), bool)
-        offset_spec = {p.name: p for p in specs}.get("integration_offset_s")
-        if "integration_offset_s" in params:
-            moved["integration_offset_s"] = params["integration_offset_s"] + 2.0 * (grid - current)
-            if offset_spec is not None:
-                offset = moved["integration_offset_s"]
-                inside = (offset >= offset_spec.low) & (offset <= offset_spec.high)
-        target = torch.as_tensor(self.rows[items])
-        values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
-        values |= {k: torch.as_tensor(v).reshape(-1, 1) for k, v in moved.items()}
-        with torch.no_grad():
-            sse = ((self.predict(effects, values, items, rule) - target) ** 2).sum(-1).numpy()
-        return grid, moved, sse, inside
 
     def fit_drift(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
         """The model with ``phase_drift``: the locked model (every drift 0) fitted under the interior rule, whose
