@@ -599,6 +599,31 @@ def bracketed_threshold_table(
     return truth
 
 
+def fit_from_threshold_start(
+    tmp_path: Path,
+    rng: np.random.Generator,
+    start_threshold_us: float,
+    exposures_us: tuple[float, ...] = (79, 246, 765),
+) -> tuple[dict[str, float], StripeProblem, Fit]:
+    """(truth, problem, fit) of threshold + offset on every row of a ``bracketed_threshold_table``, started from the
+    truth moved along the line the error is flat on: the threshold at ``start_threshold_us``, the offset moved twice
+    as far (every stripe keeps its width)."""
+    truth = bracketed_threshold_table(tmp_path / "table.csv", rng, exposures_us)
+    problem = StripeProblem(tmp_path / "table.csv", image_height=None, exposure_unit_s=None)
+    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
+    moved = start_threshold_us * 1e-6 - truth["threshold_s"]
+    start = {
+        **truth,
+        "threshold_s": start_threshold_us * 1e-6,
+        "integration_offset_s": truth["integration_offset_s"] + 2 * moved,
+    }
+    return (
+        truth,
+        problem,
+        problem.fit(effects, np.arange(problem.n_items), Fit(effects, start, {"frames": "lit"})),
+    )
+
+
 @pytest.mark.parametrize("start_threshold_us", [20.0, 46.0])
 def test_a_threshold_the_fit_rows_bracket_is_fitted_to_its_floor_whatever_the_start(
     tmp_path, start_threshold_us
@@ -608,14 +633,7 @@ def test_a_threshold_the_fit_rows_bracket_is_fitted_to_its_floor_whatever_the_st
     it (a selection fold of drawn camera 531200696 stopped at 46.5 us and darkened the 36.6 us pulses it validated,
     61.8 rows against 3.5): from a start near either end it ends at the flat's floor, just above 18.75 us (within
     the flat's grid step), and keeps the widths the rows measure."""
-    truth = bracketed_threshold_table(tmp_path / "table.csv", np.random.default_rng([SEED, 52]))
-    problem = StripeProblem(tmp_path / "table.csv", image_height=None, exposure_unit_s=None)
-    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
-    items = np.arange(problem.n_items)
-    moved = start_threshold_us * 1e-6 - truth["threshold_s"]
-    start = {**truth, "threshold_s": truth["threshold_s"] + moved}
-    start["integration_offset_s"] = truth["integration_offset_s"] + 2 * moved
-    fit = problem.fit(effects, items, Fit(effects, start, {"frames": "lit"}))
+    truth, _, fit = fit_from_threshold_start(tmp_path, np.random.default_rng([SEED, 52]), start_threshold_us)
     darkest_lit, brightest_dark = 0.01 / 208.1, 0.01 / 533.2
     about = f"STRIPES_SEED={SEED} start {start_threshold_us} us: {fit.params} {fit.extra}"
     assert fit.extra["frames"] == "lit", about
@@ -637,20 +655,15 @@ def test_a_threshold_beyond_a_step_of_several_pulses_in_one_window_is_reached(tm
     three 9.62 us ones (28.85 us), steps that no single pulse makes. A fit started at 46 us stops on the 37.5-48.05 us
     flat, where the long window's rows lose light the camera's 30 us threshold keeps; it must cross to the 28.85-37.5
     us flat, whose error is far lower, and end at that flat's floor."""
-    truth = bracketed_threshold_table(
-        tmp_path / "table.csv", np.random.default_rng([SEED, 53]), exposures_us=(79, 246, 765, 2375)
+    truth, problem, fit = fit_from_threshold_start(
+        tmp_path, np.random.default_rng([SEED, 53]), 46.0, exposures_us=(79, 246, 765, 2375)
     )
-    problem = StripeProblem(tmp_path / "table.csv", image_height=None, exposure_unit_s=None)
-    effects = frozenset({"exposure_overlap", "integration_offset", "detection_threshold"})
     items = np.arange(problem.n_items)
-    moved = 46e-6 - truth["threshold_s"]
-    start = {**truth, "threshold_s": 46e-6, "integration_offset_s": truth["integration_offset_s"] + 2 * moved}
-    fit = problem.fit(effects, items, Fit(effects, start, {"frames": "lit"}))
     three_short_pulses = 3 * 0.01 / 1040.0
     about = f"STRIPES_SEED={SEED}: {fit.params} {fit.extra}"
     assert fit.extra["frames"] == "lit", about
     assert three_short_pulses < fit.params["threshold_s"] <= 1.02 * three_short_pulses, about
-    truth_error = float(np.sum(problem.residual(Fit(effects, truth, {"frames": "lit"}), items) ** 2))
+    truth_error = float(np.sum(problem.residual(Fit(fit.effects, truth, {"frames": "lit"}), items) ** 2))
     assert float(np.sum(problem.residual(fit, items) ** 2)) <= 1.5 * truth_error, about
 
 
