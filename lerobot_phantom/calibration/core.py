@@ -61,9 +61,9 @@ BOUND_TOLERANCE = 1e-3  # share of a parameter's range within which it counts as
 TIE_SHARE = 1e-6  # errors or scores that agree within this share are equal (preferred_fit, lowest_scoring)
 
 
-def ties_lowest(value: float, lowest: float) -> bool:
+def ties_lowest(value: float | np.ndarray, lowest: float) -> bool | np.ndarray:
     """Whether ``value`` ties with ``lowest``, the least of its kind: within ``TIE_SHARE`` of it, where the data do
-    not tell the two apart."""
+    not tell the two apart (elementwise for an array of values)."""
     return value <= lowest + abs(lowest) * TIE_SHARE
 
 
