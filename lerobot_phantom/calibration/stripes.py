@@ -589,13 +589,14 @@ class StripeProblem(Problem):
         Before the floor, the fit may move to the lowest error the line reaches: a fit cannot cross a step with no
         slope before it, and the starts ``threshold_regimes_beside`` gives lie beside the steps of windows holding
         one pulse, where a window holding ``k`` pulses collects ``k`` on-times, a step too. It moves only where the
-        move validates (``line_move_validates``): a lower error on another flat can come from a single fit row, and
-        one row is no evidence that the rows to be predicted lie on that flat. Seen both ways: on the multi-pulse
-        table (``docs/bench/session52/multi_pulse_steps_probe.py``) a fit stopped at 37.7 us on a 37.5-48.1 us flat,
-        squared error 86722, where the line reaches 520 on the 28.8-37.5 us flat beside it, all but ~500 of it from
-        one row; on drawn camera 4111198912 (lit frames, sampled pulses) two selection folds' fits moved on one row's
-        evidence (6433 -> 2406), validated worse, and selection wrote the overlap alone, 2.80 -> 340.66 rows
-        held-out (``docs/bench/session53.md``). Neither move validates; one witnessed by several rows does
+        move validates (``line_move_validates``): a lower error on another flat can come from the rows of one fold
+        alone (on the multi-pulse table below, a single row), and a move they alone ask for is no evidence that the
+        rows to be predicted lie on that flat. Seen both ways: on the multi-pulse table
+        (``docs/bench/session52/multi_pulse_steps_probe.py``) a fit stopped at 37.7 us on a 37.5-48.1 us flat,
+        squared error 86722, where the line reaches 520 on the 28.8-37.5 us flat beside it; on drawn camera
+        4111198912 (lit frames, sampled pulses) two selection folds' fits moved (6433 -> 2406), validated worse, and
+        selection wrote the overlap alone, 2.80 -> 340.66 rows held-out (``docs/bench/session53.md``); in both, the
+        line's gain lies in one fold's rows. Neither move validates; one witnessed by rows of several folds does
         (``docs/bench/session54.md``)."""
         if "detection_threshold" not in effects or "detection_noise" in effects:
             return error, params
