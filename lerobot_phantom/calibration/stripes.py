@@ -603,19 +603,19 @@ class StripeProblem(Problem):
         grid, moved, errors, inside = self.threshold_line(effects, specs, items, rule, params)
         sse = errors.sum(1)
         lowest = int(np.argmin(np.where(inside, sse, np.inf)))
-        stay = int(np.searchsorted(grid, params["threshold_s"]))
+        at = int(np.searchsorted(grid, params["threshold_s"]))  # the fit's own point: the grid holds it
         if (
             inside[lowest]
             and sse[lowest] < error - abs(error) * TIE_SHARE
-            and line_move_validates(errors, inside, stay)
+            and line_move_validates(errors, inside, at)
         ):
             reached = {**params, **{k: float(v[lowest]) for k, v in moved.items()}}
             refit = self.fit_from(effects, specs, items, rule, reached)
             error, params = preferred_fit(specs, [(float(sse[lowest]), reached), refit])
             grid, moved, errors, inside = self.threshold_line(effects, specs, items, rule, params)
             sse = errors.sum(1)
+            at = int(np.searchsorted(grid, params["threshold_s"]))
         flat = inside & (np.abs(sse - error) <= abs(error) * TIE_SHARE)
-        at = int(np.searchsorted(grid, params["threshold_s"]))
         if not flat[at]:
             return error, params
         low, high = at, at

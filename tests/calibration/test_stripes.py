@@ -26,7 +26,12 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.core import Fit, at_bound, fit_least_squares, kfold, seeded_split
-from lerobot_phantom.calibration.stripes import DRIFT_EFFECTS, StripeProblem, read_stripe_table
+from lerobot_phantom.calibration.stripes import (
+    DRIFT_EFFECTS,
+    StripeProblem,
+    line_move_validates,
+    read_stripe_table,
+)
 from lerobot_phantom.calibration.structure import residual_structure
 from lerobot_phantom.transforms import physics
 
@@ -662,9 +667,9 @@ def assert_at_the_floor_above_three_short_pulses(
     "the 37.5-48.05 us flat), and the fit moves along its flat line only where the move validates across the fit "
     "rows' folds, which one row's evidence cannot (docs/bench/session54.md). Moving on any lower error (4e18abf) "
     "passes this test but fails drawn camera 4111198912 lit (sampled pulses), where two selection folds moved on "
-    "the evidence of one inner fold's rows (6433 -> 2406 in squared error), validated worse (8.03 -> 9.87 rows) and the overlap alone "
-    "was written, 2.80 -> 340.66 rows held-out (docs/bench/session53.md). Whether a row this far outside the read "
-    "noise should move a fit alone is open",
+    "the evidence of one inner fold's rows (6433 -> 2406 in squared error), validated worse (8.03 -> 9.87 rows) "
+    "and the overlap alone was written, 2.80 -> 340.66 rows held-out (docs/bench/session53.md). Whether a row this "
+    "far outside the read noise should move a fit alone is open",
 )
 def test_a_threshold_beyond_a_step_of_several_pulses_in_one_window_is_reached(tmp_path):
     """A 2375 us exposure added to the bracketed table: its windows hold two 18.75 us pulses (37.5 us of light) and
@@ -675,6 +680,27 @@ def test_a_threshold_beyond_a_step_of_several_pulses_in_one_window_is_reached(tm
         tmp_path, np.random.default_rng([SEED, 53]), 46.0, exposures_us=(79, 246, 765, 2375)
     )
     assert_at_the_floor_above_three_short_pulses(truth, problem, fit)
+
+
+def test_a_move_along_the_flat_line_validates_only_on_rows_of_several_folds():
+    """``line_move_validates`` on made-up errors of 12 rows along a line of 5 points, the fit at point 3, point 1 the
+    lowest: rows that ask for the move in every fold validate it; the same gain carried by one row does not (its fold
+    is predicted from rows that cannot tell the points apart); neither does a gain within rounding, nor a point
+    outside the offset's range."""
+    n_points, n_rows, stay = 5, 12, 3
+    everywhere = np.ones(n_points, bool)
+    every_row = np.full((n_points, n_rows), 6.0)
+    every_row[1] = 1.0  # each row predicted better at point 1 than at the fit's point
+    assert line_move_validates(every_row, everywhere, stay)
+    one_row = np.ones((n_points, n_rows))
+    one_row[[0, 2, 3, 4], 7] += 60.0  # only row 7 sets point 1 apart, by as much as all rows did above
+    assert not line_move_validates(one_row, everywhere, stay)
+    rounding = np.ones((n_points, n_rows))
+    rounding[stay] += 1e-12
+    assert not line_move_validates(rounding, everywhere, stay)
+    outside = everywhere.copy()
+    outside[1] = False
+    assert not line_move_validates(every_row, outside, stay)
 
 
 def test_a_step_of_several_pulses_that_several_fit_rows_witness_is_crossed(tmp_path):
