@@ -136,37 +136,44 @@ def calibrate(cfg: CalibrateConfig) -> dict:
         raise ValueError(f"--bootstrap must be at least 2 resamples, got {cfg.bootstrap}")
     with single_threaded():
         problem = build_problem(cfg)
-        fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
-        # selection, fits and parameter intervals see the fit items only; each stage has its own stream, so
-        # nothing about the held-out items can change what is fitted or selected
-        steps, chain, selection, withdrawn = select_and_identify(
-            problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds, draws=cfg.bootstrap
-        )
-        base, extended = chain[0], selection.fit
-        base_intervals = parameter_intervals(
-            problem, base, fit_items, draws=cfg.bootstrap, rng=np.random.default_rng([cfg.seed, 2])
-        )
-        report = build_report(
-            problem,
-            input_path=Path(cfg.measured),
-            fit_items=fit_items,
-            heldout_items=heldout_items,
-            base=base,
-            base_intervals=base_intervals,
-            selection=selection,
-            steps=steps,
-            seed=cfg.seed,
-            margin=cfg.margin,
-            folds=cfg.folds,
-            withdrawn=withdrawn,
-        )
-        if isinstance(problem, FrameProblem):
-            # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)
-            noise = select_shot_noise(
-                problem, extended, fit_items, heldout_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
+        with problem.fits_kept():
+            fit_items, heldout_items = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+            # selection, fits and parameter intervals see the fit items only; each stage has its own stream, so
+            # nothing about the held-out items can change what is fitted or selected
+            steps, chain, selection, withdrawn = select_and_identify(
+                problem, fit_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds, draws=cfg.bootstrap
             )
-            extended = apply_noise_finding(report, extended, noise)
-        write_outputs(problem, report, base, extended, heldout_items, out)
+            base, extended = chain[0], selection.fit
+            base_intervals = parameter_intervals(
+                problem, base, fit_items, draws=cfg.bootstrap, rng=np.random.default_rng([cfg.seed, 2])
+            )
+            report = build_report(
+                problem,
+                input_path=Path(cfg.measured),
+                fit_items=fit_items,
+                heldout_items=heldout_items,
+                base=base,
+                base_intervals=base_intervals,
+                selection=selection,
+                steps=steps,
+                seed=cfg.seed,
+                margin=cfg.margin,
+                folds=cfg.folds,
+                withdrawn=withdrawn,
+            )
+            if isinstance(problem, FrameProblem):
+                # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)
+                noise = select_shot_noise(
+                    problem,
+                    extended,
+                    fit_items,
+                    heldout_items,
+                    seed=cfg.seed,
+                    margin=cfg.margin,
+                    folds=cfg.folds,
+                )
+                extended = apply_noise_finding(report, extended, noise)
+            write_outputs(problem, report, base, extended, heldout_items, out)
     return report
 
 

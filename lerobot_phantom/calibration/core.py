@@ -239,6 +239,31 @@ class Problem:
         """Least-squares fit of the model with ``effects`` on ``items``; ``start``: a nested model's fit."""
         raise NotImplementedError
 
+    @contextmanager
+    def fits_kept(self) -> Iterator[None]:
+        """Within the block, ``fit`` returns the fit it already made for the same effects, items and start.
+
+        A fit is a function of those alone while the problem's data stay fixed (the starting points a problem scans
+        for a model are kept from that model's first fit, so a repeat finds the same ones), and one calibration
+        asks for many fits again: a selection pass after a withdrawal repeats the pass before it, with the same
+        folds, seeds and starts, up to the step that took the withdrawn effect; the residual-structure test refits
+        the base model cold on the selection's folds. A start is keyed by identity and kept with the entry, so
+        that its id cannot be reused by another fit while the entry lives."""
+        fit = self.fit
+        kept: dict[tuple, tuple[Fit | None, Fit]] = {}
+
+        def kept_fit(effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+            key = (frozenset(effects), tuple(int(i) for i in items), id(start))
+            if key not in kept:
+                kept[key] = (start, fit(effects, items, start))
+            return kept[key][1]
+
+        self.fit = kept_fit
+        try:
+            yield
+        finally:
+            del self.fit
+
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
         """Sum of squared errors (in the data's units) and number of values over ``items``."""
         raise NotImplementedError

@@ -81,6 +81,39 @@ def test_the_two_scores_from_their_item_terms():
         error_ratio(squared, squared, draws=2, rng=np.random.default_rng(0), score="median")
 
 
+class CountedLine(LineWithALoneItem):
+    """``LineWithALoneItem`` that counts the fits it makes."""
+
+    def __init__(self) -> None:
+        super().__init__("mean_item_error", 0)
+        self.fits_made = 0
+
+    def fit(self, effects, items, start=None) -> Fit:
+        self.fits_made += 1
+        return super().fit(effects, items, start)
+
+
+def test_kept_fits_repeat_no_fit_of_the_same_model_items_and_start():
+    problem, items, slope = CountedLine(), np.arange(12), frozenset({"slope"})
+    with problem.fits_kept():
+        first = problem.fit(slope, items)
+        assert problem.fit(slope, items.copy()) is first and problem.fits_made == 1
+        assert problem.fit(frozenset(), items).effects == frozenset()  # another model
+        problem.fit(slope, items[1:])  # other items
+        problem.fit(slope, items, first)  # another start
+        # a start is keyed by identity: an equal copy is another start (a problem may read more than its params)
+        problem.fit(slope, items, Fit(first.effects, dict(first.params)))
+        assert problem.fits_made == 5
+        # a selection run again (a pass after a withdrawal, same folds and seeds) makes no fit
+        chosen, steps = forward_select(problem, items, seed=0, margin=0.05)
+        made = problem.fits_made
+        again, repeated = forward_select(problem, items, seed=0, margin=0.05)
+        assert again == chosen and [s.tried for s in repeated] == [s.tried for s in steps]
+        assert problem.fits_made == made
+    problem.fit(slope, items)
+    assert problem.fits_made == made + 1  # outside the block every call fits
+
+
 class FixedErrors(Problem):
     """A problem whose models have no parameters: a model's error is fixed by its effects (``error``) and the same
     on every one of 20 items."""
