@@ -246,9 +246,9 @@ class Problem:
         A fit is a function of those alone while the problem's data stay fixed (the starting points a problem scans
         for a model are kept from that model's first fit, so a repeat finds the same ones), and one calibration
         asks for many fits again: a selection pass after a withdrawal repeats the pass before it, with the same
-        folds, seeds and starts, up to the step that took the withdrawn effect; the residual-structure test refits
-        the base model cold on the selection's folds. A start is keyed by identity and kept with the entry, so
-        that its id cannot be reused by another fit while the entry lives."""
+        folds, seeds and starts, up to the step that took the withdrawn effect; where the written model is the base,
+        the residual-structure test refits it cold on the selection's folds, as selection did. A start is keyed by
+        identity and kept with the entry, so that its id cannot be reused by another fit while the entry lives."""
         fit = self.fit
         kept: dict[tuple, tuple[Fit | None, Fit]] = {}
 
