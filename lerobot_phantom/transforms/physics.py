@@ -572,13 +572,16 @@ def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torc
     ys = torch.linspace(-1.0, 1.0, height, dtype=x.dtype, device=x.device) if height > 1 else x.new_zeros(1)
     xs = torch.linspace(-1.0, 1.0, width, dtype=x.dtype, device=x.device) if width > 1 else x.new_zeros(1)
     grid_y, grid_x = torch.meshgrid(ys, xs, indexing="ij")
+    identity = torch.stack([grid_x, grid_y], dim=-1)  # (H, W, 2): grid_sample's (x, y) order
     scale_x = 2.0 / max(width - 1, 1)
     scale_y = 2.0 / max(height - 1, 1)
+    # every tap's shift (taps, B, 2) at once; one add per tap then builds its grid (the same sums, bit for bit, as
+    # shifting each coordinate and stacking them, which cost a copy of the grid per tap)
+    taps = offsets.to(x.dtype).reshape(-1, 1)
+    shifts = torch.stack([taps * dx * scale_x, taps * dy * scale_y], dim=-1)
     out = torch.zeros_like(x)
-    for offset in offsets.to(x.dtype):
-        gx = grid_x.unsqueeze(0) + (offset * dx * scale_x).reshape(-1, 1, 1)
-        gy = grid_y.unsqueeze(0) + (offset * dy * scale_y).reshape(-1, 1, 1)
-        grid = torch.stack([gx, gy], dim=-1)
+    for shift in shifts:
+        grid = identity + shift.reshape(-1, 1, 1, 2)
         out = out + torch.nn.functional.grid_sample(
             x, grid, mode="bilinear", padding_mode="border", align_corners=True
         )
