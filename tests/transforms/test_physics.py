@@ -164,6 +164,39 @@ def test_blur_paths_and_line_blur():
     assert torch.allclose(physics.line_blur(flat, 5.0, 2.0, sinus.float()[::50]), flat, atol=1e-6)
 
 
+def reference_line_blur(x, dx, dy, offsets):
+    """The per-tap form ``line_blur`` computes: each tap shifts the pixel grid's two coordinates and samples."""
+    batch, _, height, width = x.shape
+    grid_y, grid_x = torch.meshgrid(
+        torch.linspace(-1.0, 1.0, height, dtype=x.dtype),
+        torch.linspace(-1.0, 1.0, width, dtype=x.dtype),
+        indexing="ij",
+    )
+    dx, dy = (torch.as_tensor(v, dtype=x.dtype).reshape(-1).expand(batch) for v in (dx, dy))
+    total = torch.zeros_like(x)
+    for offset in offsets.to(x.dtype):
+        gx = grid_x + (offset * dx * (2.0 / (width - 1))).reshape(-1, 1, 1)
+        gy = grid_y + (offset * dy * (2.0 / (height - 1))).reshape(-1, 1, 1)
+        grid = torch.stack([gx, gy], dim=-1)
+        total = total + torch.nn.functional.grid_sample(x, grid, padding_mode="border", align_corners=True)
+    return total / len(offsets)
+
+
+@pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
+def test_line_blur_is_the_per_tap_sampling_to_the_bit(dtype):
+    generator = torch.Generator().manual_seed(3)
+    x = torch.rand(3, 3, 21, 34, generator=generator, dtype=dtype)
+    dx, dy = (
+        torch.randn(3, generator=generator, dtype=dtype) * 5,
+        torch.randn(3, generator=generator, dtype=dtype),
+    )
+    offsets = physics.blur_path_offsets("sinusoidal", 9, dtype=dtype)
+    for shift_x, shift_y in [(dx, dy), (float(dx[0]), float(dy[0]))]:
+        assert torch.equal(
+            physics.line_blur(x, shift_x, shift_y, offsets), reference_line_blur(x, shift_x, shift_y, offsets)
+        )
+
+
 def test_em_colour_map_and_masks():
     x = torch.tensor([0.2, 0.3, 0.4]).reshape(1, 3, 1, 1)
     y = physics.em_color_map(x, 2.0, 0.1)
