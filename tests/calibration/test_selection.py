@@ -112,6 +112,11 @@ def test_kept_fits_repeat_no_fit_of_the_same_model_items_and_start():
         assert problem.fits_made == made
     problem.fit(slope, items)
     assert problem.fits_made == made + 1  # outside the block every call fits
+    with problem.fits_kept():
+        with problem.fits_kept():  # an inner block fits through the enclosing one, which keeps the fit
+            inner = problem.fit(slope, items)
+        assert problem.fit(slope, items) is inner and problem.fits_made == made + 2
+    assert "fit" not in vars(problem)  # the class's fit again
 
 
 class FixedErrors(Problem):
