@@ -111,3 +111,26 @@ def test_registered_costs_over_the_lit_rows_equal_the_whole_frame(tone):
                     for k in (0, len(phases) // 2, len(phases) - 1):
                         predicted = problem.predict_stripe(params, index, float(phases[k]))
                         torch.testing.assert_close(predicted, whole[k], rtol=1e-13, atol=1e-15)
+
+
+@pytest.mark.parametrize("period", [None, 0.47])
+def test_the_pairs_stripes_predicted_together_are_each_pairs_own_to_the_bit(period):
+    """The fit's residual takes every pair's row light from one call over the tallest frame's rows; frames of other
+    heights must get exactly the rows a call for them alone gives."""
+    rng = np.random.default_rng(5)
+    pairs = []
+    for i, height in enumerate([40, 47, 53, 61]):
+        clean = torch.from_numpy(rng.uniform(0.1, 0.6, (3, height, WIDTH)))
+        pairs.append(Pair(f"pair_{i}", clean, clean, None, float(rng.uniform(0.6, 1.0))))
+    problem = StripFrames(pairs, seed=0)
+    params = {k: torch.tensor(v, dtype=torch.float64) for k, v in STRIPE.items()}
+    if period is not None:
+        params["period_share"] = torch.tensor(period, dtype=torch.float64)
+    items = np.array([3, 0, 2, 1])
+    phases = {int(i): float(rng.uniform(-30.0, -5.0)) for i in items}  # stripes inside every frame
+    together = problem.predict_stripes(params, items, phases)
+    for predicted, i in zip(together, items, strict=True):
+        assert torch.equal(predicted, problem.predict_stripe(params, int(i), phases[int(i)]))
+    assert all(
+        not torch.equal(predicted, pairs[int(i)].clean) for predicted, i in zip(together, items, strict=True)
+    )

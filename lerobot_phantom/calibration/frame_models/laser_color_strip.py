@@ -147,13 +147,14 @@ class StripFrames(LatentFrameProblem):
 
     # -- the rolling-shutter stripe
     @staticmethod
-    def row_light(params, height: int, phase_rows: torch.Tensor) -> torch.Tensor:
-        """(B, H) lit fraction of every row for the pulse phases ``phase_rows`` (in rows)."""
+    def row_light(params, height, phase_rows: torch.Tensor, rows: int | None = None) -> torch.Tensor:
+        """(B, rows) lit fraction of every row for the pulse phases ``phase_rows`` (in rows) of frames ``height``
+        rows tall (a number, or one per phase); ``rows`` defaults to ``height``."""
         period = params.get("period_share", SINGLE_PULSE_PERIOD)
         period = torch.as_tensor(period, dtype=torch.float64)
         on = torch.as_tensor(params["on_share"], dtype=torch.float64)
         return physics.rolling_shutter_row_light(
-            height,
+            height if rows is None else rows,
             1.0 / period,
             (on / period).clamp(max=1.0),
             params["exposure_share"],
@@ -188,9 +189,14 @@ class StripFrames(LatentFrameProblem):
         )
         return frames[0], frames[1]
 
-    def predict_stripe(self, params, index: int, phase_rows) -> torch.Tensor:
+    def predict_stripe(
+        self, params, index: int, phase_rows, light: torch.Tensor | None = None
+    ) -> torch.Tensor:
+        """Pair ``index``'s attacked frame with the pulse at ``phase_rows``; ``light``: its rows' lit fractions,
+        when already computed (``predict_stripes``)."""
         pair = self.pairs[index]
-        light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
+        if light is None:
+            light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
         added = pair.intensity * self.stripe_gains(params).reshape(3, 1, 1) * light.reshape(1, -1, 1)
         _, encode = self.tone(params)
         # a stripe lights a share of the rows: the tone curve runs over those, the others hold the unlit frame
@@ -199,6 +205,22 @@ class StripFrames(LatentFrameProblem):
         predicted = unlit.clone()
         predicted[:, rows] = encode(linear[:, rows] + added[:, rows])
         return predicted
+
+    def predict_stripes(self, params, items: np.ndarray, phase_rows: dict[int, float]) -> list[torch.Tensor]:
+        """``predict_stripe`` of every pair of ``items`` at its phase, their row light from one call over the
+        tallest frame's rows. A row's light depends on its frame's row time and phase alone, so each frame's rows
+        hold, to the bit, what a call for that frame alone gives (the kit's frames have distinct heights)."""
+        heights = [self.pairs[int(i)].height for i in items]
+        light = self.row_light(
+            params,
+            torch.tensor(heights, dtype=torch.float64),
+            torch.tensor([float(phase_rows[int(i)]) for i in items], dtype=torch.float64),
+            rows=max(heights),
+        )
+        return [
+            self.predict_stripe(params, int(i), None, light[k, :height])
+            for k, (i, height) in enumerate(zip(items, heights, strict=True))
+        ]
 
     def phase_costs(self, params, index: int) -> tuple[torch.Tensor, np.ndarray]:
         """(pulse phases in rows, SSE of pair ``index`` for each): every stripe position, a row apart."""
@@ -355,12 +377,11 @@ class StripFrames(LatentFrameProblem):
                 phases = {int(i): self.best_phase(params, int(i)) for i in items}
 
                 def residuals(p, phases=phases):
+                    predicted = self.predict_stripes(p, items, phases)
                     return torch.cat(
                         [
-                            (
-                                self.predict_stripe(p, int(i), phases[int(i)]) - self.pairs[int(i)].attacked
-                            ).ravel()
-                            for i in items
+                            (frame - self.pairs[int(i)].attacked).ravel()
+                            for frame, i in zip(predicted, items, strict=True)
                         ]
                     )
 
