@@ -192,8 +192,8 @@ class StripFrames(LatentFrameProblem):
     def predict_stripe(
         self, params, index: int, phase_rows, light: torch.Tensor | None = None
     ) -> torch.Tensor:
-        """Pair ``index``'s attacked frame with the pulse at ``phase_rows``; ``light``: its rows' lit fractions,
-        when already computed (``predict_stripes``)."""
+        """Pair ``index``'s attacked frame with the pulse at ``phase_rows``; ``light``: its rows' lit fractions at
+        that phase, when already computed (``predict_stripes``)."""
         pair = self.pairs[index]
         if light is None:
             light = self.row_light(params, pair.height, torch.as_tensor(phase_rows, dtype=torch.float64))[0]
@@ -218,7 +218,7 @@ class StripFrames(LatentFrameProblem):
             rows=max(heights),
         )
         return [
-            self.predict_stripe(params, int(i), None, light[k, :height])
+            self.predict_stripe(params, int(i), phase_rows[int(i)], light[k, :height])
             for k, (i, height) in enumerate(zip(items, heights, strict=True))
         ]
 
