@@ -39,6 +39,9 @@ def main() -> None:
     print(f"test time: {sum(seconds.values()):.0f} s over {len(seconds)} tests with a duration line")
     for worker, total in sorted(workers.items()):
         print(f"{worker}: {total:.0f} s")
+    calibration = sum(total for group, total in groups.items() if group.startswith("calibration/"))
+    share = calibration / max(sum(groups.values()), 1e-9)
+    print(f"calibration/ test files: {calibration:.0f} s, {100 * share:.0f}% of the test time")
     print("groups over 10 s, largest first (seconds, worker, group):")
     for group, total in sorted(groups.items(), key=lambda item: -item[1]):
         if total > 10:
