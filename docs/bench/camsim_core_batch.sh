@@ -2,7 +2,7 @@
 # The camsim core selection (tests/calibration/test_independent_sim.py) on several master seeds, one after another.
 # usage: [CAMSIM_CASES=a,b] [CAMSIM_TIMEOUT=s] docs/bench/camsim_core_batch.sh TREE OUTDIR SEED...   (TREE: a checkout;
 # its package is what is tested; CAMSIM_CASES: the cases, default the core selection; CAMSIM_TIMEOUT: seconds per
-# seed, default 5400: CAMSIM_CASES=all took 1592-1674 s per seed in session 56, two seeds side by side)
+# seed, default 5400: CAMSIM_CASES=all took 1592-1942 s per seed in session 56, two seeds side by side)
 # Per seed: OUTDIR/log_SEED.txt (pytest -rA output, --runxfail), OUTDIR/bt_SEED (pytest's basetemp, with every
 # case's pairs and report.json) and one line in OUTDIR/summary.txt; docs/bench/camsim_batch_misses.py OUTDIR counts it.
 tree=$1; out=$2; shift 2
