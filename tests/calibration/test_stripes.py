@@ -466,17 +466,7 @@ def test_lit_time_is_the_overlap_minus_twice_the_threshold():
         (3, "lit"),
         (2677795359, "lit"),
         (2, "interior"),
-        pytest.param(
-            6,
-            "interior",
-            marks=pytest.mark.xfail(
-                strict=True,
-                reason="open (issue 12): on the table of the simulator that holds each step's exact pulse mean "
-                "(session 43) the fit stops at a row time of 43.1 us (4.08 rows) where the truth's start reaches "
-                "44.6 us (1.69 rows); six grid starts per row time instead of two find it, at 2.3x the first "
-                "fit's CPU time (docs/bench/session43/grid_starts_6_interior_0b32ffc.txt)",
-            ),
-        ),
+        (6, "interior"),
         (22, "lit"),
         (24, "interior"),
         (22, "interior"),

@@ -378,20 +378,11 @@ def test_without_a_threshold_a_row_is_lit_for_the_pulse_plus_its_window_and_no_l
     torch.testing.assert_close(reached, expected, rtol=1e-9, atol=0.0)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    raises=AssertionError,
-    reason="open (issue 12): where the parameters close every whole-stripe placement the interior rule falls back to "
-    "the lit rule's count (here ~335 rows against the stripe's ~232). Session 49's stand-in (the placement nearest "
-    "to whole, bc5951e) made the count continuous and fixed drawn camera 1222484455 interior (34 -> 3.3 rows "
-    "held-out), but the selection of drawn camera 4111198912 (lit) then left out the integration offset, failing "
-    "its two tests: taken back (docs/bench/session49.md)",
-)
 def test_a_closing_set_of_whole_stripe_placements_keeps_its_count():
     """One stripe of ~232 rows in a 419-row period on a 600-row frame (drawn camera 1222484455, 59.9 Hz at 50%):
     whole-stripe frames exist only while the row time is below ~39.9 us, and a measured row says they occurred. As
-    the row time grows past that point the interior count should stay with the stripe's width (the open side's
-    limit) instead of jumping to the lit rule's ~335 rows."""
+    the row time grows past that point the interior count stays with the stripe's width (the open side's limit,
+    then the frames nearest to whole) instead of jumping to the lit rule's ~335 rows."""
     row_times = torch.linspace(39.5e-6, 40.5e-6, 201, dtype=torch.float64)
     kwargs = {
         "image_rows": 600,
@@ -405,8 +396,11 @@ def test_a_closing_set_of_whole_stripe_placements_keeps_its_count():
     lit = physics.rolling_shutter_rows_lit(
         torch.tensor(59.9), torch.tensor(0.5), torch.tensor(879e-6), row_times, **(kwargs | {"frames": "lit"})
     )
+    period = 1.0 / 59.9 / row_times
     width = (0.5 / 59.9 + 879e-6 + 3.16e-5 - 2 * 1.17e-5) / row_times
-    # the grid starts open: whole-stripe frames exist there and count the stripe's width
-    assert float(interior[0]) == pytest.approx(float(width[0]), rel=1e-6)
-    assert float((lit - width).min()) > 80  # where the lit rule stands
+    closed, _ = physics._nearest_closed_placement(period, width, torch.tensor(599.0))
+    assert closed.any() and (~closed).any()  # the grid crosses the closing point
+    assert float((lit - interior).min()) > 80  # where the lit rule stood before
     assert float(interior.diff().abs().max()) < 1.0
+    torch.testing.assert_close(interior[~closed], width[~closed], rtol=1e-6, atol=0.0)
+    assert float((interior[closed] - width[closed]).abs().max()) < 20.0
