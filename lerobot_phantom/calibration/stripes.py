@@ -321,6 +321,8 @@ class StripeProblem(Problem):
     base_model = "fixed band of rows (the paper's laser color strip, band height fitted)"
     extended_model = "rolling shutter: phase-averaged pulse/exposure overlap over the row readout"
     candidates = EFFECTS
+    # threshold, read noise and offset can pay only together (drawn camera 4111198912, lit: docs/bench/session56.md)
+    joint_effects = 3
     # A table is a sparse grid of conditions over a response that switches regime (pulses above or below the
     # detection threshold, one or several pulses per exposure). A condition alone in its regime cannot be predicted
     # by the fold that validates it, whatever the model: its error (hundreds of rows) would decide every squared-
