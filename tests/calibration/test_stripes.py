@@ -956,7 +956,9 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 "STRIPES_SEED=16 and 19; of seeds 11-30, 5 of 40 cases fail, 8 before session 11, 13 before "
                 "session 9: docs/bench/second_camera_stripes.md; all on the point-sampled simulator before session "
                 "43). On the exact-pulse simulator: 197676555, 531200696 and 3808238891 at 296, 215 and 116 rows, of "
-                "40 cases (docs/bench/session44.md; 4111198912 at 341 rows until session 44)",
+                "40 cases (docs/bench/session44.md; 4111198912 at 341 rows until session 44); of session 48's 42 "
+                "drawn cases at session 57, 197676555 and 3808238891 at 296 and 116 rows (531200696 at 9.43 since "
+                "session 52; docs/bench/session57/sweep_compare_42.txt)",
             ),
         ),
         pytest.param(
@@ -968,7 +970,9 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
                 "0.96-1.45, 106 rows held-out) or a negative integration offset stands in for it (seed 30: 113 rows; "
                 "both on the point-sampled simulator before session 43). On the exact-pulse simulator: 1222484455 "
                 "and 1211740460 at 34 and 138 rows, of 40 cases; 2083087881 (14 or 94 rows) has an offset whose gain "
-                "interval ends at 1.001 +- 0.004 over generator streams (docs/bench/session44.md)",
+                "interval ends at 1.001 +- 0.004 over generator streams (docs/bench/session44.md). Of session 48's "
+                "42 drawn cases at session 57, 3503845322 at 187 rows (1222484455 and 1211740460 at 3.26 and 17.04: "
+                "docs/bench/session57/sweep_compare_42.txt)",
             ),
         ),
     ],
