@@ -485,14 +485,21 @@ def _interior_placements(
     length)`` of each interval of ``c' = height - c``, where ``c``, the first stripe's start, is uniform on
     (0, p - w] given row 0 dark; the last row is dark when ``c' mod p >= w``, and then ``ceil(c' / p)`` stripes
     fit."""
-    lowest = height - p + w
-    first = torch.floor(lowest / p)
+    first = torch.floor((height - p + w) / p)
     out = []
     for j in (first, first + 1.0):
-        start = torch.maximum(torch.maximum(j * p + w, lowest), torch.zeros_like(p))
-        stop = torch.minimum((j + 1.0) * p, height)
+        start, stop = _placement_set(p, w, height, j)
         out.append((start, j + 1.0, (stop - start).clamp(min=0.0)))
     return out
+
+
+def _placement_set(
+    p: torch.Tensor, w: torch.Tensor, height: torch.Tensor, j: torch.Tensor
+) -> tuple[torch.Tensor, torch.Tensor]:
+    """The ends of the ``j``-th set of ``c'`` that shows ``j + 1`` whole stripes (``_interior_placements``); the
+    set is empty where ``start >= stop``."""
+    start = torch.maximum(torch.maximum(j * p + w, height - p + w), torch.zeros_like(p))
+    return start, torch.minimum((j + 1.0) * p, height)
 
 
 def _nearest_closed_placement(
@@ -508,13 +515,11 @@ def _nearest_closed_placement(
     to the lit rule. Seen on drawn camera 1222484455 (interior): at 59.9 Hz and 50% one stripe of 233 rows in a
     418-row period, 233 rows measured; the fitted row time (0.9% long) closed the set and the lit rule predicted
     335. A set of no stripe, or a stripe wider than the frame, stands for nothing: no frame shows it whole."""
-    lowest = height - p + w
-    first = torch.floor(lowest / p)
+    first = torch.floor((height - p + w) / p)
     misses, middles = [], []
-    # the set below the first holds no placement (it ends at first * p <= lowest) but may be the nearest to one
+    # the set below the first holds no placement (it ends at first * p <= height - p + w) but may be the nearest
     for j in (first - 1.0, first, first + 1.0):
-        start = torch.maximum(torch.maximum(j * p + w, lowest), torch.zeros_like(p))
-        stop = torch.minimum((j + 1.0) * p, height)
+        start, stop = _placement_set(p, w, height, j)
         misses.append(torch.where(j >= 0.0, start - stop, torch.full_like(start, torch.inf)))
         middles.append(0.5 * (start + stop))
     misses, middles = torch.stack(misses), torch.stack(middles)
@@ -523,9 +528,8 @@ def _nearest_closed_placement(
     return closed, middles.gather(0, least.indices.unsqueeze(0)).squeeze(0)
 
 
-POINT_PLACEMENT = (
-    1e-12  # rows: the weight of the placement that stands for a closed set (only its count matters)
-)
+# rows: the weight of the placement that stands for a closed set (only its count matters)
+POINT_PLACEMENT = 1e-12
 
 
 DRIFT_PLACEMENTS = 16  # grid points per interval of whole-stripe placements

@@ -404,3 +404,15 @@ def test_a_closing_set_of_whole_stripe_placements_keeps_its_count():
     assert float(interior.diff().abs().max()) < 1.0
     torch.testing.assert_close(interior[~closed], width[~closed], rtol=1e-6, atol=0.0)
     assert float((interior[closed] - width[closed]).abs().max()) < 20.0
+    # a drifting recording of a closed set starts at the placement that stands for it: continuous too
+    for drift in (0.0, 0.05):
+        drifting = physics.rolling_shutter_rows_lit(
+            torch.tensor(59.9),
+            torch.tensor(0.5),
+            torch.tensor(879e-6),
+            row_times,
+            drift=torch.tensor(drift),
+            **kwargs,
+        )
+        assert float(drifting.diff().abs().max()) < 1.0, drift
+        assert float((lit - drifting).min()) > 80, drift
