@@ -28,10 +28,11 @@ from lerobot_phantom.calibration.core import Problem, seeded_split, single_threa
 from lerobot_phantom.calibration.example import write_example
 from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS, FrameProblem, load_pairs
 from lerobot_phantom.calibration.identify import parameter_intervals, select_and_identify
-from lerobot_phantom.calibration.noise import apply_noise_finding, select_shot_noise
+from lerobot_phantom.calibration.noise import apply_noise_finding, held_back_for_structure, select_shot_noise
 from lerobot_phantom.calibration.projection import TripleProblem, is_triple_table
 from lerobot_phantom.calibration.report import build_report, write_outputs
 from lerobot_phantom.calibration.stripes import StripeProblem, is_stripe_table
+from lerobot_phantom.calibration.structure import fit_items_structure
 from lerobot_phantom.transforms.registry import CAMERA_ATTACKS
 
 SUPPORTED = {
@@ -172,6 +173,17 @@ def calibrate(cfg: CalibrateConfig) -> dict:
                     margin=cfg.margin,
                     folds=cfg.folds,
                 )
+                if noise["kept"]:
+                    structure = fit_items_structure(
+                        problem,
+                        extended,
+                        fit_items,
+                        base_mse=steps[0].validation_error ** 2,  # frame pairs select by RMSE
+                        folds=cfg.folds,
+                        seed=cfg.seed,
+                        rng=np.random.default_rng([cfg.seed, 5]),
+                    )
+                    noise = held_back_for_structure(noise, structure)
                 extended = apply_noise_finding(report, extended, noise)
             write_outputs(problem, report, base, extended, heldout_items, out)
     return report

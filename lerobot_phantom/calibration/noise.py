@@ -42,7 +42,12 @@ signal against the brightest: its interval not above ``TREND_FACTOR``; read nois
 noise has under a curve, so a faster one means the curve compresses bright values more than the one assumed). A camera's photon noise is always present; it
 is named as a cause of the residual only where it is what the residual mostly is. When (4) fails, the curve the
 residuals were read through is not the camera's, and the report says "not identifiable" with why, instead of
-dividing the variance between two terms that the frames cannot tell apart. It runs after the mean model is
+dividing the variance between two terms that the frames cannot tell apart. And (5) the mean model leaves no
+structure in the fit pairs' cross-fitted residuals (``structure.fit_items_structure``, the held-out structure
+tests on fit pairs alone): a residual that still holds a mean effect the library has no name for is not sensor
+noise, and its variance grows with the light wherever that effect does (the independent simulator's EM pixel slip
+and projector falloff were named photon noise, each beside the structure it reports: docs/bench/session58.md).
+It runs after the mean model is
 selected, on that model's residuals, and changes no prediction: it is reported under ``noise`` and in the findings,
 never as an effect of the written (mean) model.
 """
@@ -281,7 +286,8 @@ def select_shot_noise(
         "validation on the fit pairs; named if the validation noise-scale ratio exp(NLL gain) is above 1, the "
         f"{100 * intervals['shot'].level:.0f}% bootstrap interval of shot (over fit pairs) excludes 0 and photon "
         f"noise is at least {SHOT_SHARE:.0%} of the modelled residual variance, also beside a multiplicative "
-        "term (variance gain^2 x^2)",
+        "term (variance gain^2 x^2), and the mean model leaves no structure in the fit pairs' cross-fitted "
+        "residuals (the held-out structure tests on fit pairs alone)",
         "tone_curve": tone_curve_name(curve),
         "validation_noise_scale_ratio": validation_ratio,
         "heldout_noise_scale_ratio": heldout_ratio,
@@ -370,6 +376,20 @@ def shot_noise_reasons(
             "proportion to it, which is not a sensor's noise"
         )
     return reasons, curve_fails
+
+
+def held_back_for_structure(noise: dict, structure: dict) -> dict:
+    """``noise`` (a kept ``select_shot_noise`` result) not named when ``structure`` (the fit pairs' cross-fitted
+    residual tests, condition 5 of the module docstring) finds structure left; the structure reading is recorded
+    either way."""
+    noise = {**noise, "fit_items_structure": structure}
+    if not structure["structure_remains"]:
+        return noise
+    reason = (
+        f"the mean model leaves structure in the fit pairs' residuals ({structure['summary']}): the residual is not "
+        "sensor noise alone, so how its variance grows with the light says nothing about photon noise"
+    )
+    return {**noise, "kept": False, "status": "not identified", "reasons": [*noise["reasons"], reason]}
 
 
 def _scaled(interval: Interval, f) -> dict:

@@ -29,7 +29,9 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   (structure.displacement_tests); the outlying-item test: {variable "items", value,
   outlying_items, largest_fit_item_error, significant, where}]} (``calibration/structure.py``; ``tested_on`` says
   whether the fit items' cross-fitted residuals joined fewer than ``structure.MIN_TESTED_ITEMS`` held-out items);
-- ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs);
+- ``residual_analysis`` {base, extended}: binned held-out RMSE per variable; ``noise`` (frame pairs; with
+  ``fit_items_structure`` {structure_remains, summary, tested_on, tests}, the fit pairs' cross-fitted residual
+  tests, where conditions 1-4 of noise.py passed: structure.fit_items_structure);
   ``per_capture_heldout_rmse`` (laser captures).
 """
 

@@ -203,26 +203,61 @@ def residual_structure(
     if sample is None or not sample.residual:
         out["summary"] = "not tested (this input has no residual sample)"
         return out
-    residual_all = np.concatenate(sample.residual)
-    mean_square = float(np.mean(residual_all**2))
+    out["tests"] = sample_tests(sample, base_mse, rng)
+    if fit_items is not None:
+        out["tests"] += outlying_item_tests(
+            problem, fit, items, fit_items, share_of_base_mse(sample, base_mse)
+        )
+    found = [t for t in out["tests"] if t["significant"]]
+    out["structure_remains"] = bool(found)
+    out["summary"] = structure_summary(found, residual)
+    return out
 
-    def share_of_base(statistic: float) -> float:
-        return statistic * mean_square / max(base_mse, 1e-300)
 
+def share_of_base_mse(sample: ResidualSample, base_mse: float) -> Callable[[float], float]:
+    """A statistic that is a share of ``sample``'s mean square -> its share of the base model's ``base_mse``."""
+    mean_square = float(np.mean(np.concatenate(sample.residual) ** 2))
+    return lambda statistic: statistic * mean_square / max(base_mse, 1e-300)
+
+
+def sample_tests(sample: ResidualSample, base_mse: float, rng: np.random.Generator) -> list[dict]:
+    """Every test of the module docstring that reads a residual sample alone (all but the outlying items)."""
+    share_of_base = share_of_base_mse(sample, base_mse)
     family = len(sample.covariates) + len(sample.noise_position)
-    out["tests"] = (
+    return (
         dependence_tests(sample, share_of_base, rng, family=family)
         + variance_tests(sample, base_mse, rng, family=family)
         + neighbour_tests(sample, share_of_base, rng)
         # last of the tests that draw from rng: the others' draws are those of a sample without lines
         + displacement_tests(sample, share_of_base, rng)
     )
-    if fit_items is not None:
-        out["tests"] += outlying_item_tests(problem, fit, items, fit_items, share_of_base)
-    found = [t for t in out["tests"] if t["significant"]]
-    out["structure_remains"] = bool(found)
-    out["summary"] = structure_summary(found, residual)
-    return out
+
+
+def fit_items_structure(
+    problem,
+    fit: Fit,
+    fit_items: np.ndarray,
+    *,
+    base_mse: float,
+    folds: int,
+    seed: int,
+    rng: np.random.Generator,
+) -> dict:
+    """The sample tests on the fit items' cross-fitted residuals alone (the written model refitted without each of
+    the selection's folds predicts the fold it left out; ``base_mse``: the base model's cross-validated mean squared
+    error over the fit items): what the fit side of a calibration may know of the structure its model leaves,
+    with no held-out item read. A JSON-ready dict like :func:`residual_structure`'s."""
+    splits = kfold(fit_items, folds, seed + 1)  # the selection's folds (core.forward_select)
+    sample = cross_fitted_sample(problem, fit, splits, rng)
+    tests = sample_tests(sample, base_mse, rng) if sample is not None and sample.residual else []
+    found = [t for t in tests if t["significant"]]
+    return {
+        "tested_on": f"the {len(fit_items)} fit items' residuals under the written model refitted without each of "
+        f"{len(splits)} folds",
+        "tests": tests,
+        "structure_remains": bool(found),
+        "summary": structure_summary(found, "cross-fitted residual of the fit items"),
+    }
 
 
 def dependence_tests(

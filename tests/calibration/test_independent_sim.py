@@ -399,9 +399,10 @@ def unexplained_structure(report: dict) -> str | None:
     return structure.get("summary") or "structure remains"
 
 
-def case_camera(case: Case) -> tuple[int, np.random.Generator, cs.Camera]:
-    """The case's seed, its generator (after the camera's draws; the render draws next) and its camera."""
-    seed = case_seed(case)
+def case_camera(case: Case, seed: int | None = None) -> tuple[int, np.random.Generator, cs.Camera]:
+    """The case's seed (``seed``, else this run's), its generator (after the camera's draws; the render draws next)
+    and its camera."""
+    seed = case_seed(case) if seed is None else seed
     rng = np.random.default_rng(seed)
     overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
     if case.name == "projection_sensor_gamma":
@@ -410,10 +411,11 @@ def case_camera(case: Case) -> tuple[int, np.random.Generator, cs.Camera]:
 
 
 @cache
-def run_case(name: str, root: str) -> dict:
+def run_case(name: str, root: str, seed: int | None = None) -> dict:
+    """The case calibrated on its draw of this run (or of case seed ``seed``), kept for the run."""
     case = CASE_BY_NAME[name]
-    seed, rng, camera = case_camera(case)
-    folder = Path(root) / name
+    seed, rng, camera = case_camera(case, seed)
+    folder = Path(root) / f"{name}_{seed}"
     cs.write_pairs(folder / "pairs", case.render(rng, camera))
     report = calibrate(
         CalibrateConfig(
@@ -471,6 +473,20 @@ def test_case(name, root):
 
 
 @pytest.mark.slow
+@pytest.mark.slow
+def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_pairs(root):
+    """The hum bars on the draw where photon noise was named beside them (suite run of session 58, master seed
+    3527317232): the mean model leaves the bars in the fit pairs' cross-fitted residuals, so the variance law read
+    from them is not the sensor's and photon noise is held back, with that reason, by the fit side alone."""
+    report = run_case("truncation_hum_bars_unnamed", root, seed=637185383)["report"]
+    noise = report["noise"]
+    assert not noise["kept"] and "shot_noise" not in named_causes(report)
+    assert noise["fit_items_structure"]["structure_remains"]
+    assert any("leaves structure in the fit pairs' residuals" in reason for reason in noise["reasons"])
+    # conditions 1-4 alone would have named it: the structure is the only reason given beside them
+    assert len(noise["reasons"]) == 1
+
+
 @pytest.mark.xfail(
     reason="issue 12 open: the share of effect cases named swings between draws. Core selection on six master "
     "seeds in session 15: 48 of 62. Session 16 (exclusive tone curves, groups of three, a log gain): the blinding "

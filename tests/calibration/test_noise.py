@@ -18,6 +18,7 @@ from lerobot_phantom.calibration.noise import (
     TREND_FACTOR,
     NoiseSample,
     fit_variance,
+    held_back_for_structure,
     linearise,
     mean_nll,
     select_shot_noise,
@@ -181,3 +182,23 @@ def test_light_that_fluctuates_in_proportion_to_its_level_is_not_named_photon_no
     # report.md's noise section gives the same figure
     section = "\n".join(_noise_lines(noise))
     assert f"the light's relative sd {relative_sd['estimate']:.3g}" in section
+
+
+def test_photon_noise_is_held_back_where_the_fit_pairs_hold_structure():
+    """Condition 5 (noise.py): photon noise that conditions 1-4 name is not named when the mean model leaves
+    structure in the fit pairs' residuals, and the report says which structure."""
+    noise = select(frame_pairs(1, shot=True, read=1.5 / FULL_WELL))
+    assert noise["kept"]
+    none_left = {
+        "structure_remains": False,
+        "summary": "no structure left",
+        "tests": [],
+        "tested_on": "fit pairs",
+    }
+    assert held_back_for_structure(noise, none_left) == {**noise, "fit_items_structure": none_left}
+    summary = "unexplained structure: residual depends on row (eta2 0.749)"
+    held = held_back_for_structure(noise, {**none_left, "structure_remains": True, "summary": summary})
+    assert not held["kept"] and held["status"] == "not identified"
+    assert len(held["reasons"]) == 1 and summary in held["reasons"][0]
+    assert summary in "\n".join(_noise_lines(held))  # report.md says why
+    assert noise["kept"] and not noise["reasons"]  # the result it was given is left as it was
