@@ -24,7 +24,7 @@ import pandas as pd
 
 from lerobot_phantom._cli import normalize_argv
 from lerobot_phantom.calibration.captures import IMAGE_SUFFIXES, MultiCapture
-from lerobot_phantom.calibration.core import Problem, seeded_split, single_threaded
+from lerobot_phantom.calibration.core import Fit, Problem, Step, seeded_split, single_threaded
 from lerobot_phantom.calibration.example import write_example
 from lerobot_phantom.calibration.frame_models import FRAME_PROBLEMS, FrameProblem, load_pairs
 from lerobot_phantom.calibration.identify import parameter_intervals, select_and_identify
@@ -164,29 +164,34 @@ def calibrate(cfg: CalibrateConfig) -> dict:
             )
             if isinstance(problem, FrameProblem):
                 # noise changes no prediction, so it is judged by likelihood after the mean model (see noise.py)
-                noise = select_shot_noise(
-                    problem,
-                    extended,
-                    fit_items,
-                    heldout_items,
-                    seed=cfg.seed,
-                    margin=cfg.margin,
-                    folds=cfg.folds,
+                extended = apply_noise_finding(
+                    report, extended, judge_noise(problem, cfg, extended, steps, fit_items, heldout_items)
                 )
-                if noise["kept"]:
-                    structure = fit_items_structure(
-                        problem,
-                        extended,
-                        fit_items,
-                        base_mse=steps[0].validation_error ** 2,  # frame pairs select by RMSE
-                        folds=cfg.folds,
-                        seed=cfg.seed,
-                        rng=np.random.default_rng([cfg.seed, 5]),
-                    )
-                    noise = held_back_for_structure(noise, structure)
-                extended = apply_noise_finding(report, extended, noise)
             write_outputs(problem, report, base, extended, heldout_items, out)
     return report
+
+
+def judge_noise(
+    problem: FrameProblem, cfg: CalibrateConfig, fit: Fit, steps: list[Step], fit_items, heldout_items
+) -> dict:
+    """noise.py's verdict on ``shot_noise`` under the written mean model ``fit``: its conditions 1-4, then, where
+    they name it, condition 5 on the fit pairs' cross-fitted residuals (``steps``: the selection's, whose first
+    score is the base model's cross-validated RMSE over the fit pairs, frame pairs being selected by RMSE)."""
+    noise = select_shot_noise(
+        problem, fit, fit_items, heldout_items, seed=cfg.seed, margin=cfg.margin, folds=cfg.folds
+    )
+    if not noise["kept"]:
+        return noise
+    structure = fit_items_structure(
+        problem,
+        fit,
+        fit_items,
+        base_mse=steps[0].validation_error ** 2,
+        folds=cfg.folds,
+        seed=cfg.seed,
+        rng=np.random.default_rng([cfg.seed, 5]),
+    )
+    return held_back_for_structure(noise, structure)
 
 
 def main(argv: list[str] | None = None) -> None:
