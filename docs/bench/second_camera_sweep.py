@@ -7,10 +7,13 @@ checkout to measure (session 29):
 
     OMP_NUM_THREADS=1 HF_HUB_OFFLINE=1 PYTHONPATH=. python docs/bench/second_camera_sweep.py SEED [SEED ...]
 
-``--frames lit`` or ``--frames interior`` (before the seeds) runs one frame rule's cases only.
+``--frames lit`` or ``--frames interior`` (before the seeds) runs one frame rule's cases only. ``groups`` gives
+the number of new effects each selection step took, in order (session 58: a 3 is a group of three, which only
+stripe tables score since session 57).
 """
 
 import importlib
+import itertools
 import os
 import sys
 from pathlib import Path
@@ -19,6 +22,15 @@ from tempfile import TemporaryDirectory
 sys.path.insert(0, str(Path("tests/calibration").resolve()))
 
 CASES = (("lit", "exposure_us"), ("interior", "exposure"))
+
+
+def groups_taken(steps: list[dict]) -> list[int]:
+    """New effects per selection step taken: between two steps that scored groups (``tried``), the model grew by
+    the group the first took; the steps inside a group (its prefixes) scored none."""
+    deciding = [k for k, step in enumerate(steps) if step["tried"]]
+    if steps and not steps[-1]["tried"]:  # every candidate taken: the last model had none left to score
+        deciding.append(len(steps) - 1)
+    return [len(steps[j]["effects"]) - len(steps[i]["effects"]) for i, j in itertools.pairwise(deciding)]
 
 
 def main(seeds: list[int], cases_run=CASES) -> None:
@@ -39,7 +51,9 @@ def main(seeds: list[int], cases_run=CASES) -> None:
             print(
                 f"{seed:>10} {frames:8s} held-out {extended:7.2f} rows (base {base:6.1f}) row time "
                 f"{row_time * 1e6:6.1f} us (camera {camera['row_time'] * 1e6:5.1f}) named "
-                f"{','.join(sorted(report['extended']['effects']))}{'  ABOVE 30' if failed else ''}",
+                f"{','.join(sorted(report['extended']['effects']))} groups "
+                f"{','.join(map(str, groups_taken(report['selection']['steps']))) or '-'}"
+                f"{'  ABOVE 30' if failed else ''}",
                 flush=True,
             )
     print(f"held-out above 30 rows: {above} of {cases}")
