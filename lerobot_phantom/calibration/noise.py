@@ -45,11 +45,10 @@ residuals were read through is not the camera's, and the report says "not identi
 dividing the variance between two terms that the frames cannot tell apart. And (5) the mean model leaves no
 structure in the fit pairs' cross-fitted residuals (``structure.fit_items_structure``, the held-out structure
 tests on fit pairs alone): a residual that still holds a mean effect the library has no name for is not sensor
-noise, and its variance grows with the light wherever that effect does (the independent simulator's EM pixel slip
-and projector falloff were named photon noise, each beside the structure it reports: docs/bench/session58.md).
-It runs after the mean model is
-selected, on that model's residuals, and changes no prediction: it is reported under ``noise`` and in the findings,
-never as an effect of the written (mean) model.
+noise, and its variance grows with the light wherever that effect does (the independent simulator's EM hum bars,
+EM pixel slip and projector falloff were named photon noise, each beside the structure the report states:
+docs/bench/session58.md). It runs after the mean model is selected, on that model's residuals, and changes no
+prediction: it is reported under ``noise`` and in the findings, never as an effect of the written (mean) model.
 """
 
 from __future__ import annotations
