@@ -414,8 +414,9 @@ def case_camera(case: Case, seed: int | None = None) -> tuple[int, np.random.Gen
 def run_case(name: str, root: str, seed: int | None = None) -> dict:
     """The case calibrated on its draw of this run (or of case seed ``seed``), kept for the run."""
     case = CASE_BY_NAME[name]
+    # the run's own draws keep the case's name (docs/bench/camsim_named_causes.py reads them back by it)
+    folder = Path(root) / (name if seed is None else f"{name}_seed{seed}")
     seed, rng, camera = case_camera(case, seed)
-    folder = Path(root) / f"{name}_{seed}"
     cs.write_pairs(folder / "pairs", case.render(rng, camera))
     report = calibrate(
         CalibrateConfig(
