@@ -172,7 +172,12 @@ def calibrate(cfg: CalibrateConfig) -> dict:
 
 
 def judge_noise(
-    problem: FrameProblem, cfg: CalibrateConfig, fit: Fit, steps: list[Step], fit_items, heldout_items
+    problem: FrameProblem,
+    cfg: CalibrateConfig,
+    fit: Fit,
+    steps: list[Step],
+    fit_items: np.ndarray,
+    heldout_items: np.ndarray,
 ) -> dict:
     """noise.py's verdict on ``shot_noise`` under the written mean model ``fit``: its conditions 1-4, then, where
     they name it, condition 5 on the fit pairs' cross-fitted residuals (``steps``: the selection's, whose first
