@@ -474,7 +474,6 @@ def test_case(name, root):
 
 
 @pytest.mark.slow
-@pytest.mark.slow
 def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_pairs(root):
     """The hum bars on the draw where photon noise was named beside them (suite run of session 58, master seed
     3527317232): the mean model leaves the bars in the fit pairs' cross-fitted residuals, so the variance law read
@@ -488,6 +487,7 @@ def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_p
     assert len(noise["reasons"]) == 1
 
 
+@pytest.mark.slow
 @pytest.mark.xfail(
     reason="issue 12 open: the share of effect cases named swings between draws. Core selection on six master "
     "seeds in session 15: 48 of 62. Session 16 (exclusive tone curves, groups of three, a log gain): the blinding "
