@@ -17,16 +17,16 @@ def main() -> None:
         for path in sorted(Path(root).glob("**/out/report.json")):
             report = json.loads(path.read_text())
             noise = report["noise"]
-            structure = noise.get("fit_items_structure")
-            held_back = [r for r in noise["reasons"] if "leaves structure in the fit pairs" in r]
+            line = f"{seed} | {path.parent.parent.name} | {noise['kept']}"
+            if "shot_share" not in noise:  # no unclipped pixel to judge the noise by
+                print(f"{line} | {noise['reasons']}")
+                continue
+            structure = noise.get("fit_items_structure")  # read only where conditions 1-4 named it
+            held_back = sum("leaves structure in the fit pairs" in r for r in noise["reasons"])
+            fit_pairs = "not read (1-4 failed)" if structure is None else structure["structure_remains"]
             print(
-                f"{seed} | {path.parent.parent.name} | {noise['kept']} | "
-                f"{len(noise['reasons']) - len(held_back)} | "
-                f"{'not read (1-4 failed)' if structure is None else structure['structure_remains']} | "
-                f"{report['unexplained_structure']['structure_remains']} | "
-                f"{noise['shot_share']['estimate']:.2f}"
-                if "shot_share" in noise
-                else f"{seed} | {path.parent.parent.name} | {noise['kept']} | {noise['reasons']}"
+                f"{line} | {len(noise['reasons']) - held_back} | {fit_pairs} | "
+                f"{report['unexplained_structure']['structure_remains']} | {noise['shot_share']['estimate']:.2f}"
             )
 
 
