@@ -30,10 +30,56 @@ def paper_start(height: int, num: int) -> int:
     return max(0, min(num, height - 2 * num))
 
 
+def count_law(counts: np.ndarray, heights: np.ndarray, intensities: np.ndarray) -> tuple[float, float, float]:
+    """The line ``r = a s`` from attack intensity ``s`` to truncation ratio, read from frames that lost
+    ``counts`` rows: (lowest slope, highest slope, jitter).
+
+    The count is ``int(h r)``, a floor (the paper's Appendix A, and ``transforms.em_truncation``): a frame that
+    lost ``n`` of ``h`` rows had ``r`` anywhere in ``[n / h, (n + 1) / h)``, and one line explains every fit frame
+    when the slopes those intervals allow overlap; each slope in the overlap is then as likely as any other.
+    Where they do not overlap (the interference's timing varies from frame to frame, or a frame was registered
+    wrongly), the ratio is given the least jitter ``d`` that makes them overlap, ``r = a s + e`` with ``|e| <= d``,
+    and the overlap is then one slope. Either way a frame's ratio is predicted uniform over
+    ``[s low - d, s high + d]``. A least-squares line through the counts (``n / h``, rounded back, until session
+    59) sits half a row low and has no spread of its own: a frame beyond the fit frames' intensities was predicted a
+    row short, every row below its band wrong, and a free band start looked like a gain on a null draw."""
+    low, high = counts / heights, (counts + 1) / heights
+    lit = intensities > 0
+    # the slope intervals of frames i and j overlap once d >= (low_i s_j - high_j s_i) / (s_i + s_j); a frame
+    # at zero intensity allows no slope to move it, only jitter (d >= low_i)
+    pairwise = np.add.outer(intensities, intensities)
+    needed = np.outer(low, intensities) - np.outer(intensities, high)
+    jitter = max(
+        0.0,
+        float(np.max(needed[pairwise > 0] / pairwise[pairwise > 0], initial=0.0)),
+        float(np.max(low[~lit], initial=0.0)),
+    )
+    if not lit.any():
+        return 0.0, 0.0, jitter
+    lowest = max(0.0, float(np.max((low[lit] - jitter) / intensities[lit])))
+    highest = float(np.min((high[lit] + jitter) / intensities[lit]))
+    return lowest, max(lowest, highest), jitter
+
+
+def count_probabilities(low: float, high: float, height: int, most: int) -> tuple[np.ndarray, np.ndarray]:
+    """Rows lost, ``int(h r)`` clipped to ``[0, most]``, and their probabilities, for a ratio uniform on
+    ``[low, high]``."""
+    first, last = int(np.floor(low * height)), int(np.floor(high * height))
+    counts = np.arange(first, last + 1)
+    if high - low > 1e-12:
+        overlap = np.minimum((counts + 1) / height, high) - np.maximum(counts / height, low)
+        weights = np.clip(overlap, 0.0, None)
+    else:
+        counts, weights = counts[:1], np.ones(1)
+    counts, where = np.unique(np.clip(counts, 0, most), return_inverse=True)
+    merged = np.bincount(where, weights=weights, minlength=len(counts))
+    keep = merged > 0
+    return counts[keep], merged[keep] / merged[keep].sum()
+
+
 class TruncationFrames(LatentFrameProblem):
-    """The fitted model predicts how many rows a frame loses from its intensity (``ratio_per_intensity``, with
-    the scatter of the fit frames' ratios about that line as its prior); where the band starts is the paper's
-    ``int(h r)``, or with ``free_band_position`` unknowable in advance (uniform over every possible start). Fit
+    """The fitted model predicts how many rows a frame loses from its intensity (:func:`count_law`); where the
+    band starts is the paper's ``int(h r)``, or with ``free_band_position`` unknowable in advance (uniform over every possible start). Fit
     frames are registered by an exhaustive search over row counts and starts (the squared error of every
     (output row, source row) match is computed once per pair); held-out frames are scored with the latent
     marginalised (``LatentFrameProblem``)."""
@@ -53,7 +99,7 @@ class TruncationFrames(LatentFrameProblem):
         self._placements: dict[tuple[bool, int], tuple[int, int]] = {}
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
-        return [Param("ratio_per_intensity", 0.2, 0.0, 0.5), Param("ratio_spread", 0.0, 0.0, 0.5)]
+        return [Param("ratio_per_intensity", 0.2, 0.0, 0.5), Param("ratio_jitter", 0.0, 0.0, 0.5)]
 
     def match_costs(self, index: int) -> np.ndarray:
         """``costs[i, j]``: squared error of predicting attacked row ``i`` by clean row ``j`` (cached)."""
@@ -94,19 +140,21 @@ class TruncationFrames(LatentFrameProblem):
             self._placements[key] = (best[1], best[2])
         return self._placements[key]
 
-    def predicted_counts(self, fit: Fit, index: int) -> np.ndarray:
-        """Rows lost the fitted model expects for pair ``index``: its intensity on the fitted line, plus each fit
-        frame's scatter about the line (the prior; equally likely)."""
+    def predicted_counts(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        """Rows lost the fitted model expects for pair ``index`` and their probabilities (:func:`count_law`)."""
         pair = self.pairs[index]
-        ratios = fit.params["ratio_per_intensity"] * pair.intensity + np.asarray(fit.extra["ratio_scatter"])
-        return np.clip(np.round(ratios * pair.height).astype(int), 0, pair.height // 2)
+        low, high = fit.extra["slope_range"]
+        jitter = fit.params["ratio_jitter"]
+        return count_probabilities(
+            pair.intensity * low - jitter, pair.intensity * high + jitter, pair.height, pair.height // 2
+        )
 
     def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
         free = "free_band_position" in fit.effects
         height = self.pairs[index].height
-        counts, weights = np.unique(self.predicted_counts(fit, index), return_counts=True)
+        counts, weights = self.predicted_counts(fit, index)
         sse, prior = [], []
-        for num, weight in zip(counts, weights / weights.sum(), strict=True):
+        for num, weight in zip(counts, weights, strict=True):
             starts = self.starts(free, height, int(num))
             sse.append(self.band_costs(index, int(num), starts))
             prior.append(np.full(len(starts), weight / len(starts)))
@@ -123,19 +171,16 @@ class TruncationFrames(LatentFrameProblem):
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         free = "free_band_position" in effects
-        ratios, strengths = [], []
+        counts, heights, strengths = [], [], []
         for i in items:
-            num, _ = self.placement(free, int(i))
-            ratios.append(num / self.pairs[int(i)].height)
+            counts.append(self.placement(free, int(i))[0])
+            heights.append(self.pairs[int(i)].height)
             strengths.append(self.pairs[int(i)].intensity)
-        s, r = np.asarray(strengths), np.asarray(ratios)
-        # the shared part: the ratio per unit of attack intensity (least squares through the origin)
-        slope = float((s * r).sum() / max((s * s).sum(), 1e-12))
-        scatter = r - slope * s
+        low, high, jitter = count_law(np.asarray(counts), np.asarray(heights), np.asarray(strengths))
         fit = Fit(
             effects,
-            {"ratio_per_intensity": slope, "ratio_spread": float(np.sqrt(np.mean(scatter**2)))},
-            {"ratio_scatter": scatter.tolist()},
+            {"ratio_per_intensity": 0.5 * (low + high), "ratio_jitter": jitter},
+            {"slope_range": [low, high]},
         )
         fit.extra["noise_variance"] = self.noise_variance(fit, items)
         return fit
