@@ -77,3 +77,22 @@ def test_count_probabilities_are_the_floors_of_a_uniform_ratio():
     assert counts.tolist() == [18, 19, 20] and np.allclose(weights, [0.25, 0.25, 0.5])
     counts, weights = count_probabilities(0.2, 0.2, 40, 20)  # one ratio, one count
     assert counts.tolist() == [8] and weights.tolist() == [1.0]
+
+
+def test_a_free_band_reaching_into_the_repeated_tail_is_registered_and_an_unchanged_frame_leaves_the_count_free():
+    rng = np.random.default_rng(3)
+    clean = torch.from_numpy(rng.uniform(0.0, 1.0, (3, HEIGHT, WIDTH)))
+    num = 10
+    pairs = []
+    for start in (5, HEIGHT - 2 * num + 4, HEIGHT - num):  # inside the paper's clamp, into the tail, the tail
+        attacked = clean[:, torch.from_numpy(truncation_source_rows(HEIGHT, num, start))]
+        pairs.append(Pair(f"start_{start}", clean, attacked, None, 0.8))
+    problem = TruncationFrames(pairs, 0)
+    assert problem.placement(True, 0) == (num, 5)
+    assert problem.placement(True, 1) == (num, HEIGHT - 2 * num + 4)
+    assert torch.equal(pairs[2].attacked, clean)
+    # the two frames that show their count agree with a line; the unchanged one would have read 0 rows lost
+    fit = problem.fit(frozenset({"free_band_position"}), np.arange(3))
+    assert fit.params["ratio_jitter"] == 0.0
+    low, high = fit.extra["slope_range"]
+    assert np.floor(HEIGHT * low * 0.8) == num == np.floor(HEIGHT * (high - 1e-9) * 0.8)

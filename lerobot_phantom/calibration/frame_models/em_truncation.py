@@ -123,7 +123,11 @@ class TruncationFrames(LatentFrameProblem):
         return same[starts] + (moved[height - num] - moved[starts]) + (same[-1] - same[height - num])
 
     def starts(self, free: bool, height: int, num: int) -> np.ndarray:
-        return np.arange(0, height - 2 * num + 1) if free else np.array([paper_start(height, num)])
+        """Where a band of ``num`` rows can start: the paper's row, or with a free position any row from the top
+        to ``h - num``, the band then reaching into the rows the tail repeats (at ``h - num`` it is the tail
+        itself and the frame comes out as it went in). Until session 59 a free band stopped at ``h - 2 num``,
+        the paper's clamp, and a quarter of the starts an independent simulator drew had no placement."""
+        return np.arange(0, height - num + 1) if free else np.array([paper_start(height, num)])
 
     def placement(self, free: bool, index: int) -> tuple[int, int]:
         """(rows lost, band start) that best explain pair ``index`` (registration: fit frames, or reporting)."""
@@ -173,8 +177,12 @@ class TruncationFrames(LatentFrameProblem):
         free = "free_band_position" in effects
         counts, heights, strengths = [], [], []
         for i in items:
-            counts.append(self.placement(free, int(i))[0])
-            heights.append(self.pairs[int(i)].height)
+            num, band_start = self.placement(free, int(i))
+            height = self.pairs[int(i)].height
+            if free and (num == 0 or band_start + num >= height):
+                continue  # an unchanged frame: the band may have been the tail itself, of any size
+            counts.append(num)
+            heights.append(height)
             strengths.append(self.pairs[int(i)].intensity)
         low, high, jitter = count_law(np.asarray(counts), np.asarray(heights), np.asarray(strengths))
         fit = Fit(
