@@ -396,6 +396,15 @@ def kfold(
     return splits
 
 
+def selection_folds(
+    fit_items: np.ndarray, folds: int, seed: int, max_train_items: int | None = None
+) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The selection's folds of the fit items (:func:`forward_select`), seeded ``seed + 1`` so that they draw from
+    another stream than the calibration's split. Every reading of the fit side "refitted without each selection
+    fold" (cross-fitted residuals, the photon-noise validation) uses these, so all of them see the same folds."""
+    return kfold(fit_items, folds, seed + 1, max_train_items)
+
+
 @dataclass
 class Step:
     effects: list[str]
@@ -576,7 +585,7 @@ def forward_select(
     Before that comparison, a scored group is set aside (``Step.set_aside``, with the reason) when a member's own
     parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
     of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`)."""
-    splits = kfold(fit_items, folds, seed + 1, max_train_items)
+    splits = selection_folds(fit_items, folds, seed, max_train_items)
 
     def aligned(per_item: dict[int, float]) -> np.ndarray:
         return np.array([per_item[int(i)] for i in fit_items], np.float64)

@@ -62,7 +62,7 @@ import torch
 from scipy import ndimage
 from scipy.optimize import nnls
 
-from lerobot_phantom.calibration.core import Fit, binned_rmse, kfold
+from lerobot_phantom.calibration.core import Fit, binned_rmse, selection_folds
 from lerobot_phantom.calibration.identify import Interval, bootstrap
 from lerobot_phantom.calibration.tone import shoulder_decode
 from lerobot_phantom.transforms import physics
@@ -317,7 +317,7 @@ def validation_noise_scale_ratio(
     fold has unclipped pixels on both sides."""
     validation = {"read": 0.0, "shot": 0.0}
     count = 0
-    for train, val in kfold(fit_items, folds, seed + 1):
+    for train, val in selection_folds(fit_items, folds, seed):
         trained, scored = joined(train), joined(val)
         if len(trained.residual) == 0 or len(scored.residual) == 0:
             continue

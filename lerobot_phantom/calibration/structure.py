@@ -56,7 +56,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import Fit, bin_index, kfold
+from lerobot_phantom.calibration.core import Fit, bin_index, selection_folds
 from lerobot_phantom.calibration.identify import RESUMMED_DRAWS, percentile_interval, resummed_totals
 from lerobot_phantom.calibration.noise import NoiseSample, fit_variance, model_variance
 
@@ -178,7 +178,7 @@ def residual_structure(
     )
     few = len(items) < MIN_TESTED_ITEMS
     if sample is not None and few and folds is not None and fit_items is not None and len(fit_items) > 1:
-        splits = kfold(fit_items, folds, seed + 1)  # the selection's folds (core.forward_select)
+        splits = selection_folds(fit_items, folds, seed)
         sample = sample.joined(cross_fitted_sample(problem, fit, splits, rng))
         tested_on += (
             f", and (fewer than {MIN_TESTED_ITEMS} held-out items) the {len(fit_items)} fit items' residuals under "
@@ -247,7 +247,7 @@ def fit_items_structure(
     the selection's folds predicts the fold it left out; ``base_mse``: the base model's cross-validated mean squared
     error over the fit items): what the fit side of a calibration may know of the structure its model leaves,
     with no held-out item read. A JSON-ready dict like :func:`residual_structure`'s."""
-    splits = kfold(fit_items, folds, seed + 1)  # the selection's folds (core.forward_select)
+    splits = selection_folds(fit_items, folds, seed)
     sample = cross_fitted_sample(problem, fit, splits, rng)
     tests = sample_tests(sample, base_mse, rng) if sample is not None and sample.residual else []
     found = [t for t in tests if t["significant"]]
