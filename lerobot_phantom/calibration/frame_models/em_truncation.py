@@ -79,10 +79,10 @@ def count_probabilities(low: float, high: float, height: int, most: int) -> tupl
 
 class TruncationFrames(LatentFrameProblem):
     """The fitted model predicts how many rows a frame loses from its intensity (:func:`count_law`); where the
-    band starts is the paper's ``int(h r)``, or with ``free_band_position`` unknowable in advance (uniform over every possible start). Fit
-    frames are registered by an exhaustive search over row counts and starts (the squared error of every
-    (output row, source row) match is computed once per pair); held-out frames are scored with the latent
-    marginalised (``LatentFrameProblem``)."""
+    band starts is the paper's ``int(h r)``, or with ``free_band_position`` unknowable in advance (uniform over
+    every possible start, :meth:`starts`). Fit frames are registered by an exhaustive search over row counts and
+    starts (the squared error of every (output row, source row) match is computed once per pair); held-out frames
+    are scored with the latent marginalised (``LatentFrameProblem``)."""
 
     attack = "em_truncation"
     base_model = (
