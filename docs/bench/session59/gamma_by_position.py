@@ -6,7 +6,8 @@ then fits each model in ``EFFECTS`` (effects joined by ``+``) on the calibration
 pixels per pair drawn from the whole frame, from the half of the pixels nearest the frame's centre, and from the
 half farthest from it, and prints the fitted parameters. A camera's tone curve acts on every pixel alike, so a
 gamma that is the same in both halves and whole is the camera's; one that appears only when the halves are pooled
-stands for something that changes across the frame.
+stands for something that changes across the frame. The last line of each model with a gamma compares the whole
+frame's departure from 1 with the halves' mean departure (1 where the gamma is the same everywhere).
 """
 
 from __future__ import annotations
@@ -57,11 +58,18 @@ def main() -> None:
         f"{name} under master seed {master}: case seed {seed}, tone {camera.tone}, gamma {camera.tone_gamma:.3f}"
     )
     for effects in (frozenset(e.split("+")) for e in sys.argv[4:]):
+        gammas = {}
         for region in ("whole", "inner", "outer"):
             problem.samples = region_samples(problem, region)
             fit = problem.fit(effects, fit_items)
             params = ", ".join(f"{k} {v:.3f}" for k, v in fit.params.items())
             print(f"  {'+'.join(sorted(effects))} | {region} | {params}")
+            gammas[region] = fit.params.get("gamma")
+        if gammas["whole"] is not None:
+            halves = 0.5 * (gammas["inner"] + gammas["outer"]) - 1.0
+            print(
+                f"  pooled excess, (whole - 1) / (mean of the halves - 1): {(gammas['whole'] - 1.0) / halves:.2f}"
+            )
 
 
 if __name__ == "__main__":
