@@ -495,8 +495,9 @@ def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_p
         # through the counts predicted two frames beyond its intensities a row short, and the band's freedom to
         # start anywhere hedged the missing row (cross-validated 3.43 -> 3.12 grey levels, no held-out gain)
         ("truncation_null", 832276012),
-        # a planted free band not named (session 59's draws): three of eight bands started past h - 2n, reaching
-        # into the rows the tail repeats, where the free band had no placement
+        # a planted free band not named (session 59's draws): two of eight bands start past h - 2n, reaching into
+        # the rows the tail repeats, where the free band had no placement, and one frame is unchanged (its band was
+        # the tail itself)
         ("truncation_free_band", 3533591311),
     ],
 )
