@@ -21,6 +21,13 @@ Deviations from the paper's code (and why):
   the paper's ``np.delete`` / ``np.append`` does.
 * **"random"** draws the authors' adversarial-training ratio ``r ~ U(0.1, 0.3)``.
 
+Calibrated options (``lerobot-phantom-calibrate --attack em_truncation`` writes them; issue 12):
+``ratio_per_intensity`` replaces the level table by the measured line ``r = a s``, and ``free_band_position``
+draws each sample's band start uniformly over every row from the top to ``h - num`` (the interference corrupts
+the buffer address at a moment set by its timing, not by how many rows are lost; at ``h - num`` the band is the
+tail itself and the frame passes unchanged). The count's jitter the calibration reports is not drawn: at zero
+intensity there is no attack.
+
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
 band shrinks as ``r`` grows, so on texture-free noise images the paper's strong level differs from the clean image
@@ -45,9 +52,11 @@ def truncation_row_index(height: int, ratio: torch.Tensor) -> torch.Tensor:
     return _rows_losing(height, torch.floor(height * ratio).long())
 
 
-def _rows_losing(height: int, num: torch.Tensor) -> torch.Tensor:
-    """``truncation_row_index`` from the number of lost rows per sample ``num`` (long ``(B,)``)."""
-    start = torch.clamp(torch.minimum(num, height - 2 * num), min=0)
+def _rows_losing(height: int, num: torch.Tensor, start: torch.Tensor | None = None) -> torch.Tensor:
+    """``truncation_row_index`` from the number of lost rows per sample ``num`` (long ``(B,)``); the band starts
+    at the paper's clamped row, or at ``start`` (long ``(B,)``, at most ``height - num``)."""
+    if start is None:
+        start = torch.clamp(torch.minimum(num, height - 2 * num), min=0)
     rows = torch.arange(height, device=num.device).unsqueeze(0)  # (1, H)
     num, start = num.unsqueeze(1), start.unsqueeze(1)
     shifted = (rows >= start) & (rows < height - num)
@@ -68,23 +77,34 @@ def _ratios(ratio: float | torch.Tensor, batch: int) -> list[float]:
     return values
 
 
-def em_truncation(image: torch.Tensor, ratio: float | torch.Tensor) -> torch.Tensor:
+def em_truncation(
+    image: torch.Tensor, ratio: float | torch.Tensor, start_fraction: torch.Tensor | None = None
+) -> torch.Tensor:
     """EM truncation of ``image`` (``(..., C, H, W)``, any dtype) with truncation ratio ``ratio`` in [0, 0.5].
 
-    ``ratio`` is a float or a tensor with one value per image of the batch (leading dims flattened). Returns a
-    new tensor of the input's shape, dtype and device. See the module docstring for the algorithm and the fix.
+    ``ratio`` is a float or a tensor with one value per image of the batch (leading dims flattened). Without
+    ``start_fraction`` the band starts where the paper puts it; with it (one value in [0, 1) per image), at
+    ``floor(start_fraction * (h - num + 1))``, anywhere from the top to ``h - num``. Returns a new tensor of the
+    input's shape, dtype and device. See the module docstring for the algorithm and the fix.
     """
     check_image(image)
     channels, height, width = image.shape[-3:]
     batch = image.numel() // (channels * height * width)
     ratios = _ratios(ratio, batch)
     lost = {int(height * r) for r in ratios}  # int(h * r) as the paper (and truncation_row_index)
-    if len(lost) == 1:  # one ratio for the whole batch: a cached row index, no per-call index arithmetic
+    if start_fraction is None and len(lost) == 1:  # one ratio for the batch: a cached row index
         index = _shared_row_index(batch * channels, height, lost.pop(), image.device)
-    else:  # per-sample ratios: still one gather of whole rows over the flattened batch
-        per_image = truncation_row_index(
-            height, torch.tensor(ratios, dtype=torch.float64, device=image.device)
-        )
+    else:  # per-sample ratios or starts: still one gather of whole rows over the flattened batch
+        num = torch.floor(height * torch.tensor(ratios, dtype=torch.float64, device=image.device)).long()
+        start = None
+        if start_fraction is not None:
+            fraction = start_fraction.detach().reshape(-1).to(device=image.device, dtype=torch.float64)
+            if fraction.numel() != batch or not bool(((fraction >= 0) & (fraction < 1)).all()):
+                raise ValueError(
+                    f"start_fraction needs one value in [0, 1) per image ({batch}), got {fraction.tolist()}"
+                )
+            start = torch.floor(fraction * (height - num + 1)).long()
+        per_image = _rows_losing(height, num, start)
         index = per_image.repeat_interleave(channels, dim=0) + height * torch.arange(
             batch * channels, device=image.device
         ).unsqueeze(1)
@@ -117,18 +137,26 @@ class EMTruncation(CameraAttack):
         intensity: IntensitySpec = "medium",
         *,
         ratio: float | None = None,
+        ratio_per_intensity: float | None = None,
+        free_band_position: bool = False,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
         if ratio is not None and not (0.0 <= float(ratio) <= MAX_RATIO):
             raise ValueError(f"ratio must lie in [0, {MAX_RATIO}], got {ratio!r}")
+        if ratio_per_intensity is not None and not (0.0 <= float(ratio_per_intensity) <= MAX_RATIO):
+            raise ValueError(f"ratio_per_intensity must lie in [0, {MAX_RATIO}], got {ratio_per_intensity!r}")
         self.ratio = None if ratio is None else float(ratio)
+        self.ratio_per_intensity = None if ratio_per_intensity is None else float(ratio_per_intensity)
+        self.free_band_position = bool(free_band_position)
 
     def ratio_for(self, s: torch.Tensor) -> torch.Tensor:
         """The truncation ratio used at intensity ``s`` (per sample)."""
         if self.ratio is not None:
             return torch.full_like(s, self.ratio, dtype=torch.float32)
+        if self.ratio_per_intensity is not None:
+            return (self.ratio_per_intensity * s).to(torch.float32)
         return interpolate_levels(s, self.LEVEL_RATIOS)
 
     def _sample(self, s, height, width, generator, device):
@@ -137,15 +165,25 @@ class EMTruncation(CameraAttack):
             len(set(values)) == 1
         ):  # a fixed intensity: the level map once per value, not a dozen tiny ops per call
             ratio = self._cached(("ratio", values[0]), lambda: float(self.ratio_for(s[:1])[0]))
-            return {"ratio": torch.full((len(values),), ratio, dtype=torch.float32, device=device)}
-        return {"ratio": self.ratio_for(s).to(device)}
+            params = {"ratio": torch.full((len(values),), ratio, dtype=torch.float32, device=device)}
+        else:
+            params = {"ratio": self.ratio_for(s).to(device)}
+        if self.free_band_position:
+            if generator is None:
+                raise ValueError("free_band_position=True needs a torch.Generator (pass generator= or seed=)")
+            start = torch.rand(len(values), generator=generator, dtype=torch.float64, device=generator.device)
+            params["start_fraction"] = start.to(device)
+        return params
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        return em_truncation(x, params["ratio"])
+        return em_truncation(x, params["ratio"], params.get("start_fraction"))
 
     def apply_params(self, img: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         # A row gather is exact in any dtype and channel count, so skip the float RGB round trip of the base.
-        return em_truncation(img, params["ratio"])
+        return em_truncation(img, params["ratio"], params.get("start_fraction"))
 
     def extra_repr(self) -> str:
-        return super().extra_repr() + ("" if self.ratio is None else f", ratio={self.ratio}")
+        extra = "" if self.ratio is None else f", ratio={self.ratio}"
+        if self.ratio_per_intensity is not None:
+            extra += f", ratio_per_intensity={self.ratio_per_intensity}"
+        return super().extra_repr() + extra + (", free_band_position=True" if self.free_band_position else "")

@@ -502,9 +502,16 @@ def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_p
     ],
 )
 def test_em_truncation_draws_that_failed(name, seed, root):
+    from lerobot_phantom.transforms.registry import make_attack
+
     case = CASE_BY_NAME[name]
     result = run_case(name, root, seed=seed)
-    assert set(result["report"]["extended"]["effects"]) == set(case.planted), replay(case, result)
+    report = result["report"]
+    assert set(report["extended"]["effects"]) == set(case.planted), replay(case, result)
+    # the calibrated attack runs what was written: the measured line, and the free start where it was named
+    attack = make_attack("em_truncation", calibration=str(Path(root) / f"{name}_seed{seed}" / "out"))
+    assert attack.ratio_per_intensity == report["extended"]["params"]["ratio_per_intensity"]
+    assert attack.free_band_position == ("free_band_position" in case.planted)
 
 
 @pytest.mark.slow

@@ -183,3 +183,61 @@ def test_one_shared_ratio_and_per_sample_ratios_take_the_same_rows():
         torch.testing.assert_close(per_sample[:2], shared[:2], atol=0, rtol=0)
         torch.testing.assert_close(per_sample[2], img[2], atol=0, rtol=0)
         assert shared.data_ptr() != img.data_ptr()
+
+
+def test_calibrated_line_and_free_band_start_per_sample_anywhere_up_to_h_minus_num():
+    """The calibrated options (issue 12): ``r = a s`` in place of the level table, and each sample's band start
+    drawn over every row from the top to ``h - num`` (the tail itself included: that frame passes unchanged)."""
+    height, batch = 40, 256
+    attack = EMTruncation(0.8, ratio_per_intensity=0.25, free_band_position=True, seed=3)
+    params = attack.sample_params(batch, height, 8, generator=torch.Generator().manual_seed(5))
+    num = int(height * 0.25 * 0.8)  # 8 rows lost at every sample
+    assert torch.allclose(params["ratio"], torch.full((batch,), 0.2))
+    starts = torch.floor(params["start_fraction"] * (height - num + 1)).long()
+    # every start from 0 to h - num is drawn, beyond the paper's clamp h - 2 num
+    assert set(starts.tolist()) == set(range(height - num + 1))
+    image = torch.arange(height, dtype=torch.float32).view(1, 1, height, 1).expand(batch, 3, height, 8)
+    out = attack.apply_params(image, params)
+    for k in range(batch):
+        start = int(starts[k])
+        rows = torch.arange(height)
+        expected = torch.where((rows >= start) & (rows < height - num), rows + num, rows)
+        assert torch.equal(out[k, 0, :, 0], expected.float()), start
+    # at zero intensity nothing is lost, wherever the band would start
+    zero = EMTruncation(0.0, ratio_per_intensity=0.25, free_band_position=True, seed=3)
+    assert torch.equal(zero(image), image)
+
+    # reproducible, picklable, and a generator is required
+    def fresh():
+        return EMTruncation(0.8, ratio_per_intensity=0.25, free_band_position=True, seed=3)
+
+    clone = pickle.loads(pickle.dumps(fresh()))
+    assert torch.equal(fresh()(image), clone(image))
+    assert not torch.equal(fresh()(image), EMTruncation(0.8, free_band_position=True, seed=4)(image))
+    with pytest.raises(ValueError, match=r"needs a torch\.Generator"):
+        EMTruncation(0.8, free_band_position=True).sample_params(2, height, 8)
+    with pytest.raises(ValueError, match=r"ratio_per_intensity must lie in \[0, 0.5\]"):
+        EMTruncation(0.8, ratio_per_intensity=0.7)
+
+
+def test_the_transform_loses_the_rows_the_calibration_models():
+    """The calibration's row model (``calibration.frame_models.em_truncation.truncation_source_rows``) and the
+    transform agree for every count and start, the paper's and the free ones."""
+    from lerobot_phantom.calibration.frame_models.em_truncation import paper_start, truncation_source_rows
+
+    height = 24
+    image = torch.arange(height, dtype=torch.float32).view(1, 1, height, 1).expand(1, 3, height, 2)
+    for num in range(height // 2 + 1):
+        # inside [num, num + 1) rows, clear of float rounding (half the frame: exactly 0.5, the largest ratio)
+        ratio = torch.tensor([min(num + 0.5, height / 2) / height])
+        paper = em_truncation(image, ratio)[0, 0, :, 0]
+        assert torch.equal(
+            paper, torch.from_numpy(truncation_source_rows(height, num, paper_start(height, num))).float()
+        )
+        for start in range(height - num + 1):
+            fraction = torch.tensor([(start + 0.5) / (height - num + 1)])
+            free = em_truncation(image, ratio, fraction)[0, 0, :, 0]
+            assert torch.equal(free, torch.from_numpy(truncation_source_rows(height, num, start)).float()), (
+                num,
+                start,
+            )

@@ -195,8 +195,13 @@ class TruncationFrames(LatentFrameProblem):
         return fit
 
     def transform_kwargs(self, fit: Fit) -> dict:
-        """``EMTruncation`` keeps its intensity -> ratio table; a free band position is reported, not simulated."""
-        return {}
+        """``EMTruncation`` options: the measured line from intensity to ratio in place of the paper's level table
+        (the middle of the slopes the fit frames allow), and the band's start drawn anywhere where the written
+        model frees it. The count's jitter is not simulated (``transforms.em_truncation``)."""
+        return {
+            "ratio_per_intensity": fit.params["ratio_per_intensity"],
+            "free_band_position": "free_band_position" in fit.effects,
+        }
 
     def derived(self, fit: Fit) -> dict:
         return {"ratio_at_intensity_1": fit.params["ratio_per_intensity"]}
