@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.transforms.registry import make_attack
 
 MASTER_SEED = int(os.environ["CAMSIM_SEED"])  # drawn fresh per run by tests/conftest.py
 N_PAIRS = 8
@@ -55,8 +56,6 @@ def library_band_profile(cam: cs.Camera) -> np.ndarray:
     """The paper's laser strip band with the constants the library chose (Appendix A gives no sigmas or centre),
     read black-box from the library's transform on a black frame: the null case must be the base model."""
     import torch
-
-    from lerobot_phantom.transforms.registry import make_attack
 
     band = make_attack("laser_color_strip", 0.02)(torch.zeros(3, cam.height, cam.width, dtype=torch.uint8))
     band = band.float().amax(dim=0).numpy()
@@ -423,7 +422,7 @@ def run_case(name: str, root: str, seed: int | None = None) -> dict:
             attack=case.attack, measured=str(folder / "pairs"), out=str(folder / "out"), seed=seed % 2**31
         )
     )
-    return {"report": report, "seed": seed, "camera": camera}
+    return {"report": report, "seed": seed, "camera": camera, "out": folder / "out"}
 
 
 def tolerated(case: Case, camera: cs.Camera) -> frozenset:
@@ -502,14 +501,12 @@ def test_photon_noise_is_not_named_where_the_model_leaves_structure_in_the_fit_p
     ],
 )
 def test_em_truncation_draws_that_failed(name, seed, root):
-    from lerobot_phantom.transforms.registry import make_attack
-
     case = CASE_BY_NAME[name]
     result = run_case(name, root, seed=seed)
     report = result["report"]
     assert set(report["extended"]["effects"]) == set(case.planted), replay(case, result)
     # the calibrated attack runs what was written: the measured line, and the free start where it was named
-    attack = make_attack("em_truncation", calibration=str(Path(root) / f"{name}_seed{seed}" / "out"))
+    attack = make_attack("em_truncation", calibration=str(result["out"]))
     assert attack.ratio_per_intensity == report["extended"]["params"]["ratio_per_intensity"]
     assert attack.free_band_position == ("free_band_position" in case.planted)
 
