@@ -1,8 +1,8 @@
 """Two ``truncation_draws.py`` outputs on the same draws, per case: ``python compare_draws.py BEFORE AFTER``.
 
 Prints, per case: draws, passes before and after (the test's rules), the median held-out RMSE of the written model
-before and after, and the draws whose held-out RMSE moved by more than 1% (better / worse), then every draw whose
-verdict or named causes changed.
+before and after, and the draws whose held-out RMSE moved by more than 1% (better / worse), the null cases' largest cross-validated gain
+of an extension (the first selection step's), then every draw whose verdict or named causes changed.
 """
 
 import sys
@@ -41,6 +41,13 @@ def main() -> None:
             f"{int((ratio > 1.01).sum())}"
         )
         changed += [(b, a) for b, a in rows if b[3:5] != a[3:5]]
+    for label, side in (("before", 0), ("after", 1)):
+        gains = [
+            1 - float(pair[side][5].split("->")[1]) / float(pair[side][5].split("->")[0])
+            for pair in by_case.get("truncation_null", [])
+        ]
+        if gains:
+            print(f"nulls' largest cross-validated gain of an extension, {label}: {max(gains):.1%}")
     for b, a in changed:
         print(
             f"changed: {b[0]} {b[1]}: {b[3]} {b[4]} -> {a[3]} {a[4]} "
