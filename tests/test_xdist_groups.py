@@ -33,6 +33,7 @@ def test_files_and_session_artefact_dirs_stay_on_one_worker_and_share_the_seeds_
     tests = tmp_path / "tests"
     (tests / "train").mkdir(parents=True)
     shutil.copy(CONFTEST, tests / "conftest.py")
+    shutil.copy(CONFTEST.with_name("sampling.py"), tests / "sampling.py")
     for path in ("test_a.py", "test_b.py", "test_c.py", "train/test_one.py", "train/test_two.py"):
         (tests / path).write_text(RECORDER)
     (tmp_path / "pyproject.toml").write_text("")

@@ -18,6 +18,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 import camsim as cs
 import test_independent_sim as sim

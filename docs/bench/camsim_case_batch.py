@@ -17,6 +17,7 @@ from collections.abc import Iterator
 from types import ModuleType
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 
 def cases_per_master_seed(name: str, seeds: list[str]) -> Iterator[tuple[str, ModuleType, object]]:

@@ -14,6 +14,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
+sys.path.insert(
+    1, str(Path(__file__).resolve().parents[2] / "tests")
+)  # tests/sampling.py, which the case selection imports
 
 
 def case_draws(name: str, seeds) -> Iterator[tuple[int, object, object, int, np.random.Generator, object]]:

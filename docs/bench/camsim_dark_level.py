@@ -17,6 +17,7 @@ import numpy as np
 import torch
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 sys.path.insert(0, "tests")
 
 import camsim as cs

@@ -19,6 +19,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "tests" / "calibration"))
+sys.path.insert(
+    1, str(Path(__file__).resolve().parents[2] / "tests")
+)  # tests/sampling.py, which the case selection imports
 import camsim as cs
 
 # the test module reads its master seed on import; only its camera draw is used

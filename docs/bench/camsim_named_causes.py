@@ -4,7 +4,7 @@ structure reported, which is printed), the causes named, the unplanted ones (the
 ``named_causes`` and ``tolerated``), and the held-out RMSE of the written model and of the base.
 
 Usage: ``CAMSIM_CASES=... python docs/bench/camsim_named_causes.py OUTDIR...`` from the repository root (the same
-``CAMSIM_CASES`` as the batch). Cases whose ``report.json`` is missing (a run still going) are skipped. With
+``CAMSIM_CASES`` as the batch; unset, ``core``, the batch's default). Cases whose ``report.json`` is missing (a run still going) are skipped. With
 ``CAMSIM_WITHOUT_IMPLIED=1`` the causes that an identified form implies (``Effect.implies``, since session 22) are
 taken out of each report first: how the same fits were named before (the implication adds findings and changes
 no fit).
@@ -19,7 +19,9 @@ import sys
 from collections.abc import Iterator
 from pathlib import Path
 
+os.environ.setdefault("CAMSIM_CASES", "core")  # camsim_core_batch.sh's default
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 
 def without_implied(report: dict) -> dict:

@@ -84,6 +84,7 @@ def main() -> None:
     if decode not in ("camera", "projector"):
         raise SystemExit(f"DECODE must be camera or projector, got {decode!r}")
     sys.path.insert(0, tests_dir)
+    sys.path.insert(1, str(Path(tests_dir).parent))  # tests/sampling.py, which the case selection imports
     camsim = importlib.import_module("camsim")
     for master in seeds:
         os.environ["CAMSIM_SEED"] = str(master)

@@ -16,6 +16,7 @@ import importlib
 import os
 import sys
 import tempfile
+from pathlib import Path
 
 NAME = "truncation_shot_noise"
 
@@ -27,6 +28,9 @@ def main() -> None:
     parser.add_argument("--tone", default=None, help="override the drawn tone curve (srgb, filmic, power)")
     args = parser.parse_args()
     sys.path.insert(0, args.tests_dir)
+    sys.path.insert(
+        1, str(Path(args.tests_dir).parent)
+    )  # tests/sampling.py, which the case selection imports
     for master in args.seeds:
         os.environ["CAMSIM_SEED"] = str(master)
         sim = importlib.reload(importlib.import_module("test_independent_sim"))

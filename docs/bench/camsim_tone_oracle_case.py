@@ -24,6 +24,7 @@ from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.transforms.physics import linear_to_srgb
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 
 def main() -> None:

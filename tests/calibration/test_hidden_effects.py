@@ -16,19 +16,19 @@ from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.structure import MIN_TESTED_ITEMS
 from lerobot_phantom.transforms.registry import make_attack
 
-SLOW = pytest.mark.slow  # > 10 s each on 2 cores
+SAMPLED = [pytest.mark.slow, pytest.mark.sampled]  # 60-145 s each on 2 cores (session 59)
 CASES = [
-    pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SLOW),
-    pytest.param("laser_blinding", {"auto_exposure"}, 12, marks=SLOW),
+    pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SAMPLED),
+    pytest.param("laser_blinding", {"auto_exposure"}, 12, marks=SAMPLED),
     # an expected failure until session 37 (additive_light not named next to channel_crosstalk); it passed in every
     # recorded suite run from session 30 on (docs/bench/session3*/suite_*.log)
-    pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SLOW),
-    pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SLOW),
+    pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SAMPLED),
+    pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SAMPLED),
     pytest.param("em_color_strip", {"bayer_phase_flip"}, 41),
     pytest.param("em_truncation", {"free_band_position"}, 51),
-    pytest.param("laser_color_strip", {"exposure_overlap"}, 62, marks=SLOW),
-    pytest.param("laser_color_strip", {"exposure_overlap", "stripe_period"}, 63, marks=SLOW),
-    pytest.param("laser_color_strip", {"exposure_overlap", "sensor_gamma"}, 64, marks=SLOW),
+    pytest.param("laser_color_strip", {"exposure_overlap"}, 62, marks=SAMPLED),
+    pytest.param("laser_color_strip", {"exposure_overlap", "stripe_period"}, 63, marks=SAMPLED),
+    pytest.param("laser_color_strip", {"exposure_overlap", "sensor_gamma"}, 64, marks=SAMPLED),
 ]
 
 
@@ -66,6 +66,7 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_no_planted_effect_keeps_the_base_model(tmp_path):
     measured = tmp_path / "measured"
     measured.mkdir()
@@ -81,7 +82,7 @@ def test_no_planted_effect_keeps_the_base_model(tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("attack", "seed"), [("em_truncation", 6), pytest.param("laser_color_strip", 61, marks=SLOW)]
+    ("attack", "seed"), [("em_truncation", 6), pytest.param("laser_color_strip", 61, marks=SAMPLED)]
 )
 def test_row_attacks_keep_the_paper_model_when_it_is_right(tmp_path, attack, seed):
     measured = tmp_path / "measured"

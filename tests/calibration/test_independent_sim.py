@@ -22,6 +22,7 @@ from pathlib import Path
 import camsim as cs
 import numpy as np
 import pytest
+import sampling
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.transforms.registry import make_attack
@@ -332,8 +333,8 @@ CASES = [
     ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
-# every named frame-pair effect of the library, all six nulls and two unnamed effects run every time; one of the
-# other variants joins each run, drawn from the master seed (CAMSIM_CASES=all runs the whole matrix)
+# the cases CAMSIM_CASES=core runs: every named frame-pair effect of the library, all six nulls and two unnamed
+# effects, with one of the other variants drawn from the master seed (the default before session 60)
 CORE = (
     "blinding_null",
     "blinding_auto_exposure",
@@ -354,18 +355,34 @@ CORE = (
     "blur_sinusoidal",
     "blur_rotation_unnamed",
 )
+KINDS = ("null", "effect", "unexplained")
+
+
+def sampled_cases(share: float) -> list[str]:
+    """The run's draw of cases (tests/sampling.py): ``share`` of each kind's cases on average, drawn from the master
+    seed, at least one effect case (the naming share is taken over them)."""
+    names = []
+    for kind in KINDS:
+        of_kind = [c.name for c in CASES if c.kind == kind]
+        rng = sampling.group_rng(MASTER_SEED, kind)
+        names += sampling.draw(of_kind, share, rng, at_least=int(kind == "effect"))
+    return [c.name for c in CASES if c.name in names]
 
 
 def selected_cases() -> list[str]:
-    choice = os.environ.get("CAMSIM_CASES", "core")
+    """The cases this run calibrates: ``CAMSIM_CASES`` (all, core, sampled or names), by default ``sampled``, at
+    ``SAMPLED_SHARE`` (all: every case)."""
+    choice = os.environ.get("CAMSIM_CASES", "sampled")
     if choice == "all":
         return [c.name for c in CASES]
+    if choice == "sampled":
+        return sampled_cases(sampling.share_from_env())
     if choice != "core":
         names = choice.split(",")
         unknown = sorted(set(names) - set(CASE_BY_NAME))
         if unknown:
             raise ValueError(
-                f"CAMSIM_CASES: unknown cases {unknown}; valid: all, core or {sorted(CASE_BY_NAME)}"
+                f"CAMSIM_CASES: unknown cases {unknown}; valid: all, core, sampled or {sorted(CASE_BY_NAME)}"
             )
         return names
     extras = [c.name for c in CASES if c.name not in CORE]

@@ -19,6 +19,7 @@ from lerobot_phantom.transforms.light_projection import LightProjection
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 @pytest.mark.parametrize("spread_px", [0.0, 1.0])
 def test_light_spread_is_named_and_measured_only_when_the_light_spreads(spread_px):
     # scipy's Gaussian blur of the sharp frame the projector was sent (calibration_testkit), not the package's

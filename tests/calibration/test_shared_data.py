@@ -52,6 +52,8 @@ def assert_named_causes_are_identified(report):
                 assert not result["reasons"]
 
 
+@pytest.mark.slow
+@pytest.mark.sampled
 def test_logitech_stripes(tmp_path):
     table = MEASURED / "rolling_shutter/logitech_stripe_rows.csv"
     # the table's README: exposure in UVC units of 100 us, 720-row frames (the table itself states neither)
@@ -75,6 +77,7 @@ def test_logitech_stripes(tmp_path):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 @pytest.mark.parametrize("name", ["stop_sign", "bottle"])
 def test_slap_triples(tmp_path, name):
     report = run(tmp_path, "light_projection", f"projection/slap_{name}_triples.csv")
@@ -85,6 +88,7 @@ def test_slap_triples(tmp_path, name):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_laser_capture_beats_gaussian_spot(tmp_path):
     # all four captures: effects are shared, so one capture's halo exponent at its bound keeps halo unnamed
     report = run(tmp_path, "laser_blinding", "blinding")

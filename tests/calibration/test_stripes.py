@@ -813,6 +813,7 @@ def drift_reports(tmp_path_factory) -> Callable[[str | None], tuple[dict, str, d
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 @pytest.mark.parametrize(
     "start_at",
     [
@@ -920,6 +921,7 @@ def gain_interval(report: dict, effect: str) -> tuple[float, float] | None:
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
     """The same camera and drifts, the recordings starting at any whole placement against starting as their
     stripes come whole into view: drift_from_entry is named on the entry table, and on the placement table it is
@@ -943,6 +945,7 @@ def test_the_entry_start_is_told_from_any_whole_placement(drift_reports):
 
 # -- a second camera, end to end ---------------------------------------------------------------------------------
 @pytest.mark.slow
+@pytest.mark.sampled
 @pytest.mark.parametrize(
     ("frames", "style"),
     [
@@ -1005,6 +1008,7 @@ def test_second_camera_heldout_rows_and_parameters(tmp_path, frames, style):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_an_overlap_of_no_use_alone_is_named_with_the_threshold_it_hosts(tmp_path):
     """A drawn camera (seed 13, whole stripes only) whose exposure overlap alone barely beats a fixed band: it was
     left out for that, with the threshold and offset that live in it (254 rows held-out); judged with them it is
@@ -1019,6 +1023,7 @@ def test_an_overlap_of_no_use_alone_is_named_with_the_threshold_it_hosts(tmp_pat
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as_the_threshold(tmp_path):
     """A drawn camera (seed 1804228398, lit frames) whose fit rows hold no pulse or window shorter than its
     threshold: the threshold and a negative integration offset score the same to 1e-12, and which one won was
@@ -1039,6 +1044,7 @@ def test_a_threshold_the_fit_rows_cannot_tell_from_a_negative_offset_is_taken_as
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_an_offset_taken_with_the_threshold_is_judged_with_the_noise_the_pair_made_possible(tmp_path):
     """A drawn camera (seed 4111198912, lit frames): selection takes the threshold and an integration offset as one
     step (ratio 1.22, its interval spanning 1), then read noise on the threshold (to 4.09 rows from 8.03); without
@@ -1064,6 +1070,7 @@ def test_an_offset_taken_with_the_threshold_is_judged_with_the_noise_the_pair_ma
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_an_offset_whose_gain_interval_ends_near_1_is_judged_on_the_data_not_the_generator_stream(tmp_path):
     """The same drawn camera on the exact-pulse table: selection takes the threshold, then read noise and an
     integration offset as a pair (7.27 -> 4.59 rows). The offset's ratio, 1.583, has its 5% end at 1.026; with 200
@@ -1090,6 +1097,7 @@ def fixed_band_table(path, rng: np.random.Generator, camera: dict):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_fixed_band_keeps_the_base(tmp_path):
     """Null case: rows follow the paper's band (H/3 whatever the settings, plus frame noise)."""
     rng = np.random.default_rng([SEED, 3])
@@ -1145,6 +1153,7 @@ def test_residual_structure_of_a_stripe_table(tmp_path, flicker):
 
 
 @pytest.mark.slow
+@pytest.mark.sampled
 def test_an_unnamed_stripe_effect_is_reported_as_structure_not_as_a_cause(tmp_path):
     rng = np.random.default_rng([SEED, 5])
     band_table(tmp_path / "beat.csv", rng, 600, flicker=0.4)

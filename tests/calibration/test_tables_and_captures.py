@@ -161,9 +161,11 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
             "600",
             "--exposure-unit-s",
             "1e-4",
-            # one frame rule and a short bootstrap: this test is about the command line, not the fit
+            # one frame rule, two folds and a short bootstrap: this test is about the command line, not the fit
             "--stripe-frames",
             "all",
+            "--folds",
+            "2",
             "--bootstrap",
             "10",
         ]
@@ -176,6 +178,7 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
     assert report["extended"]["derived"]["frames_averaged"] == "all"
     # stripe tables are compared row by row (StripeProblem.selection_score), and the report says so
     assert report["selection"]["score"] == "mean per-item error"
+    assert "by 2-fold cross-validated" in report["selection"]["criterion"]
     assert "each table row's absolute error" in report["selection"]["criterion"]
 
 

@@ -41,6 +41,7 @@ from lerobot_phantom.calibration.frame_models import light_projection
 from lerobot_phantom.calibration.tone import shoulder_encode
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 MODES = (
     "as_tested",

@@ -15,6 +15,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 
 
 def main(seeds: list[str]) -> None:

@@ -18,6 +18,7 @@ import sys
 import numpy as np
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 os.environ.setdefault("CAMSIM_SEED", "0")  # the module reads one at import; each seed below replaces it
 
 import camsim as cs

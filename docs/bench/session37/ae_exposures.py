@@ -6,6 +6,9 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "tests" / "calibration"))
+sys.path.insert(
+    1, str(Path(__file__).resolve().parents[3] / "tests")
+)  # tests/sampling.py, which the case selection imports
 os.environ["CAMSIM_SEED"] = sys.argv[1]
 import camsim as cs
 import test_independent_sim as t

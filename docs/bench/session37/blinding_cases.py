@@ -7,6 +7,7 @@ import sys
 
 repo, root, seeds = sys.argv[1], sys.argv[2], [int(s) for s in sys.argv[3:]]
 sys.path.insert(0, f"{repo}/tests/calibration")
+sys.path.insert(1, f"{repo}/tests")  # tests/sampling.py, which the case selection imports
 sys.path.insert(0, repo)
 
 CASES = ["blinding_null", "blinding_saturation", "blinding_auto_exposure", "blinding_halo"]

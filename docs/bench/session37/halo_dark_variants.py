@@ -9,6 +9,9 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[3] / "tests" / "calibration"))
+sys.path.insert(
+    1, str(Path(__file__).resolve().parents[3] / "tests")
+)  # tests/sampling.py, which the case selection imports
 import camsim as cs
 
 REAL = cs.ambient_light

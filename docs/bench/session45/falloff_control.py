@@ -12,6 +12,7 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, "tests/calibration")
+sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
 os.environ["CAMSIM_SEED"] = sys.argv[1]
 sim = importlib.import_module("test_independent_sim")
 cs = sim.cs

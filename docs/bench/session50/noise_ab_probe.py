@@ -25,6 +25,7 @@ def main() -> None:
     parser.add_argument("--cases", default="all", help="comma-separated camsim case names (default: all)")
     args = parser.parse_args()
     sys.path.insert(0, "tests/calibration")
+    sys.path.insert(1, "tests")  # tests/sampling.py, which the case selection imports
     for master in args.seeds:
         os.environ["CAMSIM_SEED"] = str(master)
         os.environ["CAMSIM_CASES"] = args.cases

@@ -20,6 +20,7 @@ import numpy as np
 import torch
 
 sys.path.insert(0, str(Path.cwd() / "tests" / "calibration"))
+sys.path.insert(1, str(Path.cwd() / "tests"))  # tests/sampling.py, which the case selection imports
 
 
 def region_samples(problem, region: str, count: int = 800) -> list[torch.Tensor]:

@@ -9,6 +9,7 @@ import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path.cwd() / "tests" / "calibration"))
+sys.path.insert(1, str(Path.cwd() / "tests"))  # tests/sampling.py, which the case selection imports
 os.environ.setdefault("CAMSIM_SEED", "0")  # read by the module; the case seed is given explicitly
 
 import test_independent_sim as sim

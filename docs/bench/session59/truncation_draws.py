@@ -17,6 +17,7 @@ import numpy as np
 
 ROOT = Path.cwd()
 sys.path.insert(0, str(ROOT / "tests" / "calibration"))
+sys.path.insert(1, str(ROOT / "tests"))  # tests/sampling.py, which the case selection imports
 os.environ.setdefault("CAMSIM_SEED", "0")  # the module reads it; every case seed below is given explicitly
 
 import test_independent_sim as sim  # noqa: E402
