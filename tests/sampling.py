@@ -20,8 +20,9 @@ import numpy as np
 
 SHARE_VARIABLE = "SAMPLED_SHARE"
 SEED_VARIABLE = "SAMPLED_SEED"
-# a fifth: about 1000 of those 5114 s a run on average
-DEFAULT_SHARE = 0.2
+# a tenth: at 0.2 the suite took 32.9 min (session 60, docs/bench/session60/suite_339e1f2_durations.log), 1975 s
+# of its test time in the tests every run runs; a tenth of the sampled ones adds about 600 s on that machine
+DEFAULT_SHARE = 0.1
 
 
 def share_from_env(environ: Mapping[str, str] = os.environ) -> float:
