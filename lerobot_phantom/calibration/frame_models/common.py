@@ -370,10 +370,20 @@ class PixelProblem(FrameProblem):
         return flat.T.reshape(3, pair.height, pair.width)
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
-        feats = [self.features(int(i), self.samples[int(i)]) for i in items]
+        return self.fit_on_pixels(effects, items, [self.samples[int(i)] for i in items], start)
+
+    def fit_on_pixels(
+        self, effects: frozenset[str], items: np.ndarray, pixels: list[torch.Tensor], start: Fit | None = None
+    ) -> Fit:
+        """The model ``effects`` fitted on ``pixels`` of ``items`` (one index tensor per item, in ``items``'
+        order); ``fit`` passes each item's seeded sample."""
+        feats = [self.features(int(i), rows) for i, rows in zip(items, pixels, strict=True)]
         stacked = {k: torch.cat([f[k] for f in feats]) for k in feats[0]}
         target = torch.cat(
-            [self.pairs[int(i)].attacked.reshape(3, -1)[:, self.samples[int(i)]].T for i in items]
+            [
+                self.pairs[int(i)].attacked.reshape(3, -1)[:, rows].T
+                for i, rows in zip(items, pixels, strict=True)
+            ]
         )
         params = fit_least_squares(
             self.param_specs(effects),
@@ -385,6 +395,20 @@ class PixelProblem(FrameProblem):
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return None if start is None else start.params
+
+    def position_halves(self, items: np.ndarray) -> tuple[list[torch.Tensor], list[torch.Tensor]]:
+        """Each item's sampled pixels nearest its frame's centre and the rest, split at their median distance from
+        it (in shares of the frame's sides, so both halves reach every side of a wide frame alike)."""
+        inner, outer = [], []
+        for i in items:
+            pair, rows = self.pairs[int(i)], self.samples[int(i)]
+            x_mid, y_mid = self.centre(int(i))
+            y, x = rows // pair.width, rows % pair.width
+            radius = torch.hypot((x - x_mid) / pair.width, (y - y_mid) / pair.height)
+            near = radius <= radius.median()
+            inner.append(rows[near])
+            outer.append(rows[~near])
+        return inner, outer
 
 
 # the neighbourhood a pattern value is compared with: wider than demosaicing's and compression's one or two pixels,

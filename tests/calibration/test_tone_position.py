@@ -1,0 +1,83 @@
+"""A light projection's gamma is named the camera's tone curve only if it holds at every position of the frame
+(``ProjectionFrames.identification_checks``): frames of the independent simulator, at case seeds of draws whose
+calibration named ``sensor_gamma`` (docs/bench/session60.md)."""
+
+from __future__ import annotations
+
+import camsim as cs
+import pytest
+import test_independent_sim as sim
+import torch
+
+from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
+from lerobot_phantom.calibration.core import seeded_split
+
+
+def drawn_problem(name: str, case_seed: int, folder):
+    """The case's frames at ``case_seed``, read as the calibration CLI reads them, and its fit pairs."""
+    case = sim.CASE_BY_NAME[name]
+    _, rng, camera = sim.case_camera(case, case_seed)
+    cs.write_pairs(folder, case.render(rng, camera))
+    cfg = CalibrateConfig(
+        attack=case.attack, measured=str(folder), out=str(folder / "out"), seed=case_seed % 2**31
+    )
+    problem = build_problem(cfg)
+    fit_items, _ = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+    return problem, fit_items
+
+
+def test_position_halves_split_each_pairs_sample_at_its_median_distance_from_the_centre(tmp_path):
+    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    inner, outer = problem.position_halves(items)
+    for i, near, far in zip(items, inner, outer, strict=True):
+        pair = problem.pairs[int(i)]
+        assert torch.equal(torch.sort(torch.cat([near, far])).values, problem.samples[int(i)])
+        assert len(near) >= len(far) > 0  # ties at the median join the inner half
+        x_mid, y_mid = problem.centre(int(i))
+
+        def radius(rows, pair=pair, x_mid=x_mid, y_mid=y_mid):
+            return torch.hypot(
+                (rows % pair.width - x_mid) / pair.width, (rows // pair.width - y_mid) / pair.height
+            )
+
+        assert radius(near).max() <= radius(far).min()
+
+
+@pytest.mark.parametrize(
+    ("name", "case_seed", "effects", "named"),
+    [
+        # master seed 4006062913 (session 56): the projector's falloff, no tone curve planted, named sensor_gamma
+        ("projection_falloff_unnamed", 1900328395, {"sensor_gamma"}, False),
+        # the same master seed's planted power-law tone curve (2.338), named with the light it bends
+        (
+            "projection_sensor_gamma",
+            1225097670,
+            {"additive_light", "albedo_modulation", "sensor_gamma"},
+            True,
+        ),
+    ],
+)
+def test_a_gamma_is_the_cameras_only_if_both_position_halves_find_it(
+    tmp_path, name, case_seed, effects, named
+):
+    problem, items = drawn_problem(name, case_seed, tmp_path)
+    fit = problem.fit(frozenset(effects), items)
+    assert abs(fit.params["gamma"] - 1.0) > 0.1  # the pooled frame does show a gamma
+    reasons = problem.identification_checks("sensor_gamma", fit, items)
+    if named:
+        assert reasons == []
+    else:
+        assert len(reasons) == 1 and "bends light that changes across the frame" in reasons[0], reasons
+    # the check concerns the tone curve only
+    assert problem.identification_checks("additive_light", fit, items) == []
+
+
+def test_a_fit_on_given_pixels_is_the_fit_on_those_pixels_as_the_sample(tmp_path):
+    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    inner, _ = problem.position_halves(items)
+    whole = problem.fit(frozenset(), items)
+    on_inner = problem.fit_on_pixels(frozenset(), items, inner)
+    assert on_inner.params != pytest.approx(whole.params)  # the pixels given were used
+    for rows, i in zip(inner, items, strict=True):
+        problem.samples[int(i)] = rows
+    assert problem.fit(frozenset(), items).params == pytest.approx(on_inner.params)
