@@ -9,7 +9,8 @@ must say that structure is left).
 
 Acceptance (issue 12, "How it will be checked"): planted effects named in >= 90% of the effect cases, at most one
 unplanted named cause in any case, null cases keep the base model. The run's master seed is printed in every failure;
-``CAMSIM_SEED=<seed>`` replays a run.
+``CAMSIM_SEED=<seed>`` replays a run. A run calibrates a share of each kind of case, drawn from the master seed
+(``sampled_cases``, tests/sampling.py): ``CAMSIM_CASES=all`` or ``SAMPLED_SHARE=all`` runs the whole matrix.
 """
 
 from __future__ import annotations
