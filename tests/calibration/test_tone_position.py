@@ -11,6 +11,7 @@ import torch
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
 from lerobot_phantom.calibration.core import seeded_split
+from lerobot_phantom.calibration.frame_models.light_projection import TONE_POSITION_EXCESS
 
 
 def drawn_problem(name: str, case_seed: int, folder):
@@ -64,6 +65,11 @@ def test_a_gamma_is_the_cameras_only_if_both_position_halves_find_it(
     fit = problem.fit(frozenset(effects), items)
     assert abs(fit.params["gamma"] - 1.0) > 0.1  # the pooled frame does show a gamma
     reasons = problem.identification_checks("sensor_gamma", fit, items)
+    inner, outer = problem.gamma_by_position(fit, items)
+    ratio = (fit.params["gamma"] - 1.0) / ((inner + outer) / 2 - 1.0)
+    # the check's verdict is the stated rule on the figures it reports
+    assert (reasons == []) == (0.0 < ratio <= TONE_POSITION_EXCESS)
+    assert f"({inner:.3f})" in "".join(reasons) or named
     if named:
         assert reasons == []
     else:

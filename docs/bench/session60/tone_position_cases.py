@@ -6,7 +6,7 @@ it with the checkout's package and prints what is named, whether the case passes
 withdrawn and why (the check's reason starts "the gamma fitted on the pixels nearest"), and, where ``sensor_gamma``
 is written, the check's own figures on the written model: the gamma of each position half and the whole frame's
 departure from 1 as a multiple of the halves' mean departure (``TONE_POSITION_EXCESS`` is the most it may be).
-On a checkout without the check (no ``position_halves``) the figures are left out.
+On a checkout without the check (no ``gamma_by_position``) the figures are left out.
 """
 
 from __future__ import annotations
@@ -36,14 +36,11 @@ def position_figures(cfg, report: dict) -> str:
     from lerobot_phantom.calibration.core import Fit, seeded_split
 
     problem = build_problem(cfg)
-    if not hasattr(problem, "position_halves"):
+    if not hasattr(problem, "gamma_by_position"):
         return ""
     fit_items, _ = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
     fit = Fit(frozenset(report["extended"]["effects"]), report["extended"]["params"])
-    halves = [
-        problem.fit_on_pixels(fit.effects, fit_items, rows).params["gamma"]
-        for rows in problem.position_halves(fit_items)
-    ]
+    halves = problem.gamma_by_position(fit, fit_items)
     ratio = (fit.params["gamma"] - 1.0) / (np.mean(halves) - 1.0)
     return f" | gamma whole {fit.params['gamma']:.3f} inner {halves[0]:.3f} outer {halves[1]:.3f} ratio {ratio:.2f}"
 

@@ -127,6 +127,14 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
 
+    def gamma_by_position(self, fit: Fit, items: np.ndarray) -> list[float]:
+        """The gamma of ``fit``'s model refitted on ``items``' sampled pixels nearest the frame's centre, and on the
+        rest (``position_halves``), each half with all its own parameters."""
+        return [
+            self.fit_on_pixels(fit.effects, items, rows).params["gamma"]
+            for rows in self.position_halves(items)
+        ]
+
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """A camera's tone curve acts on every pixel alike: the written model refitted on the fit pairs' pixels
         nearest the frame's centre, and on the rest, must find the gamma the whole frame does, within
@@ -135,10 +143,7 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         not named the camera's."""
         if effect != "sensor_gamma":
             return []
-        halves = [
-            self.fit_on_pixels(fit.effects, items, rows).params["gamma"]
-            for rows in self.position_halves(items)
-        ]
+        halves = self.gamma_by_position(fit, items)
         whole, halves_mean = fit.params["gamma"] - 1.0, float(np.mean(halves)) - 1.0
         fitted = (
             f"the gamma fitted on the pixels nearest the frame's centre ({halves[0]:.3f}) and on the rest "
