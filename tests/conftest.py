@@ -61,7 +61,8 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
     left_out = sampled_out(config, items)
     if left_out:
         config.hook.pytest_deselected(items=left_out)
-        items[:] = [item for item in items if item not in left_out]
+        dropped = {item.nodeid for item in left_out}
+        items[:] = [item for item in items if item.nodeid not in dropped]
 
 
 def named_on_command_line(config: pytest.Config, item: pytest.Item) -> bool:

@@ -359,15 +359,20 @@ CORE = (
 KINDS = ("null", "effect", "unexplained")
 
 
-def sampled_cases(share: float) -> list[str]:
-    """The run's draw of cases (tests/sampling.py): ``share`` of each kind's cases on average, drawn from the master
-    seed, at least one effect case (the naming share is taken over them)."""
+def sampled_cases_for(master_seed: int, share: float) -> list[str]:
+    """A master seed's draw of cases (tests/sampling.py): ``share`` of each kind's cases on average, at least one
+    effect case (the naming share is taken over them), in the matrix's order."""
     names = []
     for kind in KINDS:
         of_kind = [c.name for c in CASES if c.kind == kind]
-        rng = sampling.group_rng(MASTER_SEED, kind)
+        rng = sampling.group_rng(master_seed, kind)
         names += sampling.draw(of_kind, share, rng, at_least=int(kind == "effect"))
     return [c.name for c in CASES if c.name in names]
+
+
+def sampled_cases(share: float) -> list[str]:
+    """This run's draw of cases, from its master seed."""
+    return sampled_cases_for(MASTER_SEED, share)
 
 
 def selected_cases() -> list[str]:
@@ -456,6 +461,22 @@ def replay(case: Case, result: dict) -> str:
         f"case {case.name} (case seed {result['seed']}); replay with CAMSIM_SEED={MASTER_SEED}; "
         f"camera {result['camera']}"
     )
+
+
+def test_a_run_draws_a_share_of_each_kind_of_case_and_at_least_one_effect_case():
+    kinds = {kind: [c.name for c in CASES if c.kind == kind] for kind in KINDS}
+    assert sampled_cases(1.0) == [c.name for c in CASES]
+    counts = {kind: [] for kind in KINDS}
+    for seed in range(300):
+        drawn = sampled_cases_for(seed, 0.1)
+        assert drawn == [c.name for c in CASES if c.name in drawn]  # in the matrix's order
+        for kind, names in kinds.items():
+            counts[kind].append(len(set(drawn) & set(names)))
+    assert min(counts["effect"]) >= 1
+    # on average a tenth of each kind (the effect cases' floor of one adds to theirs)
+    for kind in ("null", "unexplained"):
+        assert np.mean(counts[kind]) == pytest.approx(0.1 * len(kinds[kind]), abs=0.15)
+    assert sampled_cases_for(5, 0.1) == sampled_cases_for(5, 0.1)
 
 
 @pytest.fixture(scope="module")
