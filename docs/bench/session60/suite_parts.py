@@ -56,6 +56,8 @@ def main() -> None:
     print(f"test time {sum(parts.values()):.0f} s ({len(sampled)} sampled tests in the checkout)")
     for name, seconds in parts.most_common():
         print(f"  {seconds:6.0f} s  {name}")
+    drawn = parts["sampled tests drawn"] + parts["camsim cases drawn"]
+    print(f"  {drawn:6.0f} s  drawn, both kinds ({100 * drawn / sum(parts.values()):.0f}% of the test time)")
 
 
 if __name__ == "__main__":
