@@ -2,7 +2,7 @@
 
 A test marked ``sampled`` runs a whole calibration on generated or measured data and judges it (40 s to 6 min each on
 two cores). The 34 of them and the independent simulator's cases took 77% of the suite's test time in session 59's
-run (5114 of 6684 s, ``docs/bench/session59/suite_abac8ef_durations.log``; 58.5 min on two workers, against the 30
+run (5114 of 6684 s, ``docs/bench/session60/suite_abac8ef_parts.txt``; 58.5 min on two workers, against the 30
 the project allows its suite). So each run draws a share of every file's sampled tests (and of the simulator's cases,
 by kind), afresh from ``SAMPLED_SEED``: over runs every check runs, and each run still meets fresh draws.
 ``SAMPLED_SHARE=all`` runs every one (what a change to the calibration is checked with before it is merged); a test
