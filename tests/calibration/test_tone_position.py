@@ -87,3 +87,25 @@ def test_a_fit_on_given_pixels_is_the_fit_on_those_pixels_as_the_sample(tmp_path
     for rows, i in zip(inner, items, strict=True):
         problem.samples[int(i)] = rows
     assert problem.fit(frozenset(), items).params == pytest.approx(on_inner.params)
+
+
+@pytest.mark.parametrize(
+    ("whole", "halves", "reason"),
+    [
+        (1.20, [0.98, 0.99], "does not depart from 1 on the side"),  # the halves bend the other way
+        (1.20, [1.00, 1.00], "does not depart from 1 on the side"),  # the halves do not bend at all
+        (1.30, [1.10, 1.10], "3.00 times as far, more than 1.5"),
+        (0.80, [0.85, 0.87], None),  # 1.43 times as far, below 1: the rule holds on either side of 1
+        (1.28, [1.20, 1.20], None),  # 1.4 times as far
+    ],
+)
+def test_the_verdict_on_given_halves(tmp_path, monkeypatch, whole, halves, reason):
+    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    monkeypatch.setattr(problem, "gamma_by_position", lambda fit, items: halves)
+    fit = problem.fit(frozenset({"sensor_gamma"}), items)
+    fit.params["gamma"] = whole
+    reasons = problem.identification_checks("sensor_gamma", fit, items)
+    if reason is None:
+        assert reasons == []
+    else:
+        assert len(reasons) == 1 and reason in reasons[0], reasons
