@@ -25,8 +25,11 @@ Calibrated options (``lerobot-phantom-calibrate --attack em_truncation`` writes 
 ``ratio_per_intensity`` replaces the level table by the measured line ``r = a s``, and ``free_band_position``
 draws each sample's band start uniformly over every row from the top to ``h - num`` (the interference corrupts
 the buffer address at a moment set by its timing, not by how many rows are lost; at ``h - num`` the band is the
-tail itself and the frame passes unchanged). The count's jitter the calibration reports is not drawn: at zero
-intensity there is no attack.
+tail itself and the frame passes unchanged). ``ratio_per_intensity_spread`` and ``ratio_jitter`` draw each
+sample's ratio from the law the calibration predicts held-out frames with, ``r = (a + w u) s + d z``, ``u``
+uniform on ``[-1, 1]``, ``z`` standard normal, clipped to ``[0, 0.5]``: ``w`` is half the range of slopes the
+measured frames leave possible (their counts are floors), ``d`` the frame-to-frame jitter no one line removes (the
+calibration gives one of the two, never both). At zero intensity there is no attack, jitter or not.
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
@@ -49,14 +52,21 @@ MAX_RATIO = 0.5
 
 def truncation_row_index(height: int, ratio: torch.Tensor) -> torch.Tensor:
     """Source row of every output row, ``(B, height)`` long, for per-sample ratios ``(B,)`` in [0, 0.5]."""
-    return _rows_losing(height, torch.floor(height * ratio).long())
+    return rows_after_losing(height, torch.floor(height * ratio).long())
 
 
-def _rows_losing(height: int, num: torch.Tensor, start: torch.Tensor | None = None) -> torch.Tensor:
-    """``truncation_row_index`` from the number of lost rows per sample ``num`` (long ``(B,)``); the band starts
-    at the paper's clamped row, or at ``start`` (long ``(B,)``, at most ``height - num``)."""
+def paper_band_start(height: int, num: torch.Tensor) -> torch.Tensor:
+    """The paper's band start ``int(h r)``, which is the count ``num`` itself, clamped so that the band never
+    overlaps the appended tail (the module docstring's first deviation)."""
+    return torch.clamp(torch.minimum(num, height - 2 * num), min=0)
+
+
+def rows_after_losing(height: int, num: torch.Tensor, start: torch.Tensor | None = None) -> torch.Tensor:
+    """Source row of every output row, ``(B, height)`` long, when each sample loses ``num`` rows (long ``(B,)``)
+    from ``start`` (long ``(B,)``, at most ``height - num``; by default :func:`paper_band_start`) and repeats its
+    last ``num`` rows. The calibration's frame model predicts frames with it too."""
     if start is None:
-        start = torch.clamp(torch.minimum(num, height - 2 * num), min=0)
+        start = paper_band_start(height, num)
     rows = torch.arange(height, device=num.device).unsqueeze(0)  # (1, H)
     num, start = num.unsqueeze(1), start.unsqueeze(1)
     shifted = (rows >= start) & (rows < height - num)
@@ -104,7 +114,7 @@ def em_truncation(
                     f"start_fraction needs one value in [0, 1) per image ({batch}), got {fraction.tolist()}"
                 )
             start = torch.floor(fraction * (height - num + 1)).long()
-        per_image = _rows_losing(height, num, start)
+        per_image = rows_after_losing(height, num, start)
         index = per_image.repeat_interleave(channels, dim=0) + height * torch.arange(
             batch * channels, device=image.device
         ).unsqueeze(1)
@@ -115,7 +125,7 @@ def em_truncation(
 @functools.lru_cache(maxsize=32)
 def _shared_row_index(planes: int, height: int, num: int, device: torch.device) -> torch.Tensor:
     """Source row of every row of ``planes`` stacked ``height``-row planes that all lose ``num`` rows."""
-    rows = _rows_losing(height, torch.tensor([num]))[0]
+    rows = rows_after_losing(height, torch.tensor([num]))[0]
     offsets = height * torch.arange(planes).unsqueeze(1)
     return (rows.unsqueeze(0) + offsets).reshape(-1).to(device)
 
@@ -124,7 +134,8 @@ class EMTruncation(CameraAttack):
     """EM truncation attack as a torchvision v2 transform.
 
     Intensity -> ratio: 0 (identity) / 0.1 (weak) / 0.2 (medium) / 0.3 (strong), piecewise linear in between
-    (paper, Table 2). ``ratio=`` fixes the physical ratio (in [0, 0.5]) whatever the intensity.
+    (paper, Table 2). ``ratio=`` fixes the physical ratio (in [0, 0.5]) whatever the intensity, calibrated or not. The calibrated
+    options (``ratio_per_intensity``, its ``_spread``, ``ratio_jitter``, ``free_band_position``): module docstring.
     """
 
     name: ClassVar[str] = "em_truncation"
@@ -138,21 +149,39 @@ class EMTruncation(CameraAttack):
         *,
         ratio: float | None = None,
         ratio_per_intensity: float | None = None,
+        ratio_per_intensity_spread: float = 0.0,
+        ratio_jitter: float = 0.0,
         free_band_position: bool = False,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
-        if ratio is not None and not (0.0 <= float(ratio) <= MAX_RATIO):
-            raise ValueError(f"ratio must lie in [0, {MAX_RATIO}], got {ratio!r}")
-        if ratio_per_intensity is not None and not (0.0 <= float(ratio_per_intensity) <= MAX_RATIO):
-            raise ValueError(f"ratio_per_intensity must lie in [0, {MAX_RATIO}], got {ratio_per_intensity!r}")
+        for option, value in (
+            ("ratio", ratio),
+            ("ratio_per_intensity", ratio_per_intensity),
+            ("ratio_per_intensity_spread", ratio_per_intensity_spread),
+            ("ratio_jitter", ratio_jitter),
+        ):
+            if value is not None and not (0.0 <= float(value) <= MAX_RATIO):
+                raise ValueError(f"{option} must lie in [0, {MAX_RATIO}], got {value!r}")
+        if (ratio_per_intensity_spread or ratio_jitter) and ratio_per_intensity is None and ratio is None:
+            raise ValueError(
+                "ratio_per_intensity_spread and ratio_jitter spread the measured line: they need ratio_per_intensity"
+            )
+        if ratio_per_intensity is not None and ratio_per_intensity_spread > ratio_per_intensity:
+            raise ValueError(
+                f"ratio_per_intensity_spread ({ratio_per_intensity_spread!r}) must not exceed ratio_per_intensity "
+                f"({ratio_per_intensity!r}): the slopes would go below 0"
+            )
         self.ratio = None if ratio is None else float(ratio)
         self.ratio_per_intensity = None if ratio_per_intensity is None else float(ratio_per_intensity)
+        self.ratio_per_intensity_spread = float(ratio_per_intensity_spread)
+        self.ratio_jitter = float(ratio_jitter)
         self.free_band_position = bool(free_band_position)
 
     def ratio_for(self, s: torch.Tensor) -> torch.Tensor:
-        """The truncation ratio used at intensity ``s`` (per sample)."""
+        """The truncation ratio used at intensity ``s`` (per sample); with a spread or jitter, the centre of the
+        ratios drawn."""
         if self.ratio is not None:
             return torch.full_like(s, self.ratio, dtype=torch.float32)
         if self.ratio_per_intensity is not None:
@@ -168,12 +197,28 @@ class EMTruncation(CameraAttack):
             params = {"ratio": torch.full((len(values),), ratio, dtype=torch.float32, device=device)}
         else:
             params = {"ratio": self.ratio_for(s).to(device)}
+        if self.ratio is None and (self.ratio_per_intensity_spread or self.ratio_jitter):
+            params["ratio"] = self._spread_ratio(s, generator).to(device)
         if self.free_band_position:
             if generator is None:
                 raise ValueError("free_band_position=True needs a torch.Generator (pass generator= or seed=)")
             start = torch.rand(len(values), generator=generator, dtype=torch.float64, device=generator.device)
             params["start_fraction"] = start.to(device)
         return params
+
+    def _spread_ratio(self, s: torch.Tensor, generator: torch.Generator | None) -> torch.Tensor:
+        """Each sample's ratio ``(a + w u) s + d z`` (module docstring), clipped to ``[0, 0.5]``; none at zero
+        intensity."""
+        if generator is None:
+            raise ValueError(
+                "ratio_per_intensity_spread and ratio_jitter need a torch.Generator (pass generator= or seed=)"
+            )
+        u = torch.rand(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
+        z = torch.randn(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
+        s = s.detach().cpu().to(torch.float64)
+        slope = self.ratio_per_intensity + self.ratio_per_intensity_spread * (2 * u - 1)
+        ratio = torch.clamp(slope * s + self.ratio_jitter * z, 0.0, MAX_RATIO)
+        return torch.where(s > 0, ratio, torch.zeros_like(ratio)).to(torch.float32)
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         return em_truncation(x, params["ratio"], params.get("start_fraction"))
@@ -186,4 +231,6 @@ class EMTruncation(CameraAttack):
         extra = "" if self.ratio is None else f", ratio={self.ratio}"
         if self.ratio_per_intensity is not None:
             extra += f", ratio_per_intensity={self.ratio_per_intensity}"
+        if self.ratio_per_intensity_spread or self.ratio_jitter:
+            extra += f", ratio_per_intensity_spread={self.ratio_per_intensity_spread}, ratio_jitter={self.ratio_jitter}"
         return super().extra_repr() + extra + (", free_band_position=True" if self.free_band_position else "")

@@ -44,7 +44,12 @@ CALIBRATED = {
     },
     "ultrasound_blur": {"path": "sinusoidal", "gamma": 2.2},
     "em_color_strip": {"model": "bayer_phase_flip", "gain": 1.8, "offset": 0.05},
-    "em_truncation": {"ratio_per_intensity": 0.25, "free_band_position": True},
+    "em_truncation": {
+        "ratio_per_intensity": 0.25,
+        "ratio_per_intensity_spread": 0.02,
+        "ratio_jitter": 0.01,
+        "free_band_position": True,
+    },
 }
 
 

@@ -4,16 +4,25 @@ from __future__ import annotations
 
 import numpy as np
 import torch
+from scipy import stats
 
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.em_truncation import (
     TruncationFrames,
     count_law,
     count_probabilities,
-    truncation_source_rows,
 )
 
 HEIGHT, WIDTH = 48, 8
+
+
+def rows_after_deleting(height: int, num: int, start: int) -> torch.Tensor:
+    """The paper's operation written out (``np.delete`` of the band, ``np.append`` of the tail), independently of
+    the package's index arithmetic: the source row of every output row."""
+    rows = np.arange(height)
+    return torch.from_numpy(
+        np.concatenate([np.delete(rows, np.arange(start, start + num)), rows[height - num :]])
+    )
 
 
 def truncated_pair(
@@ -24,7 +33,7 @@ def truncated_pair(
     clean = torch.from_numpy(rng.uniform(0.0, 1.0, (3, HEIGHT, WIDTH)))
     num = int(HEIGHT * ratio_per_intensity * intensity)
     start = max(0, min(num, HEIGHT - 2 * num))
-    attacked = clean[:, torch.from_numpy(truncation_source_rows(HEIGHT, num, start))]
+    attacked = clean[:, rows_after_deleting(HEIGHT, num, start)]
     return Pair(f"pair_{intensity:.3f}", clean, attacked, None, intensity), num
 
 
@@ -51,7 +60,7 @@ def test_the_count_line_reads_floored_counts_without_bias_and_predicts_beyond_th
     assert covered == 20, covered
 
 
-def test_one_line_explains_exact_counts_and_contradicting_counts_get_the_least_jitter():
+def test_one_line_explains_exact_counts():
     heights = np.array([48, 48, 60])
     intensities = np.array([0.4, 0.8, 1.0])
     slope = 0.27
@@ -62,11 +71,54 @@ def test_one_line_explains_exact_counts_and_contradicting_counts_get_the_least_j
     for a in (low, 0.5 * (low + high), high - 1e-9):
         assert (np.floor(heights * a * intensities) == counts).all()
     assert (np.floor(heights * (high + 1e-6) * intensities) != counts).any()
-    # two frames at one intensity, 10 and 12 rows lost: [10, 11) and [12, 13) rows meet with half a row of jitter
+
+
+def test_contradicting_counts_get_the_most_likely_normal_jitter_which_gives_every_count_a_probability():
+    """Two frames at one intensity that lost 10 and 12 rows: the least jitter that reconciles them (half a row,
+    until session 61) predicted 11 rows for every frame at that intensity, neither count seen. The most likely normal
+    jitter is the one at which 0.5 phi(0.5 / d) = 1.5 phi(1.5 / d) (rows): d = 1 / sqrt(ln 3) rows; 10 and 12 rows
+    each have the probability Phi(-0.5 / d) - Phi(-1.5 / d). A frame at zero intensity that lost 3 rows: jitter
+    alone explains it, 4 phi(4 / d) = 3 phi(3 / d), d = sqrt(7 / (2 ln 4/3)) rows."""
     low, high, jitter = count_law(np.array([10, 12]), np.array([48, 48]), np.array([0.8, 0.8]))
-    assert np.isclose(jitter, 0.5 / 48) and np.isclose(low, high)
-    # a frame at zero intensity that lost rows: only jitter explains it
-    assert count_law(np.array([3]), np.array([48]), np.array([0.0]))[2] == 3 / 48
+    assert low == high and np.isclose(low * 0.8 * 48, 11.5, atol=1e-4)
+    assert np.isclose(jitter * 48, 1 / np.sqrt(np.log(3)), rtol=1e-3)
+    counts, weights = count_probabilities(0.8 * low, 0.8 * high, 48, 24, jitter=jitter)
+    share = {int(c): w for c, w in zip(counts, weights, strict=True)}
+    expected = stats.norm.cdf(-0.5 * np.sqrt(np.log(3))) - stats.norm.cdf(-1.5 * np.sqrt(np.log(3)))
+    assert np.isclose(share[10], expected, rtol=1e-3) and np.isclose(share[12], expected, rtol=1e-3)
+    assert share[11] > share[10] and {9, 13} <= set(share)
+    zero = count_law(np.array([3]), np.array([48]), np.array([0.0]))[2]
+    assert np.isclose(zero * 48, np.sqrt(7 / (2 * np.log(4 / 3))), rtol=1e-3)
+
+
+def log_likelihood(counts, heights, intensities, slope, jitter) -> float:
+    """The frames' counts under ``r = a s + e``, ``e`` normal with standard deviation ``d``, by scipy's normal."""
+    low, high = counts / heights, (counts + 1) / heights
+    centre = slope * intensities
+    with np.errstate(divide="ignore"):  # a count the line and jitter make impossible: -inf, never the best
+        return float(
+            np.sum(np.log(stats.norm.cdf(high, centre, jitter) - stats.norm.cdf(low, centre, jitter)))
+        )
+
+
+def test_the_jittered_law_is_at_least_as_likely_as_any_line_and_jitter_on_a_fine_grid():
+    """Frames whose ratio was drawn with a jitter (10 draws of 8 frames): no (slope, jitter) on a 201 x 201 grid
+    explains their counts better than the law's."""
+    for seed in range(10):
+        rng = np.random.default_rng(seed)
+        heights = rng.choice([48, 60, 72], 8)
+        intensities = rng.uniform(0.2, 1.0, 8)
+        slope, spread = rng.uniform(0.15, 0.3), rng.uniform(0.01, 0.04)
+        counts = np.floor(heights * (slope * intensities + rng.uniform(-spread, spread, 8))).astype(int)
+        low, high, jitter = count_law(counts, heights, intensities)
+        assert jitter > 0 and low == high, seed
+        best = log_likelihood(counts, heights, intensities, low, jitter)
+        grid = max(
+            log_likelihood(counts, heights, intensities, a, d)
+            for a in np.linspace(max(low - 0.03, 0.0), low + 0.03, 201)
+            for d in np.linspace(jitter / 3, jitter * 3, 201)
+        )
+        assert best >= grid - 1e-6, (seed, best, grid)
 
 
 def test_count_probabilities_are_the_floors_of_a_uniform_ratio():
@@ -85,7 +137,7 @@ def test_a_free_band_reaching_into_the_repeated_tail_is_registered_and_an_unchan
     num = 10
     pairs = []
     for start in (5, HEIGHT - 2 * num + 4, HEIGHT - num):  # inside the paper's clamp, into the tail, the tail
-        attacked = clean[:, torch.from_numpy(truncation_source_rows(HEIGHT, num, start))]
+        attacked = clean[:, rows_after_deleting(HEIGHT, num, start)]
         pairs.append(Pair(f"start_{start}", clean, attacked, None, 0.8))
     problem = TruncationFrames(pairs, 0)
     assert problem.placement(True, 0) == (num, 5)
@@ -96,3 +148,37 @@ def test_a_free_band_reaching_into_the_repeated_tail_is_registered_and_an_unchan
     assert fit.params["ratio_jitter"] == 0.0
     low, high = fit.extra["slope_range"]
     assert np.floor(HEIGHT * low * 0.8) == num == np.floor(HEIGHT * (high - 1e-9) * 0.8)
+
+
+def test_the_calibrated_transform_draws_from_the_law_held_out_frames_are_scored_with():
+    """Contradicting counts (10 and 12 rows at one intensity) need jitter; the transform the calibration writes
+    draws each frame's count from the same law (``predicted_counts``) instead of one count per intensity."""
+    from lerobot_phantom.transforms.em_truncation import EMTruncation
+
+    rng = np.random.default_rng(5)
+    clean = torch.from_numpy(rng.uniform(0.0, 1.0, (3, HEIGHT, WIDTH)))
+    pairs = [
+        Pair(
+            f"lost_{num}",
+            clean,
+            clean[:, rows_after_deleting(HEIGHT, num, min(num, HEIGHT - 2 * num))],
+            None,
+            s,
+        )
+        for num, s in ((10, 0.8), (12, 0.8), (5, 0.4))
+    ]
+    problem = TruncationFrames(pairs, 0)
+    fit = problem.fit(frozenset(), np.arange(3))
+    kwargs = problem.transform_kwargs(fit)
+    assert kwargs["ratio_jitter"] > 0
+    attack = EMTruncation(**kwargs, seed=0)
+    draws = 4000
+    params = attack.sample_params(
+        draws, HEIGHT, WIDTH, intensity=torch.full((draws,), 0.8), generator=torch.Generator().manual_seed(9)
+    )
+    drawn, frequency = np.unique([int(HEIGHT * r) for r in params["ratio"].tolist()], return_counts=True)
+    counts, weights = problem.predicted_counts(fit, 0)
+    assert set(drawn.tolist()) <= set(counts.tolist()) and {10, 12} <= set(drawn.tolist())
+    observed = np.array([frequency[drawn.tolist().index(c)] if c in drawn else 0 for c in counts]) / draws
+    assert np.abs(observed - weights).max() < 4.5 * np.sqrt(0.25 / draws)
+    assert kwargs["ratio_per_intensity_spread"] == 0.0  # the law's jitter or its slopes' range, never both

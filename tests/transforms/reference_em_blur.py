@@ -44,15 +44,18 @@ def em_color_strip_reference(
     return out
 
 
-def em_truncation_reference(image: np.ndarray, ratio: float, *, paper_start: bool = False) -> np.ndarray:
+def em_truncation_reference(
+    image: np.ndarray, ratio: float, *, paper_start: bool = False, start: int | None = None
+) -> np.ndarray:
     """Delete ``int(h*r)`` rows starting at ``int(h*r)`` and append the last ``int(h*r)`` rows.
 
     ``paper_start=True`` keeps the released code's ``start = int(h*r)`` (identity at r = 0.5, taller output above);
-    otherwise ``start = max(0, min(int(h*r), h - 2*num))``.
+    otherwise ``start = max(0, min(int(h*r), h - 2*num))``, or the given ``start`` (a free band).
     """
     h = image.shape[0]
     num = int(h * ratio)
-    start = int(h * ratio) if paper_start else max(0, min(int(h * ratio), h - 2 * num))
+    if start is None:
+        start = int(h * ratio) if paper_start else max(0, min(int(h * ratio), h - 2 * num))
     kept = [image[row] for row in range(h) if not (start <= row < start + num)]
     appended = [image[row] for row in range(h - num, h)]
     return np.stack(kept + appended, axis=0)

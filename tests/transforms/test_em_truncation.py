@@ -220,24 +220,122 @@ def test_calibrated_line_and_free_band_start_per_sample_anywhere_up_to_h_minus_n
         EMTruncation(0.8, ratio_per_intensity=0.7)
 
 
-def test_the_transform_loses_the_rows_the_calibration_models():
-    """The calibration's row model (``calibration.frame_models.em_truncation.truncation_source_rows``) and the
-    transform agree for every count and start, the paper's and the free ones."""
-    from lerobot_phantom.calibration.frame_models.em_truncation import paper_start, truncation_source_rows
-
+def test_every_count_and_start_loses_the_rows_the_paper_deletes():
+    """The row index (``rows_after_losing``, which the calibration's frame model predicts frames with too) against
+    the reference's delete-and-append for every count, at the paper's clamped start and at every free start."""
     height = 24
     image = torch.arange(height, dtype=torch.float32).view(1, 1, height, 1).expand(1, 3, height, 2)
+    column = _hwc(image[0])
     for num in range(height // 2 + 1):
         # inside [num, num + 1) rows, clear of float rounding (half the frame: exactly 0.5, the largest ratio)
-        ratio = torch.tensor([min(num + 0.5, height / 2) / height])
-        paper = em_truncation(image, ratio)[0, 0, :, 0]
-        assert torch.equal(
-            paper, torch.from_numpy(truncation_source_rows(height, num, paper_start(height, num))).float()
-        )
+        ratio = min(num + 0.5, height / 2) / height
+        paper = em_truncation(image, torch.tensor([ratio]))[0]
+        assert torch.equal(paper, _chw(em_truncation_reference(column, ratio))), num
         for start in range(height - num + 1):
             fraction = torch.tensor([(start + 0.5) / (height - num + 1)])
-            free = em_truncation(image, ratio, fraction)[0, 0, :, 0]
-            assert torch.equal(free, torch.from_numpy(truncation_source_rows(height, num, start)).float()), (
-                num,
-                start,
-            )
+            free = em_truncation(image, torch.tensor([ratio]), fraction)[0]
+            assert torch.equal(free, _chw(em_truncation_reference(column, ratio, start=start))), (num, start)
+
+
+def _drawn_counts(attack: EMTruncation, height: int, intensity: torch.Tensor, seed: int) -> torch.Tensor:
+    """Rows each sample loses: ``int(h r)`` of its drawn ratio, as ``em_truncation`` counts them."""
+    params = attack.sample_params(
+        len(intensity), height, 4, intensity=intensity, generator=torch.Generator().manual_seed(seed)
+    )
+    return torch.tensor([int(height * r) for r in params["ratio"].tolist()])
+
+
+def assert_counts_follow(counts: torch.Tensor, expected_counts: np.ndarray, expected: np.ndarray) -> None:
+    """Every drawn count is one the law allows, and each allowed count's frequency is within 4.5 standard errors
+    of its probability."""
+    draws = len(counts)
+    seen, frequency = np.unique(counts.numpy(), return_counts=True)
+    assert set(seen.tolist()) <= set(expected_counts.tolist()), (seen, expected_counts)
+    observed = (
+        np.array([frequency[seen.tolist().index(c)] if c in seen else 0 for c in expected_counts]) / draws
+    )
+    tolerance = 4.5 * np.sqrt(expected * (1 - expected) / draws) + 1e-4
+    assert (np.abs(observed - expected) <= tolerance).all(), (observed, expected)
+
+
+def test_a_spread_line_draws_the_counts_the_calibration_predicts_held_out_frames_with():
+    """With the calibration's slope range (uniform slopes, counts consistent) or its jitter (normal, counts that
+    contradict one line), each sample's count has the probability the calibration scores held-out frames with
+    (``count_probabilities``), and every sample of a batch draws its own."""
+    from lerobot_phantom.calibration.frame_models.em_truncation import count_probabilities
+
+    height, draws, slope = 40, 20000, 0.25
+    spread_line = EMTruncation(ratio_per_intensity=slope, ratio_per_intensity_spread=0.05)
+    jittered_line = EMTruncation(ratio_per_intensity=slope, ratio_jitter=0.02)
+    for s in (0.3, 0.8, 1.0):
+        counts = _drawn_counts(spread_line, height, torch.full((draws,), s), seed=int(s * 10))
+        assert_counts_follow(counts, *count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20))
+        counts = _drawn_counts(jittered_line, height, torch.full((draws,), s), seed=int(s * 10) + 1)
+        assert_counts_follow(counts, *count_probabilities(slope * s, slope * s, height, 20, jitter=0.02))
+    # without the spread and jitter the line gives one count per intensity
+    assert set(
+        _drawn_counts(EMTruncation(ratio_per_intensity=slope), height, torch.full((50,), 0.8), 0).tolist()
+    ) == {8}
+
+
+def test_a_spread_line_loses_each_samples_drawn_rows_and_none_at_zero_intensity():
+    height, batch = 40, 64
+    image = torch.arange(height, dtype=torch.float32).view(1, 1, height, 1).expand(batch, 3, height, 2)
+    attack = EMTruncation(
+        0.9, ratio_per_intensity=0.3, ratio_per_intensity_spread=0.1, ratio_jitter=0.05, seed=7
+    )
+    params = attack.sample_params(batch, height, 2, generator=torch.Generator().manual_seed(1))
+    assert len(set(params["ratio"].tolist())) > batch // 2  # per sample, not one draw for the batch
+    assert bool(((params["ratio"] >= 0) & (params["ratio"] <= 0.5)).all())
+    out = attack.apply_params(image, params)
+    for k in range(batch):
+        expected = em_truncation_reference(_hwc(image[k]), float(params["ratio"][k]))
+        assert torch.equal(out[k], _chw(expected)), k
+    # jitter is the attack's spread, not an attack of its own: at zero intensity every frame passes unchanged
+    zero = EMTruncation(
+        0.0, ratio_per_intensity=0.3, ratio_per_intensity_spread=0.1, ratio_jitter=0.05, seed=7
+    )
+    assert torch.equal(zero(image), image)
+    mixed = torch.tensor([0.0, 0.5, 1.0]).repeat(20)
+    counts = _drawn_counts(attack, height, mixed, seed=2)
+    assert (counts[mixed == 0] == 0).all() and (counts[mixed > 0] > 0).any()
+
+    def fresh():
+        return EMTruncation(
+            0.9, ratio_per_intensity=0.3, ratio_per_intensity_spread=0.1, ratio_jitter=0.05, seed=7
+        )
+
+    assert torch.equal(pickle.loads(pickle.dumps(fresh()))(image), fresh()(image))
+    assert "ratio_jitter=0.05" in repr(fresh())
+
+
+@pytest.mark.parametrize(
+    ("options", "message"),
+    [
+        ({"ratio_per_intensity_spread": 0.05}, "they need ratio_per_intensity"),
+        (
+            {"ratio_per_intensity": 0.1, "ratio_per_intensity_spread": 0.2},
+            r"must not exceed ratio_per_intensity",
+        ),
+        ({"ratio_per_intensity": 0.1, "ratio_jitter": 0.6}, r"ratio_jitter must lie in \[0, 0.5\]"),
+        ({"ratio_per_intensity": 0.1, "ratio_per_intensity_spread": -0.01}, r"spread must lie in \[0, 0.5\]"),
+    ],
+)
+def test_a_spread_line_refuses_options_that_describe_no_law(options, message):
+    with pytest.raises(ValueError, match=message):
+        EMTruncation(0.5, **options)
+
+
+def test_a_spread_line_needs_a_generator():
+    attack = EMTruncation(0.5, ratio_per_intensity=0.2, ratio_jitter=0.01)
+    with pytest.raises(ValueError, match=r"ratio_jitter need a torch\.Generator"):
+        attack.sample_params(2, 40, 8)
+
+
+def test_a_fixed_ratio_wins_over_a_calibrated_spread_line():
+    """``make_attack(..., calibration=DIR, ratio=0.2)``: the explicit ratio, as it wins over the measured line."""
+    attack = EMTruncation(
+        0.7, ratio=0.2, ratio_per_intensity=0.3, ratio_per_intensity_spread=0.1, ratio_jitter=0.05
+    )
+    params = attack.sample_params(16, 40, 8, generator=torch.Generator().manual_seed(0))
+    assert torch.allclose(params["ratio"], torch.full((16,), 0.2))

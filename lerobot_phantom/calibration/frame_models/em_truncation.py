@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import numpy as np
 import torch
+from scipy import optimize, special
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
+from lerobot_phantom.transforms.em_truncation import paper_band_start, rows_after_losing
 
 TRUNCATION_EFFECTS = (
     Effect(
@@ -17,53 +19,105 @@ TRUNCATION_EFFECTS = (
 )
 
 
-def truncation_source_rows(height: int, num: int, start: int) -> np.ndarray:
-    """Source row of every output row when rows ``[start, start + num)`` are deleted and the tail is repeated."""
-    rows = np.arange(height)
-    shifted = (rows >= start) & (rows < height - num)
-    return np.where(shifted, rows + num, rows)
-
-
-def paper_start(height: int, num: int) -> int:
-    """The paper's band start ``int(h r) = num``, clamped so the band never overlaps the appended tail (as
-    ``transforms.em_truncation``)."""
-    return max(0, min(num, height - 2 * num))
-
-
 def count_law(counts: np.ndarray, heights: np.ndarray, intensities: np.ndarray) -> tuple[float, float, float]:
     """The line ``r = a s`` from attack intensity ``s`` to truncation ratio, read from frames that lost
     ``counts`` rows: (lowest slope, highest slope, jitter).
 
     The count is ``int(h r)``, a floor (the paper's Appendix A, and ``transforms.em_truncation``): a frame that
     lost ``n`` of ``h`` rows had ``r`` anywhere in ``[n / h, (n + 1) / h)``, and one line explains every fit frame
-    when the slopes those intervals allow overlap; each slope in the overlap is then as likely as any other.
-    Where they do not overlap (the interference's timing varies from frame to frame, or a frame was registered
-    wrongly), the ratio is given the least jitter ``d`` that makes them overlap, ``r = a s + e`` with ``|e| <= d``,
-    and the overlap is then one slope. Either way a frame's ratio is predicted uniform over
-    ``[s low - d, s high + d]``. A least-squares line through the counts (``n / h``, rounded back, until session
-    59) sits half a row low and has no spread of its own: a frame beyond the fit frames' intensities was predicted a
-    row short, every row below its band wrong, and a free band start looked like a gain on a null draw."""
+    when the slopes those intervals allow overlap; each slope in the overlap is then as likely as any other, and a
+    frame's ratio is predicted uniform over ``[s low, s high]``. Where they do not overlap (the interference's
+    timing varies from frame to frame, or a frame was registered wrongly), the ratio jitters, ``r = a s + e`` with
+    ``e`` normal of standard deviation ``d``, and the line and jitter are the most likely ones
+    (:func:`most_likely_jitter`): one slope. A least-squares line through the counts (``n / h``, rounded back,
+    until session 59) sits half a row low and has no spread of its own: a frame beyond the fit frames' intensities
+    was predicted a row short, every row below its band wrong, and a free band start looked like a gain on a null
+    draw."""
     low, high = counts / heights, (counts + 1) / heights
     lit = intensities > 0
-    # the slope intervals of frames i and j overlap once d >= (low_i s_j - high_j s_i) / (s_i + s_j); a frame
-    # at zero intensity allows no slope to move it, only jitter (d >= low_i)
+    touching = least_jitter(low, high, intensities)
+    if touching == 0.0:
+        if not lit.any():
+            return 0.0, 0.0, 0.0
+        lowest = max(0.0, float(np.max(low[lit] / intensities[lit])))
+        highest = float(np.min(high[lit] / intensities[lit]))
+        return lowest, max(lowest, highest), 0.0
+    slope, jitter = most_likely_jitter(low, high, intensities, touching)
+    return slope, slope, jitter
+
+
+def least_jitter(low: np.ndarray, high: np.ndarray, intensities: np.ndarray) -> float:
+    """The least ``d`` for which some line ``a s`` (``a >= 0``) comes within ``d`` of every frame's interval
+    ``[low, high]``: the slope intervals of frames ``i`` and ``j`` meet once ``d >= (low_i s_j - high_j s_i) /
+    (s_i + s_j)``, and a frame at zero intensity allows no slope to move it, only jitter (``d >= low_i``)."""
     pairwise = np.add.outer(intensities, intensities)
     needed = np.outer(low, intensities) - np.outer(intensities, high)
-    jitter = max(
+    return max(
         0.0,
         float(np.max(needed[pairwise > 0] / pairwise[pairwise > 0], initial=0.0)),
-        float(np.max(low[~lit], initial=0.0)),
+        float(np.max(low[intensities <= 0], initial=0.0)),
     )
-    if not lit.any():
-        return 0.0, 0.0, jitter
-    lowest = max(0.0, float(np.max((low[lit] - jitter) / intensities[lit])))
-    highest = float(np.min((high[lit] + jitter) / intensities[lit]))
-    return lowest, max(lowest, highest), jitter
 
 
-def count_probabilities(low: float, high: float, height: int, most: int) -> tuple[np.ndarray, np.ndarray]:
+def log_interval_probability(
+    low: np.ndarray, high: np.ndarray, centre: np.ndarray, jitter: float
+) -> np.ndarray:
+    """``log P(low <= centre + e < high)`` for ``e`` normal with standard deviation ``jitter``, accurate in both
+    tails (a difference of upper-tail probabilities where both ends lie above the centre)."""
+    a, b = (low - centre) / jitter, (high - centre) / jitter
+    upper = a > 0  # both ends above the centre: Q(a) - Q(b), with Q(x) = Phi(-x)
+    first = np.where(upper, special.log_ndtr(-a), special.log_ndtr(b))
+    second = np.where(upper, special.log_ndtr(-b), special.log_ndtr(a))
+    with np.errstate(divide="ignore"):
+        return first + np.log1p(-np.exp(np.minimum(second - first, 0.0)))
+
+
+def most_likely_jitter(
+    low: np.ndarray, high: np.ndarray, intensities: np.ndarray, touching: float
+) -> tuple[float, float]:
+    """The slope ``a`` and normal jitter ``d`` under which the frames' counts are most likely (each frame's the
+    probability that ``a s + e`` falls in its interval ``[low, high)``: interval-censored normal regression),
+    where the intervals do not meet (``touching`` = :func:`least_jitter` > 0).
+
+    Session 61 tried the least uniform jitter first, then the most likely uniform one: at the least, the line only
+    touches the outermost intervals, whose counts then have no probability at all (two frames at one intensity
+    that lost 10 and 12 rows predicted 11 for every frame); a uniform, even at its most likely width, still gives a
+    held-out frame no probability one row past the fit frames' spread, which a free band start then "explained"
+    on null draws whose count varied from frame to frame. A normal jitter gives every count a probability that
+    falls with its distance from the line. Starts at the touching line, ``d`` at the touching jitter."""
+    lit = intensities > 0
+    slope = 0.0
+    if lit.any():
+        slope = 0.5 * (
+            max(0.0, float(np.max((low[lit] - touching) / intensities[lit])))
+            + float(np.min((high[lit] + touching) / intensities[lit]))
+        )
+
+    def negative_log_likelihood(x: np.ndarray) -> float:
+        return -float(np.sum(log_interval_probability(low, high, x[0] * intensities, float(np.exp(x[1])))))
+
+    result = optimize.minimize(
+        negative_log_likelihood,
+        np.array([slope, np.log(touching)]),
+        method="L-BFGS-B",
+        bounds=[(0.0, 1.0), (np.log(touching) - 5.0, np.log(0.5))],
+    )
+    return float(result.x[0]), float(np.exp(result.x[1]))
+
+
+def count_probabilities(
+    low: float, high: float, height: int, most: int, jitter: float = 0.0
+) -> tuple[np.ndarray, np.ndarray]:
     """Rows lost, ``int(h r)`` clipped to ``[0, most]``, and their probabilities, for a ratio uniform on
-    ``[low, high]``."""
+    ``[low, high]`` or, with ``jitter``, normal about ``low`` (= ``high``) with that standard deviation (counts
+    below a millionth of a percent left out)."""
+    if jitter > 0:
+        counts = np.arange(0, most + 1)
+        below = np.where(counts == 0, -np.inf, counts / height)
+        above = np.where(counts == most, np.inf, (counts + 1) / height)
+        weights = np.exp(log_interval_probability(below, above, np.full(len(counts), low), jitter))
+        keep = weights > 1e-8
+        return counts[keep], weights[keep] / weights[keep].sum()
     first, last = int(np.floor(low * height)), int(np.floor(high * height))
     counts = np.arange(first, last + 1)
     if high - low > 1e-12:
@@ -128,7 +182,9 @@ class TruncationFrames(LatentFrameProblem):
         itself and the frame comes out as it went in). Until session 59 a free band stopped at ``h - 2 num``,
         the paper's clamp, and ``num`` of the ``h - num + 1`` starts an independent simulator draws from (camsim:
         about a fifth at its typical counts) had no placement."""
-        return np.arange(0, height - num + 1) if free else np.array([paper_start(height, num)])
+        return (
+            np.arange(0, height - num + 1) if free else paper_band_start(height, torch.tensor([num])).numpy()
+        )
 
     def placement(self, free: bool, index: int) -> tuple[int, int]:
         """(rows lost, band start) that best explain pair ``index`` (registration: fit frames, or reporting)."""
@@ -151,7 +207,7 @@ class TruncationFrames(LatentFrameProblem):
         low, high = fit.extra["slope_range"]
         jitter = fit.params["ratio_jitter"]
         return count_probabilities(
-            pair.intensity * low - jitter, pair.intensity * high + jitter, pair.height, pair.height // 2
+            pair.intensity * low, pair.intensity * high, pair.height, pair.height // 2, jitter
         )
 
     def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
@@ -172,7 +228,7 @@ class TruncationFrames(LatentFrameProblem):
     def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
         num, start = self.placement("free_band_position" in fit.effects, index)
         pair = self.pairs[index]
-        return pair.clean[:, torch.as_tensor(truncation_source_rows(pair.height, num, start))]
+        return pair.clean[:, rows_after_losing(pair.height, torch.tensor([num]), torch.tensor([start]))[0]]
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         free = "free_band_position" in effects
@@ -197,9 +253,13 @@ class TruncationFrames(LatentFrameProblem):
     def transform_kwargs(self, fit: Fit) -> dict:
         """``EMTruncation`` options: the measured line from intensity to ratio in place of the paper's level table
         (the middle of the slopes the fit frames allow), and the band's start drawn anywhere where the written
-        model frees it. The count's jitter is not simulated (``transforms.em_truncation``)."""
+        model frees it; each frame's ratio is drawn from the law held-out frames are predicted with (half the
+        slopes' range as the spread, and the jitter)."""
+        low, high = fit.extra["slope_range"]
         return {
             "ratio_per_intensity": fit.params["ratio_per_intensity"],
+            "ratio_per_intensity_spread": 0.5 * (high - low),
+            "ratio_jitter": fit.params["ratio_jitter"],
             "free_band_position": "free_band_position" in fit.effects,
         }
 
