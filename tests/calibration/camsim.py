@@ -643,11 +643,15 @@ def em_truncation_pairs(
     *,
     free_position: bool = False,
     hum_bars: float = 0.0,
+    count_spread: float = 0.0,
 ) -> list[FramePair]:
     """EM truncation: rows [s, s + n) are lost, the frame moves up and its last n rows are stitched below (the
     paper's Appendix A), with n = int(h * r), r = ratio_per_intensity * intensity. The paper puts s = n; with
     ``free_position`` the corrupted address is anywhere, s uniform in [0, h - n]. ``hum_bars``: EMI also couples
-    into the analogue gain as a slow row-periodic ripple of this relative depth (no library effect names it)."""
+    into the analogue gain as a slow row-periodic ripple of this relative depth (no library effect names it).
+    ``count_spread``: the interference's timing varies from frame to frame, so the count is the nearest whole row
+    to h r (1 + g), g normal with this relative standard deviation (the library's count law is a floor with a
+    bounded, uniform jitter: a different form)."""
     h = cam.height
     ratio_per_intensity = rng.uniform(0.2, 0.3)
     ripple_period, ripple_phase = rng.uniform(0.3, 0.6) * h, rng.uniform(0, 2 * np.pi)
@@ -658,6 +662,14 @@ def em_truncation_pairs(
         clean, exposure = session.clean(refl * light, rng)
         attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
         n = int(h * ratio_per_intensity * intensity)
+        if count_spread:
+            n = int(
+                np.clip(
+                    np.rint(h * ratio_per_intensity * intensity * (1 + rng.normal(0, count_spread))),
+                    0,
+                    h // 2,
+                )
+            )
         start = int(rng.integers(0, h - n + 1)) if free_position else n
         rows = np.concatenate([np.arange(0, start), np.arange(start + n, h), np.arange(h - n, h)])
         attacked = quantised(attacked)[rows]
