@@ -58,9 +58,10 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     assert report["n_fit"] + report["n_heldout"] == 10
     calibrated = json.loads((tmp_path / "out" / "calibrated.json").read_text())
     assert calibrated["attack"] == attack and set(calibrated["effects"]) == named
-    # the fitted model drives the attack transform
+    # the fitted model drives the attack transform (on a batch: a free band drawn at the tail, one start in
+    # h - n + 1, rightly leaves its frame unchanged)
     attack_transform = make_attack(attack, intensity="strong", calibration=str(tmp_path / "out"), seed=0)
-    image = torch.rand(1, 3, 48, 64, generator=torch.Generator().manual_seed(seed))
+    image = torch.rand(4, 3, 48, 64, generator=torch.Generator().manual_seed(seed))
     attacked = attack_transform(image)
     assert attacked.shape == image.shape and not torch.equal(attacked, image)
 

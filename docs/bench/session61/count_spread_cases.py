@@ -20,16 +20,6 @@ sys.path.insert(0, str(TESTS / "calibration"))
 sys.path.insert(1, str(TESTS))
 
 
-def passes(sim, case, report: dict, camera) -> bool:
-    """The camsim test's rule (``test_case``), restated for a batch of seeds."""
-    named = sim.named_causes(report)
-    if case.kind == "effect":
-        return case.planted <= named and len(named - case.planted - sim.tolerated(case, camera)) <= 1
-    if case.kind == "unexplained":
-        return not named - sim.tolerated(case, camera) and bool(sim.unexplained_structure(report))
-    return not report["extended"]["effects"]
-
-
 def main() -> None:
     import lerobot_phantom
 
@@ -46,7 +36,7 @@ def main() -> None:
         low, high = heldout["heldout_rmse_interval"]["low"], heldout["heldout_rmse_interval"]["high"]
         print(
             f"{name} {master} (case seed {result['seed']}) "
-            f"{'pass' if passes(sim, case, report, result['camera']) else 'FAIL'} "
+            f"{'pass' if sim.passes(case, report, result['camera']) else 'FAIL'} "
             f"named {sorted(sim.named_causes(report))} slope {params['ratio_per_intensity']:.4f} "
             f"jitter {params['ratio_jitter'] * height:.2f} rows | heldout {heldout['heldout_rmse']:.3f} "
             f"[{low:.3f}, {high:.3f}] registered {heldout.get('heldout_registered_rmse', float('nan')):.3f}",
