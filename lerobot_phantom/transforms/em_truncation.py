@@ -134,8 +134,9 @@ class EMTruncation(CameraAttack):
     """EM truncation attack as a torchvision v2 transform.
 
     Intensity -> ratio: 0 (identity) / 0.1 (weak) / 0.2 (medium) / 0.3 (strong), piecewise linear in between
-    (paper, Table 2). ``ratio=`` fixes the physical ratio (in [0, 0.5]) whatever the intensity, calibrated or not. The calibrated
-    options (``ratio_per_intensity``, its ``_spread``, ``ratio_jitter``, ``free_band_position``): module docstring.
+    (paper, Table 2). ``ratio=`` fixes the physical ratio (in [0, 0.5]) whatever the intensity, calibrated or
+    not. The calibrated options (``ratio_per_intensity``, its ``_spread``, ``ratio_jitter``,
+    ``free_band_position``): module docstring.
     """
 
     name: ClassVar[str] = "em_truncation"
@@ -232,5 +233,6 @@ class EMTruncation(CameraAttack):
         if self.ratio_per_intensity is not None:
             extra += f", ratio_per_intensity={self.ratio_per_intensity}"
         if self.ratio_per_intensity_spread or self.ratio_jitter:
-            extra += f", ratio_per_intensity_spread={self.ratio_per_intensity_spread}, ratio_jitter={self.ratio_jitter}"
+            extra += f", ratio_per_intensity_spread={self.ratio_per_intensity_spread}"
+            extra += f", ratio_jitter={self.ratio_jitter}"
         return super().extra_repr() + extra + (", free_band_position=True" if self.free_band_position else "")

@@ -100,7 +100,8 @@ def most_likely_jitter(
         negative_log_likelihood,
         np.array([slope, np.log(touching)]),
         method="L-BFGS-B",
-        bounds=[(0.0, 1.0), (np.log(touching) - 5.0, np.log(0.5))],
+        # the transform's and Param's range: a ratio past 0.5 would lose more rows than the tail can repeat
+        bounds=[(0.0, 0.5), (np.log(touching) - 5.0, np.log(0.5))],
     )
     return float(result.x[0]), float(np.exp(result.x[1]))
 
