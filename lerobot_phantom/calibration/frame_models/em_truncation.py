@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import torch
-from scipy import optimize, special
+from scipy import optimize, stats
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
@@ -62,14 +62,9 @@ def least_jitter(low: np.ndarray, high: np.ndarray, intensities: np.ndarray) -> 
 def log_interval_probability(
     low: np.ndarray, high: np.ndarray, centre: np.ndarray, jitter: float
 ) -> np.ndarray:
-    """``log P(low <= centre + e < high)`` for ``e`` normal with standard deviation ``jitter``, accurate in both
-    tails (a difference of upper-tail probabilities where both ends lie above the centre)."""
-    a, b = (low - centre) / jitter, (high - centre) / jitter
-    upper = a > 0  # both ends above the centre: Q(a) - Q(b), with Q(x) = Phi(-x)
-    first = np.where(upper, special.log_ndtr(-a), special.log_ndtr(b))
-    second = np.where(upper, special.log_ndtr(-b), special.log_ndtr(a))
-    with np.errstate(divide="ignore"):
-        return first + np.log1p(-np.exp(np.minimum(second - first, 0.0)))
+    """``log P(low <= centre + e < high)`` for ``e`` normal with standard deviation ``jitter`` (scipy's
+    two-argument ``logcdf``, accurate in both tails; real, as every interval here has a probability)."""
+    return np.real(stats.Normal(mu=centre, sigma=jitter).logcdf(low, high))
 
 
 def most_likely_jitter(
