@@ -25,8 +25,8 @@ from lerobot_phantom.transforms.registry import make_attack
 DRAWS = 4000
 
 
-def frame_counts(root: Path, case: str, seed: str) -> tuple[list[tuple[float, int, int]], int]:
-    """(intensity, height, registered count) of each held-out frame, and the number of frames."""
+def frame_counts(root: Path, case: str, seed: str) -> list[tuple[float, int, int]]:
+    """(intensity, height, registered count) of each held-out frame."""
     folder = root / seed / case
     report = json.loads((folder / "out" / "report.json").read_text())
     cfg = CalibrateConfig(
@@ -41,7 +41,7 @@ def frame_counts(root: Path, case: str, seed: str) -> tuple[list[tuple[float, in
     for index in heldout:
         pair = problem.pairs[int(index)]
         frames.append((pair.intensity, pair.height, problem.placement(False, int(index))[0]))
-    return frames, problem.n_items
+    return frames
 
 
 def simulated_share(calibration: Path, intensity: float, height: int, count: int) -> float:
@@ -60,7 +60,7 @@ def main() -> None:
     before, after, case, seeds = Path(sys.argv[1]), Path(sys.argv[2]), sys.argv[3], sys.argv[4:]
     totals = {"before": [], "after": []}
     for seed in seeds:
-        frames, _ = frame_counts(after, case, seed)
+        frames = frame_counts(after, case, seed)
         line = []
         for label, root in (("before", before), ("after", after)):
             shares = [simulated_share(root / seed / case / "out", s, h, n) for s, h, n in frames]
