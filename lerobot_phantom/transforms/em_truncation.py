@@ -191,15 +191,15 @@ class EMTruncation(CameraAttack):
 
     def _sample(self, s, height, width, generator, device):
         values = s.tolist()
-        if (
+        if self.ratio is None and (self.ratio_per_intensity_spread or self.ratio_jitter):
+            params = {"ratio": self._spread_ratio(s, generator).to(device)}
+        elif (
             len(set(values)) == 1
         ):  # a fixed intensity: the level map once per value, not a dozen tiny ops per call
             ratio = self._cached(("ratio", values[0]), lambda: float(self.ratio_for(s[:1])[0]))
             params = {"ratio": torch.full((len(values),), ratio, dtype=torch.float32, device=device)}
         else:
             params = {"ratio": self.ratio_for(s).to(device)}
-        if self.ratio is None and (self.ratio_per_intensity_spread or self.ratio_jitter):
-            params["ratio"] = self._spread_ratio(s, generator).to(device)
         if self.free_band_position:
             if generator is None:
                 raise ValueError("free_band_position=True needs a torch.Generator (pass generator= or seed=)")
