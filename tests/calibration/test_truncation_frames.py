@@ -3,8 +3,9 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import torch
-from scipy import stats
+from scipy import integrate, stats
 
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.em_truncation import (
@@ -66,7 +67,8 @@ def test_one_line_explains_exact_counts():
     slope = 0.27
     counts = np.floor(heights * slope * intensities).astype(int)
     low, high, jitter = count_law(counts, heights, intensities)
-    assert jitter == 0.0 and low <= slope < high
+    # agreement leaves a jitter possible, less than half a row of the tallest frame on these three counts
+    assert 0.0 < jitter < 0.5 / heights.max() and low <= slope < high
     # every slope in the range reproduces every count, and a slope just outside it does not
     for a in (low, 0.5 * (low + high), high - 1e-9):
         assert (np.floor(heights * a * intensities) == counts).all()
@@ -89,6 +91,50 @@ def test_contradicting_counts_get_the_most_likely_normal_jitter_which_gives_ever
     assert share[11] > share[10] and {9, 13} <= set(share)
     zero = count_law(np.array([3]), np.array([48]), np.array([0.0]))[2]
     assert np.isclose(zero * 48, np.sqrt(7 / (2 * np.log(4 / 3))), rtol=1e-3)
+
+
+def test_counts_that_agree_by_chance_leave_a_held_out_count_one_row_past_them_possible():
+    """Four frames whose counts one line explains (camsim count-spread seed 596587659 drew such a fold): until
+    session 62 the law was the slopes' range alone, and a held-out frame at the lowest intensity that lost a row
+    more or less than the range allows had no probability; a free band start was named to explain it."""
+    heights = np.full(4, 120)
+    intensities = np.array([0.381, 0.5, 0.7, 0.9])
+    counts = np.floor(heights * 0.25 * intensities).astype(int)
+    low, high, jitter = count_law(counts, heights, intensities)
+    assert jitter > 0.0
+    predicted, weights = count_probabilities(0.381 * low, 0.381 * high, 120, 60, jitter=jitter)
+    share = dict(zip(predicted.tolist(), weights.tolist(), strict=True))
+    seen = counts[0]
+    assert share[seen] > 0.9 and 0.0 < share[seen - 1] < share[seen] and 0.0 < share[seen + 1] < share[seen]
+
+
+def test_the_agreeing_counts_jitter_is_the_posterior_median_by_direct_integration():
+    """The posterior median of the jitter (flat slope prior on [0, 0.5], log-uniform jitter prior from a tenth
+    of a row to 0.5) by scipy's adaptive quadrature over the slope and a fine log grid over the jitter, against
+    the function's own grids, on agreeing counts of three to six frames."""
+    rng = np.random.default_rng(62)
+    for n in (3, 4, 6):
+        heights = rng.choice([48, 60, 72], n)
+        intensities = rng.uniform(0.3, 1.0, n)
+        counts = np.floor(heights * 0.27 * intensities).astype(int)
+        below, above = counts / heights, (counts + 1) / heights
+
+        def likelihood(slope, jitter, below=below, above=above, intensities=intensities):
+            centre = slope * intensities
+            return float(
+                np.prod(stats.norm.cdf(above, centre, jitter) - stats.norm.cdf(below, centre, jitter))
+            )
+
+        log_jitters = np.linspace(np.log(0.1 / heights.max()), np.log(0.5), 150)
+        marginal = np.array(
+            [
+                integrate.quad(likelihood, 0.0, 0.5, args=(np.exp(x),), points=[0.27], limit=200)[0]
+                for x in log_jitters
+            ]
+        )
+        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (marginal[1:] + marginal[:-1]))])
+        median = np.exp(np.interp(0.5 * cumulative[-1], cumulative, log_jitters))
+        assert count_law(counts, heights, intensities)[2] == pytest.approx(median, rel=0.01), n
 
 
 def log_likelihood(counts, heights, intensities, slope, jitter) -> float:
@@ -145,7 +191,7 @@ def test_a_free_band_reaching_into_the_repeated_tail_is_registered_and_an_unchan
     assert torch.equal(pairs[2].attacked, clean)
     # the two frames that show their count agree with a line; the unchanged one would have read 0 rows lost
     fit = problem.fit(frozenset({"free_band_position"}), np.arange(3))
-    assert fit.params["ratio_jitter"] == 0.0
+    assert 0.0 < fit.params["ratio_jitter"] < 0.5 / HEIGHT
     low, high = fit.extra["slope_range"]
     assert np.floor(HEIGHT * low * 0.8) == num == np.floor(HEIGHT * (high - 1e-9) * 0.8)
 

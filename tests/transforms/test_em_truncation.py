@@ -259,19 +259,25 @@ def assert_counts_follow(counts: torch.Tensor, expected_counts: np.ndarray, expe
 
 
 def test_a_spread_line_draws_the_counts_the_calibration_predicts_held_out_frames_with():
-    """With the calibration's slope range (uniform slopes, counts consistent) or its jitter (normal, counts that
-    contradict one line), each sample's count has the probability the calibration scores held-out frames with
-    (``count_probabilities``), and every sample of a batch draws its own."""
+    """With the calibration's slope range (uniform slopes, counts consistent), its jitter (normal, counts that
+    contradict one line) or both (counts that agree, and the jitter agreement leaves possible), each sample's count
+    has the probability the calibration scores held-out frames with (``count_probabilities``), and every sample of a
+    batch draws its own."""
     from lerobot_phantom.calibration.frame_models.em_truncation import count_probabilities
 
     height, draws, slope = 40, 20000, 0.25
     spread_line = EMTruncation(ratio_per_intensity=slope, ratio_per_intensity_spread=0.05)
     jittered_line = EMTruncation(ratio_per_intensity=slope, ratio_jitter=0.02)
+    both = EMTruncation(ratio_per_intensity=slope, ratio_per_intensity_spread=0.05, ratio_jitter=0.02)
     for s in (0.3, 0.8, 1.0):
         counts = _drawn_counts(spread_line, height, torch.full((draws,), s), seed=int(s * 10))
         assert_counts_follow(counts, *count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20))
         counts = _drawn_counts(jittered_line, height, torch.full((draws,), s), seed=int(s * 10) + 1)
         assert_counts_follow(counts, *count_probabilities(slope * s, slope * s, height, 20, jitter=0.02))
+        counts = _drawn_counts(both, height, torch.full((draws,), s), seed=int(s * 10) + 2)
+        law = count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20, jitter=0.02)
+        assert_counts_follow(counts, *law)
+        assert len(law[0]) > len(count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20)[0])
     # without the spread and jitter the line gives one count per intensity
     assert set(
         _drawn_counts(EMTruncation(ratio_per_intensity=slope), height, torch.full((50,), 0.8), 0).tolist()
