@@ -4,6 +4,7 @@ import pickle
 import numpy as np
 import pytest
 import torch
+from drawn_frequencies import assert_frequencies_follow
 from reference_em_blur import em_truncation_reference
 
 from lerobot_phantom.transforms.em_truncation import EMTruncation, em_truncation, truncation_row_index
@@ -245,19 +246,6 @@ def _drawn_counts(attack: EMTruncation, height: int, intensity: torch.Tensor, se
     return torch.tensor([int(height * r) for r in params["ratio"].tolist()])
 
 
-def assert_counts_follow(counts: torch.Tensor, expected_counts: np.ndarray, expected: np.ndarray) -> None:
-    """Every drawn count is one the law allows, and each allowed count's frequency is within 4.5 standard errors
-    of its probability."""
-    draws = len(counts)
-    seen, frequency = np.unique(counts.numpy(), return_counts=True)
-    assert set(seen.tolist()) <= set(expected_counts.tolist()), (seen, expected_counts)
-    observed = (
-        np.array([frequency[seen.tolist().index(c)] if c in seen else 0 for c in expected_counts]) / draws
-    )
-    tolerance = 4.5 * np.sqrt(expected * (1 - expected) / draws) + 1e-4
-    assert (np.abs(observed - expected) <= tolerance).all(), (observed, expected)
-
-
 def test_a_spread_line_draws_the_counts_the_calibration_predicts_held_out_frames_with():
     """With the calibration's slope range (uniform slopes, counts consistent), its jitter (normal, counts that
     contradict one line) or both (counts that agree, and the jitter agreement leaves possible), each sample's count
@@ -271,12 +259,16 @@ def test_a_spread_line_draws_the_counts_the_calibration_predicts_held_out_frames
     both = EMTruncation(ratio_per_intensity=slope, ratio_per_intensity_spread=0.05, ratio_jitter=0.02)
     for s in (0.3, 0.8, 1.0):
         counts = _drawn_counts(spread_line, height, torch.full((draws,), s), seed=int(s * 10))
-        assert_counts_follow(counts, *count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20))
+        assert_frequencies_follow(
+            counts.numpy(), *count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20)
+        )
         counts = _drawn_counts(jittered_line, height, torch.full((draws,), s), seed=int(s * 10) + 1)
-        assert_counts_follow(counts, *count_probabilities(slope * s, slope * s, height, 20, jitter=0.02))
+        assert_frequencies_follow(
+            counts.numpy(), *count_probabilities(slope * s, slope * s, height, 20, jitter=0.02)
+        )
         counts = _drawn_counts(both, height, torch.full((draws,), s), seed=int(s * 10) + 2)
         law = count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20, jitter=0.02)
-        assert_counts_follow(counts, *law)
+        assert_frequencies_follow(counts.numpy(), *law)
         assert len(law[0]) > len(count_probabilities((slope - 0.05) * s, (slope + 0.05) * s, height, 20)[0])
     # without the spread and jitter the line gives one count per intensity
     assert set(
