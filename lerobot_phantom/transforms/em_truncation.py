@@ -28,8 +28,8 @@ the buffer address at a moment set by its timing, not by how many rows are lost;
 tail itself and the frame passes unchanged). ``ratio_per_intensity_spread`` and ``ratio_jitter`` draw each
 sample's ratio from the law the calibration predicts held-out frames with, ``r = (a + w u) s + d z``, ``u``
 uniform on ``[-1, 1]``, ``z`` standard normal, clipped to ``[0, 0.5]``: ``w`` is half the range of slopes the
-measured frames leave possible (their counts are floors), ``d`` the frame-to-frame jitter no one line removes (the
-calibration gives one of the two, never both). At zero intensity there is no attack, jitter or not.
+measured frames leave possible (their counts are floors; 0 where they contradict one line), ``d`` the
+frame-to-frame jitter of the interference's timing. At zero intensity there is no attack, jitter or not.
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that

@@ -76,22 +76,36 @@ def test_one_line_explains_exact_counts():
     assert (np.floor(heights * (high + 1e-6) * intensities) != counts).any()
 
 
-def test_contradicting_counts_get_the_most_likely_normal_jitter_which_gives_every_count_a_probability():
+def test_contradicting_counts_get_a_jitter_that_gives_every_count_between_and_beside_them_a_probability():
     """Two frames at one intensity that lost 10 and 12 rows: the least jitter that reconciles them (half a row,
-    until session 61) predicted 11 rows for every frame at that intensity, neither count seen. The most likely normal
-    jitter is the one at which 0.5 phi(0.5 / d) = 1.5 phi(1.5 / d) (rows): d = 1 / sqrt(ln 3) rows; 10 and 12 rows
-    each have the probability Phi(-0.5 / d) - Phi(-1.5 / d). A frame at zero intensity that lost 3 rows: jitter
-    alone explains it, 4 phi(4 / d) = 3 phi(3 / d), d = sqrt(7 / (2 ln 4/3)) rows."""
+    until session 61) predicted 11 rows for every frame at that intensity, neither count seen; the most likely
+    normal jitter (``1 / sqrt(ln 3)`` rows, where ``0.5 phi(0.5 / d) = 1.5 phi(1.5 / d)``; sessions 61-62) takes two
+    frames' spread for the jitter's whole scale, which two frames cannot pin down: the posterior median is wider."""
     low, high, jitter = count_law(np.array([10, 12]), np.array([48, 48]), np.array([0.8, 0.8]))
-    assert low == high and np.isclose(low * 0.8 * 48, 11.5, atol=1e-4)
-    assert np.isclose(jitter * 48, 1 / np.sqrt(np.log(3)), rtol=1e-3)
+    assert low == high and jitter * 48 > 1 / np.sqrt(np.log(3))
     counts, weights = count_probabilities(0.8 * low, 0.8 * high, 48, 24, jitter=jitter)
-    share = {int(c): w for c, w in zip(counts, weights, strict=True)}
-    expected = stats.norm.cdf(-0.5 * np.sqrt(np.log(3))) - stats.norm.cdf(-1.5 * np.sqrt(np.log(3)))
-    assert np.isclose(share[10], expected, rtol=1e-3) and np.isclose(share[12], expected, rtol=1e-3)
-    assert share[11] > share[10] and {9, 13} <= set(share)
-    zero = count_law(np.array([3]), np.array([48]), np.array([0.0]))[2]
-    assert np.isclose(zero * 48, np.sqrt(7 / (2 * np.log(4 / 3))), rtol=1e-3)
+    share = dict(zip(counts.tolist(), weights.tolist(), strict=True))
+    assert {9, 10, 11, 12, 13} <= set(share) and share[11] == max(share.values())
+
+
+def test_unattacked_frames_are_no_evidence_of_the_law_and_are_predicted_whole():
+    """The transform never truncates a frame at zero intensity, jitter or not: such a frame's count says nothing
+    of the line (until session 63 a zero-intensity frame that lost 3 rows was explained by a jitter of 3.4 rows,
+    and every unattacked count of 0 pulled the jitter down: on draws of the transform's own law with a fifth of the
+    frames unattacked, 0.74 rows for 1), and the law predicts it loses none."""
+    assert count_law(np.array([3]), np.array([48]), np.array([0.0])) == (0.0, 0.0, 0.0)
+    heights = np.full(5, HEIGHT)
+    lit = count_law(np.array([4, 7, 9, 12, 6]), heights, np.array([0.35, 0.6, 0.8, 1.0, 0.5]))
+    with_unattacked = count_law(
+        np.array([4, 7, 9, 12, 6, 0, 2]), np.full(7, HEIGHT), np.array([0.35, 0.6, 0.8, 1.0, 0.5, 0.0, 0.0])
+    )
+    assert with_unattacked == lit and lit[2] > 0
+    clean = torch.zeros(3, HEIGHT, WIDTH)
+    problem = TruncationFrames([Pair("unattacked", clean, clean, None, 0.0)], 0)
+    fit = problem.fit(frozenset(), np.arange(1))
+    fit.params["ratio_jitter"], fit.extra["slope_range"] = lit[2], [lit[0], lit[1]]
+    counts, weights = problem.predicted_counts(fit, 0)
+    assert counts.tolist() == [0] and weights.tolist() == [1.0]
 
 
 def test_counts_that_agree_by_chance_leave_a_held_out_count_one_row_past_them_possible():
@@ -109,15 +123,17 @@ def test_counts_that_agree_by_chance_leave_a_held_out_count_one_row_past_them_po
     assert share[seen] > 0.9 and 0.0 < share[seen - 1] < share[seen] and 0.0 < share[seen + 1] < share[seen]
 
 
-def test_the_agreeing_counts_jitter_is_the_posterior_median_by_direct_integration():
-    """The posterior median of the jitter (flat slope prior on [0, 0.5], log-uniform jitter prior from a tenth
-    of a row to 0.5) by scipy's adaptive quadrature over the slope and a fine log grid over the jitter, against
-    the function's own grids, on agreeing counts of three to six frames."""
+def test_the_law_is_the_posterior_by_direct_integration():
+    """The posterior median of the jitter and mean of the slope (flat slope prior on [0, 0.5], log-uniform jitter
+    prior from a tenth of a row to 0.5) by scipy's adaptive quadrature over the slope and a fine log grid over the
+    jitter, against the function's own grids, on counts of three to eight frames that one line explains (the slope's
+    range is then reported, not its mean) and on jittered counts that no line does."""
     rng = np.random.default_rng(62)
-    for n in (3, 4, 6):
+    for n, jittered in ((3, False), (4, False), (6, False), (4, True), (8, True)):
         heights = rng.choice([48, 60, 72], n)
         intensities = rng.uniform(0.3, 1.0, n)
-        counts = np.floor(heights * 0.27 * intensities).astype(int)
+        ratios = 0.27 * intensities + (rng.normal(0.0, 1.5 / 48, n) if jittered else 0.0)
+        counts = np.floor(heights * ratios).astype(int)
         below, above = counts / heights, (counts + 1) / heights
 
         def likelihood(slope, jitter, below=below, above=above, intensities=intensities):
@@ -126,46 +142,51 @@ def test_the_agreeing_counts_jitter_is_the_posterior_median_by_direct_integratio
                 np.prod(stats.norm.cdf(above, centre, jitter) - stats.norm.cdf(below, centre, jitter))
             )
 
-        log_jitters = np.linspace(np.log(0.1 / heights.max()), np.log(0.5), 150)
-        marginal = np.array(
-            [
-                integrate.quad(likelihood, 0.0, 0.5, args=(np.exp(x),), points=[0.27], limit=200)[0]
-                for x in log_jitters
-            ]
-        )
-        cumulative = np.concatenate([[0.0], np.cumsum(0.5 * (marginal[1:] + marginal[:-1]))])
+        def moment(slope, jitter):
+            return slope * likelihood(slope, jitter)
+
+        log_jitters = np.linspace(np.log(0.1 / heights.max()), np.log(0.5), 100)
+
+        def over_slopes(f, log_jitters=log_jitters):
+            return np.array(
+                [
+                    integrate.quad(f, 0.0, 0.5, args=(np.exp(x),), points=[0.27], limit=200)[0]
+                    for x in log_jitters
+                ]
+            )
+
+        marginal = over_slopes(likelihood)
+        cumulative = integrate.cumulative_trapezoid(marginal, log_jitters, initial=0.0)
         median = np.exp(np.interp(0.5 * cumulative[-1], cumulative, log_jitters))
-        assert count_law(counts, heights, intensities)[2] == pytest.approx(median, rel=0.01), n
-
-
-def log_likelihood(counts, heights, intensities, slope, jitter) -> float:
-    """The frames' counts under ``r = a s + e``, ``e`` normal with standard deviation ``d``, by scipy's normal."""
-    low, high = counts / heights, (counts + 1) / heights
-    centre = slope * intensities
-    with np.errstate(divide="ignore"):  # a count the line and jitter make impossible: -inf, never the best
-        return float(
-            np.sum(np.log(stats.norm.cdf(high, centre, jitter) - stats.norm.cdf(low, centre, jitter)))
-        )
-
-
-def test_the_jittered_law_is_at_least_as_likely_as_any_line_and_jitter_on_a_fine_grid():
-    """Frames whose ratio was drawn with a jitter (10 draws of 8 frames): no (slope, jitter) on a 201 x 201 grid
-    explains their counts better than the law's."""
-    for seed in range(10):
-        rng = np.random.default_rng(seed)
-        heights = rng.choice([48, 60, 72], 8)
-        intensities = rng.uniform(0.2, 1.0, 8)
-        slope, spread = rng.uniform(0.15, 0.3), rng.uniform(0.01, 0.04)
-        counts = np.floor(heights * (slope * intensities + rng.uniform(-spread, spread, 8))).astype(int)
         low, high, jitter = count_law(counts, heights, intensities)
-        assert jitter > 0 and low == high, seed
-        best = log_likelihood(counts, heights, intensities, low, jitter)
-        grid = max(
-            log_likelihood(counts, heights, intensities, a, d)
-            for a in np.linspace(max(low - 0.03, 0.0), low + 0.03, 201)
-            for d in np.linspace(jitter / 3, jitter * 3, 201)
-        )
-        assert best >= grid - 1e-6, (seed, best, grid)
+        assert jitter == pytest.approx(median, rel=0.01), n
+        assert (low < high) != jittered, n
+        if jittered:
+            mean = integrate.trapezoid(over_slopes(moment), log_jitters) / cumulative[-1]
+            assert low == pytest.approx(mean, abs=1e-3 / heights.max()), n
+
+
+def test_the_law_recovers_the_jitter_of_the_transform_that_drew_the_counts():
+    """200 draws of 10 frames from the calibrated transform itself (``r = 0.25 s + e``, ``e`` normal of 1 row
+    of 48; intensities uniform on [0, 1], a fifth of the frames unattacked), their counts as the transform loses
+    them: the fitted jitter's median over the draws is within 15% of the truth and the slope's within a tenth of a
+    row at full intensity (session 63's study, ``docs/bench/session63/count_law_recovery.py``: the most likely
+    jitter, with the unattacked frames read as evidence, gave 0.74 rows)."""
+    from lerobot_phantom.transforms.em_truncation import EMTruncation
+
+    attack = EMTruncation(ratio_per_intensity=0.25, ratio_jitter=1 / HEIGHT)
+    jitters, slopes = [], []
+    for seed in range(200):
+        generator = torch.Generator().manual_seed(seed)
+        intensity = torch.rand(10, generator=generator)
+        intensity[torch.rand(10, generator=generator) < 0.2] = 0.0
+        ratio = attack.sample_params(10, HEIGHT, 2, intensity=intensity, generator=generator)["ratio"]
+        counts = np.array([int(HEIGHT * r) for r in ratio.tolist()])
+        low, high, jitter = count_law(counts, np.full(10, HEIGHT), intensity.double().numpy())
+        jitters.append(jitter * HEIGHT)
+        slopes.append(0.5 * (low + high) * HEIGHT)
+    assert 0.85 < np.median(jitters) < 1.15, np.median(jitters)
+    assert abs(np.median(slopes) - 0.25 * HEIGHT) < 0.1, np.median(slopes)
 
 
 def test_count_probabilities_are_the_floors_of_a_uniform_ratio():
@@ -226,4 +247,4 @@ def test_the_calibrated_transform_draws_from_the_law_held_out_frames_are_scored_
     drawn = np.array([int(HEIGHT * r) for r in params["ratio"].tolist()])
     assert {10, 12} <= set(drawn.tolist())
     assert_frequencies_follow(drawn, *problem.predicted_counts(fit, 0))
-    assert kwargs["ratio_per_intensity_spread"] == 0.0  # the law's jitter or its slopes' range, never both
+    assert kwargs["ratio_per_intensity_spread"] == 0.0  # counts no one line explains: one slope
