@@ -88,6 +88,36 @@ def test_contradicting_counts_get_a_jitter_that_gives_every_count_between_and_be
     assert {9, 10, 11, 12, 13} <= set(share) and share[11] == max(share.values())
 
 
+def test_a_count_no_slope_within_the_bound_explains_is_explained_by_jitter():
+    """Frames that lost half their rows at intensities 0.6 and 0.9 need a slope of at least 0.83, past the
+    transform's 0.5: until session 63 the law's range started there and the calibrated transform refused it; now
+    jitter explains the counts, with the slope within the bound."""
+    from lerobot_phantom.transforms.em_truncation import EMTruncation
+
+    rng = np.random.default_rng(8)
+    clean = torch.from_numpy(rng.uniform(0.0, 1.0, (3, HEIGHT, WIDTH)))
+    half = HEIGHT // 2
+    pairs = [
+        Pair(
+            f"lost_{num}",
+            clean,
+            clean[:, rows_after_deleting(HEIGHT, num, max(0, min(num, HEIGHT - 2 * num)))],
+            None,
+            s,
+        )
+        for num, s in ((half, 0.6), (half, 0.9))
+    ]
+    problem = TruncationFrames(pairs, 0)
+    assert [problem.placement(False, i)[0] for i in range(2)] == [half, half]
+    fit = problem.fit(frozenset(), np.arange(2))
+    low, high = fit.extra["slope_range"]
+    assert low == high <= 0.5 and fit.params["ratio_jitter"] > 0
+    counts, weights = problem.predicted_counts(fit, 0)
+    assert counts.max() == half and weights[counts == half][0] > 0
+    attack = EMTruncation(**problem.transform_kwargs(fit), seed=0)
+    assert attack.ratio_per_intensity <= 0.5
+
+
 def test_unattacked_frames_are_no_evidence_of_the_law_and_are_predicted_whole():
     """The transform never truncates a frame at zero intensity, jitter or not: such a frame's count says nothing
     of the line (until session 63 a zero-intensity frame that lost 3 rows was explained by a jitter of 3.4 rows,
