@@ -29,7 +29,9 @@ tail itself and the frame passes unchanged). ``ratio_per_intensity_spread`` and 
 sample's ratio from the law the calibration predicts held-out frames with, ``r = (a + w u) s + d z``, ``u``
 uniform on ``[-1, 1]``, ``z`` standard normal, clipped to ``[0, 0.5]``: ``w`` is half the range of slopes the
 measured frames leave possible (their counts are floors; 0 where they contradict one line), ``d`` the
-frame-to-frame jitter of the interference's timing. At zero intensity there is no attack, jitter or not.
+frame-to-frame jitter of the interference's timing: a number, or equally likely values of which each sample draws
+one (the calibration writes its posterior's quantiles, so a frame a few rows off the line stays possible). At zero
+intensity there is no attack, jitter or not.
 
 Note on "distortion": the number of lost rows, ``int(h*r)``, grows with ``r``. The mean absolute difference to
 the clean frame does *not* always grow: only rows ``[start, h - num)`` change (shifted by ``num`` rows), and that
@@ -40,6 +42,7 @@ in fewer pixels than its weak level does.
 from __future__ import annotations
 
 import functools
+from collections.abc import Sequence
 from typing import ClassVar
 
 import torch
@@ -151,21 +154,26 @@ class EMTruncation(CameraAttack):
         ratio: float | None = None,
         ratio_per_intensity: float | None = None,
         ratio_per_intensity_spread: float = 0.0,
-        ratio_jitter: float = 0.0,
+        ratio_jitter: float | Sequence[float] = 0.0,
         free_band_position: bool = False,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
+        jitters = (ratio_jitter,) if isinstance(ratio_jitter, int | float) else tuple(ratio_jitter)
+        if not jitters:
+            raise ValueError(
+                "ratio_jitter must be a number or a non-empty sequence of equally likely numbers"
+            )
         for option, value in (
             ("ratio", ratio),
             ("ratio_per_intensity", ratio_per_intensity),
             ("ratio_per_intensity_spread", ratio_per_intensity_spread),
-            ("ratio_jitter", ratio_jitter),
+            *(("ratio_jitter", jitter) for jitter in jitters),
         ):
             if value is not None and not (0.0 <= float(value) <= MAX_RATIO):
                 raise ValueError(f"{option} must lie in [0, {MAX_RATIO}], got {value!r}")
-        if (ratio_per_intensity_spread or ratio_jitter) and ratio_per_intensity is None and ratio is None:
+        if (ratio_per_intensity_spread or any(jitters)) and ratio_per_intensity is None and ratio is None:
             raise ValueError(
                 "ratio_per_intensity_spread and ratio_jitter spread the measured line: they need ratio_per_intensity"
             )
@@ -177,7 +185,9 @@ class EMTruncation(CameraAttack):
         self.ratio = None if ratio is None else float(ratio)
         self.ratio_per_intensity = None if ratio_per_intensity is None else float(ratio_per_intensity)
         self.ratio_per_intensity_spread = float(ratio_per_intensity_spread)
-        self.ratio_jitter = float(ratio_jitter)
+        self.ratio_jitter = (
+            float(jitters[0]) if isinstance(ratio_jitter, int | float) else tuple(map(float, jitters))
+        )
         self.free_band_position = bool(free_band_position)
 
     def ratio_for(self, s: torch.Tensor) -> torch.Tensor:
@@ -191,7 +201,7 @@ class EMTruncation(CameraAttack):
 
     def _sample(self, s, height, width, generator, device):
         values = s.tolist()
-        if self.ratio is None and (self.ratio_per_intensity_spread or self.ratio_jitter):
+        if self.ratio is None and (self.ratio_per_intensity_spread or self._jitters_any()):
             params = {"ratio": self._spread_ratio(s, generator).to(device)}
         elif (
             len(set(values)) == 1
@@ -208,8 +218,8 @@ class EMTruncation(CameraAttack):
         return params
 
     def _spread_ratio(self, s: torch.Tensor, generator: torch.Generator | None) -> torch.Tensor:
-        """Each sample's ratio ``(a + w u) s + d z`` (module docstring), clipped to ``[0, 0.5]``; none at zero
-        intensity."""
+        """Each sample's ratio ``(a + w u) s + d z`` (module docstring), clipped to ``[0, 0.5]``, ``d`` drawn from
+        the equally likely jitters where there are several; none at zero intensity."""
         if generator is None:
             raise ValueError(
                 "ratio_per_intensity_spread and ratio_jitter need a torch.Generator (pass generator= or seed=)"
@@ -217,9 +227,16 @@ class EMTruncation(CameraAttack):
         u = torch.rand(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
         z = torch.randn(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
         s = s.detach().cpu().to(torch.float64)
+        jitter = self.ratio_jitter
+        if isinstance(jitter, tuple):
+            pick = torch.randint(len(jitter), (len(s),), generator=generator, device=generator.device).cpu()
+            jitter = torch.tensor(jitter, dtype=torch.float64)[pick]
         slope = self.ratio_per_intensity + self.ratio_per_intensity_spread * (2 * u - 1)
-        ratio = torch.clamp(slope * s + self.ratio_jitter * z, 0.0, MAX_RATIO)
+        ratio = torch.clamp(slope * s + jitter * z, 0.0, MAX_RATIO)
         return torch.where(s > 0, ratio, torch.zeros_like(ratio)).to(torch.float32)
+
+    def _jitters_any(self) -> bool:
+        return any(self.ratio_jitter) if isinstance(self.ratio_jitter, tuple) else bool(self.ratio_jitter)
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         return em_truncation(x, params["ratio"], params.get("start_fraction"))
@@ -232,7 +249,7 @@ class EMTruncation(CameraAttack):
         extra = "" if self.ratio is None else f", ratio={self.ratio}"
         if self.ratio_per_intensity is not None:
             extra += f", ratio_per_intensity={self.ratio_per_intensity}"
-        if self.ratio_per_intensity_spread or self.ratio_jitter:
+        if self.ratio_per_intensity_spread or self._jitters_any():
             extra += f", ratio_per_intensity_spread={self.ratio_per_intensity_spread}"
             extra += f", ratio_jitter={self.ratio_jitter}"
         return super().extra_repr() + extra + (", free_band_position=True" if self.free_band_position else "")

@@ -276,6 +276,39 @@ def test_a_spread_line_draws_the_counts_the_calibration_predicts_held_out_frames
     ) == {8}
 
 
+def test_equally_likely_jitters_draw_the_calibrations_mixture_and_keep_a_tuple():
+    """The calibration writes its posterior's jitter quantiles (``ratio_jitter=[...]``): each sample draws one of
+    them, so the counts follow the mixture the calibration predicts held-out frames with
+    (``TruncationFrames.predicted_counts``), with tails no single jitter has."""
+    from lerobot_phantom.calibration.core import Fit
+    from lerobot_phantom.calibration.frame_models.common import Pair
+    from lerobot_phantom.calibration.frame_models.em_truncation import TruncationFrames
+
+    height, draws, jitters = 40, 20000, (0.005, 0.01, 0.04)
+    attack = EMTruncation(
+        ratio_per_intensity=0.25, ratio_per_intensity_spread=0.02, ratio_jitter=list(jitters)
+    )
+    assert attack.ratio_jitter == jitters
+    blank = torch.zeros(3, height, 1)
+    for s in (0.3, 1.0):
+        problem = TruncationFrames([Pair("frame", blank, blank, None, s)], 0)
+        fit = Fit(frozenset(), {}, {"slope_range": [0.23, 0.27], "jitters": list(jitters)})
+        law = problem.predicted_counts(fit, 0)
+        counts = _drawn_counts(attack, height, torch.full((draws,), s), seed=int(s * 10) + 5)
+        assert_frequencies_follow(counts.numpy(), *law)
+        middle = EMTruncation(ratio_per_intensity=0.25, ratio_per_intensity_spread=0.02, ratio_jitter=0.01)
+        assert np.ptp(counts.numpy()) > np.ptp(
+            _drawn_counts(middle, height, torch.full((draws,), s), 1).numpy()
+        )
+    image = torch.rand(4, 3, height, 8, generator=torch.Generator().manual_seed(0))
+
+    def fresh():
+        return EMTruncation(0.9, ratio_per_intensity=0.25, ratio_jitter=jitters, seed=3)
+
+    assert torch.equal(pickle.loads(pickle.dumps(fresh()))(image), fresh()(image))
+    assert "ratio_jitter=(0.005, 0.01, 0.04)" in repr(fresh())
+
+
 def test_a_spread_line_loses_each_samples_drawn_rows_and_none_at_zero_intensity():
     height, batch = 40, 64
     image = torch.arange(height, dtype=torch.float32).view(1, 1, height, 1).expand(batch, 3, height, 2)
@@ -316,6 +349,8 @@ def test_a_spread_line_loses_each_samples_drawn_rows_and_none_at_zero_intensity(
             r"must not exceed ratio_per_intensity",
         ),
         ({"ratio_per_intensity": 0.1, "ratio_jitter": 0.6}, r"ratio_jitter must lie in \[0, 0.5\]"),
+        ({"ratio_per_intensity": 0.1, "ratio_jitter": [0.01, 0.6]}, r"ratio_jitter must lie in \[0, 0.5\]"),
+        ({"ratio_per_intensity": 0.1, "ratio_jitter": []}, "a number or a non-empty sequence"),
         ({"ratio_per_intensity": 0.1, "ratio_per_intensity_spread": -0.01}, r"spread must lie in \[0, 0.5\]"),
     ],
 )
