@@ -12,11 +12,13 @@ from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
 from lerobot_phantom.transforms.em_truncation import paper_band_start, rows_after_losing
 
-# posterior_law's grids: the log jitter from a tenth of a row to the bound, the slope across one frame
+# posterior_law's grids: the log jitter from a tenth of a row to the bound (96 points put the quantiles within 0.1%
+# of adaptive quadrature; 48 left the outer eighths 1.4% off), the slope across one frame
 JITTER_GRID_POINTS = 96
 SLOPE_GRID_POINTS = 161
 # equally likely jitters the law predicts with and the calibrated transform draws from: the posterior's
-# (k + 1/2) / 8 quantiles (4 to 16 gave held-out log probabilities within 0.003 of each other on session 63's study)
+# (k + 1/2) / 8 quantiles (4, 8 and 16 gave mean held-out log probabilities within 0.004 of each other on session
+# 63's study, docs/bench/session63/count_law_recovery.py)
 JITTER_QUANTILES = 8
 # the transform's and Param's range: a ratio past 0.5 would lose more rows than the tail can repeat
 MAX_SLOPE = 0.5
@@ -51,11 +53,10 @@ def count_law(counts: np.ndarray, heights: np.ndarray, intensities: np.ndarray) 
     jitters from frame to frame, ``r = a s + e`` with ``e`` normal of standard deviation ``d`` (the interference's
     timing varies), and ``a`` and ``d`` are read from their posterior (:func:`posterior_law`); a frame is predicted
     with ``d``'s posterior quantiles, not one value of it, so ten frames that happen to lie close to the line do not
-    rule out an eleventh three rows off (with the median alone, 5 of 1000 draws of ten frames from the transform's own
-    law gave a held-out count no probability; session 63). Where one line
-    explains every fit frame (the slopes the intervals allow overlap), each slope in the overlap is as likely as any
-    other and a frame's ratio is predicted uniform over ``[s low, s high]`` plus the jitter; where none does, one
-    slope. Frames at zero intensity carry no evidence: the transform never truncates them. A least-squares line
+    rule out an eleventh three rows off (with the median alone, 5 of 1000 draws of ten frames from the transform's
+    own law gave a held-out count no probability; session 63). Where one line explains every fit frame (the slopes
+    the intervals allow overlap), each slope in the overlap is as likely as any other and a frame's ratio is
+    predicted uniform over ``[s low, s high]`` plus the jitter; where none does, one slope. Frames at zero intensity carry no evidence: the transform never truncates them. A least-squares line
     through the counts (``n / h``, rounded back, until session 59) sat half a row low and had no spread of its own;
     the most likely jitter (sessions 61-62, where counts contradict one line) underestimated it on draws from the
     transform's own law and gave a held-out count a row or two past the fit frames' no probability (session 63)."""
@@ -103,22 +104,22 @@ def interval_probability(
 def posterior_law(
     below: np.ndarray, above: np.ndarray, tallest: int, intensities: np.ndarray
 ) -> tuple[float, float, tuple[float, ...]]:
-    """The posterior mean of the slope ``a``, median of the jitter ``d`` and ``JITTER_QUANTILES`` equally spaced
-    quantiles of it (``r = a s + e``, ``e`` normal,
-    standard deviation ``d``) given lit frames whose ratios lay in ``[below, above)``: flat prior on the slope over
-    ``[0, 0.5]`` and a log-uniform one on ``d`` (its scale is unknown) from a tenth of a row of the ``tallest``
-    frame, below which no count tells it from none, to 0.5, the transform's bound.
+    """The posterior mean of the slope ``a``, and the median and ``(k + 1/2) / JITTER_QUANTILES`` quantiles of the
+    jitter ``d`` (``r = a s + e``, ``e`` normal, standard deviation ``d``), given lit frames whose ratios lay in
+    ``[below, above)``: flat prior on the slope over ``[0, 0.5]`` and a log-uniform one on ``d`` (its scale is
+    unknown) from a tenth of a row of the ``tallest`` frame, below which no count tells it from none, to 0.5, the
+    transform's bound.
 
-    Neither the most likely jitter nor none where counts agree: agreement is no proof of no jitter (four frames
-    whose counts jitter by a couple of rows agree with one line often enough, and a held-out frame one row past the
-    slopes' range then had no probability: camsim count-spread seed 596587659 named a free band for it, session
-    62), and where counts contradict, the most likely ``d`` of ten frames fell below the truth (the slope is fitted
-    too) and sometimes far below it, leaving held-out counts a row or two out with no probability (session 63).
-    Integrating the slope out instead of fitting it corrects the first; the median over ``d`` the second. The
-    likelihood stays near its top for every ``d`` up to the slack the intervals leave and then falls as ``d ** -(n
-    - 1)`` for ``n`` frames, so the posterior narrows with more frames; with three or fewer that tail leaves the
-    mean at the prior's bound, hence the median. The slope is integrated on a grid spanning the frame at the
-    highest intensity's interval and six jitters either side (outside, that frame alone is less likely than
+    Neither no jitter where counts agree nor the most likely one where they contradict: agreement is no proof of no
+    jitter (four frames whose counts jitter by a couple of rows agree with one line often enough, and a held-out
+    frame one row past the slopes' range then had no probability: camsim count-spread seed 596587659 named a free
+    band for it; session 62), and the most likely ``d`` of ten frames fell below the truth, the slope being fitted
+    on the same counts (0.90 rows for 1 on draws of the transform's own law; session 63); with the slope integrated
+    out, the median's median over draws is within 6% of the truth in each of that study's eight settings. The
+    likelihood stays near its top for every ``d`` up to the slack the intervals leave and then falls
+    as ``d ** -(n - 1)`` for ``n`` frames, so the posterior narrows with more frames; with three or fewer that tail
+    leaves the mean at the prior's bound, hence the median. The slope is integrated on a grid spanning the frame at
+    the highest intensity's interval and six jitters either side (outside, that frame alone is less likely than
     1e-9)."""
     jitters = np.geomspace(0.1 / tallest, 0.5, JITTER_GRID_POINTS)
     top = int(np.argmax(intensities))
