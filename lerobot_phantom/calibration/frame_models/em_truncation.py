@@ -56,10 +56,11 @@ def count_law(counts: np.ndarray, heights: np.ndarray, intensities: np.ndarray) 
     rule out an eleventh three rows off (with the median alone, 5 of 1000 draws of ten frames from the transform's
     own law gave a held-out count no probability; session 63). Where one line explains every fit frame (the slopes
     the intervals allow overlap), each slope in the overlap is as likely as any other and a frame's ratio is
-    predicted uniform over ``[s low, s high]`` plus the jitter; where none does, one slope. Frames at zero intensity carry no evidence: the transform never truncates them. A least-squares line
-    through the counts (``n / h``, rounded back, until session 59) sat half a row low and had no spread of its own;
-    the most likely jitter (sessions 61-62, where counts contradict one line) underestimated it on draws from the
-    transform's own law and gave a held-out count a row or two past the fit frames' no probability (session 63)."""
+    predicted uniform over ``[s low, s high]`` plus the jitter; where none does, one slope. Frames at zero
+    intensity carry no evidence: the transform never truncates them. A least-squares line through the counts (``n /
+    h``, rounded back, until session 59) sat half a row low and had no spread of its own; the most likely jitter
+    (sessions 61-62, where counts contradict one line) underestimated it on draws from the transform's own law and
+    gave a held-out count a row or two past the fit frames' no probability (session 63)."""
     lit = intensities > 0
     counts, heights, intensities = counts[lit], heights[lit], intensities[lit]
     if len(counts) == 0:
@@ -116,8 +117,8 @@ def posterior_law(
     band for it; session 62), and the most likely ``d`` of ten frames fell below the truth, the slope being fitted
     on the same counts (0.90 rows for 1 on draws of the transform's own law; session 63); with the slope integrated
     out, the median's median over draws is within 6% of the truth in each of that study's eight settings. The
-    likelihood stays near its top for every ``d`` up to the slack the intervals leave and then falls
-    as ``d ** -(n - 1)`` for ``n`` frames, so the posterior narrows with more frames; with three or fewer that tail
+    likelihood stays near its top for every ``d`` up to the slack the intervals leave and then falls as ``d ** -(n
+    - 1)`` for ``n`` frames, so the posterior narrows with more frames; with three or fewer that tail
     leaves the mean at the prior's bound, hence the median. The slope is integrated on a grid spanning the frame at
     the highest intensity's interval and six jitters either side (outside, that frame alone is less likely than
     1e-9)."""
