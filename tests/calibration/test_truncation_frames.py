@@ -157,9 +157,9 @@ def test_counts_that_agree_by_chance_leave_a_held_out_count_one_row_past_them_po
 
 def test_the_law_is_the_posterior_by_direct_integration():
     """The posterior median and (k + 1/2) / 8 quantiles of the jitter and mean of the slope (flat slope prior on
-    [0, 0.5], log-uniform jitter prior from a tenth of a row to 0.5) by scipy's adaptive quadrature over the slope and a fine log grid over the
-    jitter, against the function's own grids, on counts of three to eight frames that one line explains (the slope's
-    range is then reported, not its mean) and on jittered counts that no line does."""
+    [0, 0.5], log-uniform jitter prior from a tenth of a row to 0.5) by scipy's adaptive quadrature over the slope
+    and a fine log grid over the jitter, against the function's own grids, on counts of three to eight frames that
+    one line explains (the slope's range is then reported, not its mean) and on jittered counts that no line does."""
     rng = np.random.default_rng(62)
     for n, jittered in ((3, False), (4, False), (6, False), (4, True), (8, True)):
         heights = rng.choice([48, 60, 72], n)
