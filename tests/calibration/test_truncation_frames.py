@@ -199,6 +199,20 @@ def test_the_law_is_the_posterior_by_direct_integration():
             assert low == pytest.approx(mean, abs=1e-3 / heights.max()), n
 
 
+def counts_drawn_by_the_transform(seed: int) -> tuple[torch.Tensor, np.ndarray]:
+    """20 frames' intensities (uniform on [0, 1], a fifth unattacked) and the rows each loses under the calibrated
+    transform ``r = 0.25 s + e``, ``e`` normal of 1 row of 48 (``docs/bench/session63/held_out_probe.py`` replays
+    them on older packages)."""
+    from lerobot_phantom.transforms.em_truncation import EMTruncation
+
+    attack = EMTruncation(ratio_per_intensity=0.25, ratio_jitter=1 / HEIGHT)
+    generator = torch.Generator().manual_seed(seed)
+    intensity = torch.rand(20, generator=generator)
+    intensity[torch.rand(20, generator=generator) < 0.2] = 0.0
+    ratio = attack.sample_params(20, HEIGHT, 2, intensity=intensity, generator=generator)["ratio"]
+    return intensity, np.array([int(HEIGHT * r) for r in ratio.tolist()])
+
+
 def test_the_law_recovers_the_jitter_of_the_transform_that_drew_the_counts_and_predicts_its_next_frames():
     """200 draws of 10 fit and 10 held-out frames from the calibrated transform itself (``r = 0.25 s + e``, ``e``
     normal of 1 row of 48; intensities uniform on [0, 1], a fifth of the frames unattacked), their counts as the
@@ -206,17 +220,10 @@ def test_the_law_recovers_the_jitter_of_the_transform_that_drew_the_counts_and_p
     tenth of a row at full intensity, and every held-out count has a probability (session 63's study,
     ``docs/bench/session63/count_law_recovery.py``: the most likely jitter, with the unattacked frames read as
     evidence, gave 0.74 rows and 5 draws a held-out count with none; the posterior median alone, 3 draws)."""
-    from lerobot_phantom.transforms.em_truncation import EMTruncation
-
-    attack = EMTruncation(ratio_per_intensity=0.25, ratio_jitter=1 / HEIGHT)
     blank = torch.zeros(3, HEIGHT, 1)
     jitters, slopes, unexplained = [], [], 0
     for seed in range(200):
-        generator = torch.Generator().manual_seed(seed)
-        intensity = torch.rand(20, generator=generator)
-        intensity[torch.rand(20, generator=generator) < 0.2] = 0.0
-        ratio = attack.sample_params(20, HEIGHT, 2, intensity=intensity, generator=generator)["ratio"]
-        counts = np.array([int(HEIGHT * r) for r in ratio.tolist()])
+        intensity, counts = counts_drawn_by_the_transform(seed)
         law = count_law(counts[:10], np.full(10, HEIGHT), intensity[:10].double().numpy())
         jitters.append(law.jitter * HEIGHT)
         slopes.append(0.5 * (law.lowest + law.highest) * HEIGHT)
