@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 import torch
 from drawn_frequencies import assert_frequencies_follow
+from reference_em_blur import rows_after_deleting
 from scipy import integrate, stats
 
 from lerobot_phantom.calibration.frame_models.common import Pair
@@ -18,15 +19,6 @@ from lerobot_phantom.calibration.frame_models.em_truncation import (
 )
 
 HEIGHT, WIDTH = 48, 8
-
-
-def rows_after_deleting(height: int, num: int, start: int) -> torch.Tensor:
-    """The paper's operation written out (``np.delete`` of the band, ``np.append`` of the tail), independently of
-    the package's index arithmetic: the source row of every output row."""
-    rows = np.arange(height)
-    return torch.from_numpy(
-        np.concatenate([np.delete(rows, np.arange(start, start + num)), rows[height - num :]])
-    )
 
 
 def truncated_pair(

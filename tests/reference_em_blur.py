@@ -44,6 +44,14 @@ def em_color_strip_reference(
     return out
 
 
+def rows_after_deleting(height: int, num: int, start: int) -> list[int]:
+    """The source row of every output row when ``num`` rows from ``start`` are deleted and the last ``num`` rows
+    appended (the released code's ``np.delete`` / ``np.append``; a band reaching past the frame deletes fewer rows
+    and the output is taller, as there)."""
+    kept = [row for row in range(height) if not (start <= row < start + num)]
+    return kept + list(range(height - num, height))
+
+
 def em_truncation_reference(
     image: np.ndarray, ratio: float, *, paper_start: bool = False, start: int | None = None
 ) -> np.ndarray:
@@ -56,9 +64,7 @@ def em_truncation_reference(
     num = int(h * ratio)
     if start is None:
         start = int(h * ratio) if paper_start else max(0, min(int(h * ratio), h - 2 * num))
-    kept = [image[row] for row in range(h) if not (start <= row < start + num)]
-    appended = [image[row] for row in range(h - num, h)]
-    return np.stack(kept + appended, axis=0)
+    return np.stack([image[row] for row in rows_after_deleting(h, num, start)], axis=0)
 
 
 def ultrasound_blur_reference(
