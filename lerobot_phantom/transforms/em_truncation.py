@@ -42,6 +42,7 @@ in fewer pixels than its weak level does.
 from __future__ import annotations
 
 import functools
+import numbers
 from collections.abc import Sequence
 from typing import ClassVar
 
@@ -160,7 +161,8 @@ class EMTruncation(CameraAttack):
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
-        jitters = (ratio_jitter,) if isinstance(ratio_jitter, int | float) else tuple(ratio_jitter)
+        one_jitter = isinstance(ratio_jitter, numbers.Real)  # numpy's scalars too
+        jitters = (ratio_jitter,) if one_jitter else tuple(ratio_jitter)
         if not jitters:
             raise ValueError(
                 "ratio_jitter must be a number or a non-empty sequence of equally likely numbers"
@@ -185,9 +187,7 @@ class EMTruncation(CameraAttack):
         self.ratio = None if ratio is None else float(ratio)
         self.ratio_per_intensity = None if ratio_per_intensity is None else float(ratio_per_intensity)
         self.ratio_per_intensity_spread = float(ratio_per_intensity_spread)
-        self.ratio_jitter = (
-            float(jitters[0]) if isinstance(ratio_jitter, int | float) else tuple(map(float, jitters))
-        )
+        self.ratio_jitter = float(jitters[0]) if one_jitter else tuple(map(float, jitters))
         self.free_band_position = bool(free_band_position)
 
     def ratio_for(self, s: torch.Tensor) -> torch.Tensor:

@@ -289,6 +289,10 @@ def test_equally_likely_jitters_draw_the_calibrations_mixture_and_keep_a_tuple()
         ratio_per_intensity=0.25, ratio_per_intensity_spread=0.02, ratio_jitter=list(jitters)
     )
     assert attack.ratio_jitter == jitters
+    # numpy's scalars are one jitter, as a float is; a numpy array is equally likely ones
+    one = EMTruncation(ratio_per_intensity=0.25, ratio_jitter=np.float32(0.01)).ratio_jitter
+    assert isinstance(one, float) and one == pytest.approx(0.01)
+    assert EMTruncation(ratio_per_intensity=0.25, ratio_jitter=np.array(jitters)).ratio_jitter == jitters
     blank = torch.zeros(3, height, 1)
     for s in (0.3, 1.0):
         problem = TruncationFrames([Pair("frame", blank, blank, None, s)], 0)
