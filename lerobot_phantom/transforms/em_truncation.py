@@ -188,6 +188,7 @@ class EMTruncation(CameraAttack):
         self.ratio_per_intensity = None if ratio_per_intensity is None else float(ratio_per_intensity)
         self.ratio_per_intensity_spread = float(ratio_per_intensity_spread)
         self.ratio_jitter = float(jitters[0]) if one_jitter else tuple(map(float, jitters))
+        self._jitters = tuple(map(float, jitters))
         self.free_band_position = bool(free_band_position)
 
     def ratio_for(self, s: torch.Tensor) -> torch.Tensor:
@@ -201,7 +202,7 @@ class EMTruncation(CameraAttack):
 
     def _sample(self, s, height, width, generator, device):
         values = s.tolist()
-        if self.ratio is None and (self.ratio_per_intensity_spread or self._jitters_any()):
+        if self.ratio is None and (self.ratio_per_intensity_spread or any(self._jitters)):
             params = {"ratio": self._spread_ratio(s, generator).to(device)}
         elif (
             len(set(values)) == 1
@@ -227,16 +228,14 @@ class EMTruncation(CameraAttack):
         u = torch.rand(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
         z = torch.randn(len(s), generator=generator, dtype=torch.float64, device=generator.device).cpu()
         s = s.detach().cpu().to(torch.float64)
-        jitter = self.ratio_jitter
-        if isinstance(jitter, tuple):
-            pick = torch.randint(len(jitter), (len(s),), generator=generator, device=generator.device).cpu()
-            jitter = torch.tensor(jitter, dtype=torch.float64)[pick]
+        jitter = torch.tensor(self._jitters, dtype=torch.float64)
+        if len(jitter) > 1:  # one draw more only where there is a choice: a single jitter keeps its streams
+            jitter = jitter[
+                torch.randint(len(jitter), (len(s),), generator=generator, device=generator.device).cpu()
+            ]
         slope = self.ratio_per_intensity + self.ratio_per_intensity_spread * (2 * u - 1)
         ratio = torch.clamp(slope * s + jitter * z, 0.0, MAX_RATIO)
         return torch.where(s > 0, ratio, torch.zeros_like(ratio)).to(torch.float32)
-
-    def _jitters_any(self) -> bool:
-        return any(self.ratio_jitter) if isinstance(self.ratio_jitter, tuple) else bool(self.ratio_jitter)
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         return em_truncation(x, params["ratio"], params.get("start_fraction"))
@@ -249,7 +248,7 @@ class EMTruncation(CameraAttack):
         extra = "" if self.ratio is None else f", ratio={self.ratio}"
         if self.ratio_per_intensity is not None:
             extra += f", ratio_per_intensity={self.ratio_per_intensity}"
-        if self.ratio_per_intensity_spread or self._jitters_any():
+        if self.ratio_per_intensity_spread or any(self._jitters):
             extra += f", ratio_per_intensity_spread={self.ratio_per_intensity_spread}"
             extra += f", ratio_jitter={self.ratio_jitter}"
         return super().extra_repr() + extra + (", free_band_position=True" if self.free_band_position else "")

@@ -10,7 +10,7 @@ from scipy import integrate, special
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
-from lerobot_phantom.transforms.em_truncation import paper_band_start, rows_after_losing
+from lerobot_phantom.transforms.em_truncation import MAX_RATIO, paper_band_start, rows_after_losing
 
 # posterior_law's grids: the log jitter from a tenth of a row to the bound (96 points put the quantiles within 0.1%
 # of adaptive quadrature; 48 left the outer eighths 1.4% off), the slope across one frame
@@ -20,8 +20,6 @@ SLOPE_GRID_POINTS = 161
 # (k + 1/2) / 8 quantiles (4, 8 and 16 gave mean held-out log probabilities within 0.004 of each other on session
 # 63's study, docs/bench/session63/count_law_recovery.py)
 JITTER_QUANTILES = 8
-# the transform's and Param's range: a ratio past 0.5 would lose more rows than the tail can repeat
-MAX_SLOPE = 0.5
 
 TRUNCATION_EFFECTS = (
     Effect(
@@ -68,10 +66,11 @@ def count_law(counts: np.ndarray, heights: np.ndarray, intensities: np.ndarray) 
     below, above = count_intervals(counts, heights, heights // 2)
     slope, jitter, jitters = posterior_law(below, above, int(heights.max()), intensities)
     lowest = max(0.0, float(np.max(below / intensities)))
-    # a frame that lost half its rows at intensity 0.6 needs a slope past the transform's bound: no line explains it
-    if least_jitter(below, above, intensities) > 0.0 or lowest > MAX_SLOPE:
+    # a frame that lost half its rows at intensity 0.6 needs a slope past the transform's bound (intensities reach 1,
+    # so the slope's bound is the ratio's): no line explains it
+    if least_jitter(below, above, intensities) > 0.0 or lowest > MAX_RATIO:
         return CountLaw(slope, slope, jitter, jitters)
-    return CountLaw(lowest, min(MAX_SLOPE, max(lowest, float(np.min(above / intensities)))), jitter, jitters)
+    return CountLaw(lowest, min(MAX_RATIO, max(lowest, float(np.min(above / intensities)))), jitter, jitters)
 
 
 def least_jitter(below: np.ndarray, above: np.ndarray, intensities: np.ndarray) -> float:
@@ -122,11 +121,11 @@ def posterior_law(
     leaves the mean at the prior's bound, hence the median. The slope is integrated on a grid spanning the frame at
     the highest intensity's interval and six jitters either side (outside, that frame alone is less likely than
     1e-9)."""
-    jitters = np.geomspace(0.1 / tallest, 0.5, JITTER_GRID_POINTS)
+    jitters = np.geomspace(0.1 / tallest, MAX_RATIO, JITTER_GRID_POINTS)
     top = int(np.argmax(intensities))
     reach = 6.0 * jitters
-    first = np.clip((np.nan_to_num(below[top], neginf=0.0) - reach) / intensities[top], 0.0, MAX_SLOPE)
-    last = np.clip((np.nan_to_num(above[top], posinf=0.5) + reach) / intensities[top], 0.0, MAX_SLOPE)
+    first = np.clip((np.nan_to_num(below[top], neginf=0.0) - reach) / intensities[top], 0.0, MAX_RATIO)
+    last = np.clip((np.nan_to_num(above[top], posinf=MAX_RATIO) + reach) / intensities[top], 0.0, MAX_RATIO)
     slopes = np.linspace(first, last, SLOPE_GRID_POINTS)  # (slopes, jitters)
     probability = interval_probability(
         below, above, slopes[..., None] * intensities, jitters[None, :, None]
