@@ -12,13 +12,15 @@ from lerobot_phantom.calibration.core import Effect, Fit, Param
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem, Pair
 from lerobot_phantom.transforms.em_truncation import MAX_RATIO, paper_band_start, rows_after_losing
 
-# posterior_law's grids: the log jitter from a tenth of a row to the bound (96 points put the quantiles within 0.1%
-# of adaptive quadrature; 48 left the outer eighths 1.4% off), the slope across one frame
+# posterior_law's grids: the log jitter from a tenth of a row to the bound (96 points put the median and eighths
+# within 0.4% of a 1536-point grid's, 48 within 1.7%: docs/bench/session63/law_choices.txt), the slope across one
+# frame
 JITTER_GRID_POINTS = 96
 SLOPE_GRID_POINTS = 161
 # equally likely jitters the law predicts with and the calibrated transform draws from: the posterior's
-# (k + 1/2) / 8 quantiles (4, 8 and 16 gave mean held-out log probabilities within 0.004 of each other on session
-# 63's study, docs/bench/session63/count_law_recovery.py)
+# (k + 1/2) / 8 quantiles (on session 63's recovery draws 4, 8 and 16 gave mean held-out log probabilities within
+# 0.009 of each other, and the median alone left a held-out count without probability in two settings of five:
+# docs/bench/session63/law_choices.txt)
 JITTER_QUANTILES = 8
 
 TRUNCATION_EFFECTS = (
@@ -94,9 +96,9 @@ def interval_probability(
 ) -> np.ndarray:
     """``P(below <= centre + e < above)`` for ``e`` normal with standard deviation ``jitter``, from the tail both
     bounds are in (so a probability far from the centre is not the difference of two numbers near 1; it
-    underflows to 0 only 38 deviations out). For the posterior's grids, tens of thousands of values per fit: about
-    11 times faster than scipy's ``stats.Normal(...).logcdf(below, above)`` (4.6 ms against 50.6 ms on 161 x 48 x
-    8), which the most likely jitter's optimiser called until session 63."""
+    underflows to 0 only 38 deviations out). For the posterior's grids, over a hundred thousand values per fit:
+    18 times faster than scipy's ``stats.Normal(...).logcdf(below, above)`` on 161 x 96 x 8 (5.4 ms against 96.0
+    ms, docs/bench/session63/law_choices.txt)."""
     x, y = (below - centre) / jitter, (above - centre) / jitter
     return np.where(x > 0, special.ndtr(-x) - special.ndtr(-y), special.ndtr(y) - special.ndtr(x))
 
