@@ -294,13 +294,13 @@ def test_equally_likely_jitters_draw_the_calibrations_mixture_and_keep_a_tuple()
     assert isinstance(one, float) and one == pytest.approx(0.01)
     assert EMTruncation(ratio_per_intensity=0.25, ratio_jitter=np.array(jitters)).ratio_jitter == jitters
     # a sequence of one jitter draws what that number draws (no draw of which jitter where there is no choice)
-    draws = [
+    one_and_a_sequence_of_one = [
         _drawn_counts(
             EMTruncation(ratio_per_intensity=0.25, ratio_jitter=j), height, torch.full((64,), 0.7), 4
         )
         for j in (0.02, [0.02])
     ]
-    assert torch.equal(*draws)
+    assert torch.equal(*one_and_a_sequence_of_one)
     blank = torch.zeros(3, height, 1)
     for s in (0.3, 1.0):
         problem = TruncationFrames([Pair("frame", blank, blank, None, s)], 0)
