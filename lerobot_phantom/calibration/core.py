@@ -4,7 +4,8 @@ A *problem* is one kind of measured data with a base model (the paper's simulati
 physical extensions. Its data is cut into *items* (table rows, image tiles or whole images) so that splits never
 share an item between fitting and scoring. Selection is forward: starting from the base, the extension that most
 lowers the inner cross-validated error is kept if it lowers it by a clear relative margin, or a pair of extensions
-when the pair beats every single one by that margin (interacting effects); repeat until nothing does. The error is
+when the pair beats every single one by that margin (interacting effects); repeat until nothing does. Where a
+pass took the simpler of two forms of one term, it is repeated without that form (:func:`select_forms`). The error is
 the problem's ``selection_score``: the RMSE over all values, or the mean of the items' own errors where one item that
 no fit can predict would otherwise decide every comparison.
 """
@@ -627,6 +628,79 @@ def forward_select(
         current, parents, per_item = scored[taken]
         steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
     return chosen, steps
+
+
+@dataclass
+class FormPass:
+    """A selection pass repeated without the simpler form of a term the first pass took (:func:`select_forms`):
+    what it selected and its last score, against the first pass's, and the steps of the pass not written."""
+
+    without: str
+    selected: list[str]
+    validation_error: float
+    first_selected: list[str]
+    first_validation_error: float
+    taken: bool
+    # the pass whose model is not written: this one's steps, or the first pass's where this one is taken
+    other_steps: list[Step] = field(repr=False, compare=False)
+
+
+def richer_forms(problem: Problem, chosen: frozenset[str], effect: str) -> list[str]:
+    """The alternative forms of ``effect``'s term (``Effect.excludes``, either direction) with more own parameters
+    in ``chosen`` with the alternative in ``effect``'s place, by name."""
+    alternatives = {o for e in problem.candidates if e.name == effect for o in e.excludes}
+    alternatives |= {e.name for e in problem.candidates if effect in e.excludes}
+    return [a for a in sorted(alternatives) if effect in simpler_forms(problem, (chosen - {effect}) | {a}, a)]
+
+
+def select_forms(
+    problem: Problem,
+    fit_items: np.ndarray,
+    *,
+    seed: int,
+    margin: float,
+    folds: int = 4,
+    max_train_items: int = 2500,
+    withdrawn: frozenset[str] = frozenset(),
+) -> tuple[frozenset[str], list[Step], list[FormPass]]:
+    """:func:`forward_select`, repeated without each simpler form of a term the pass took where a richer form is a
+    candidate; a repeated pass that takes a richer form and ends ``margin`` under the first pass's last score is
+    the selection (the lowest such one), and every repeated pass is returned as a :class:`FormPass`.
+
+    Forward selection never revisits a step. The richer form of a term can need the effects that ride on it to pay,
+    and without them its fits sit at a bound and are set aside, while the simpler form takes the step; once taken,
+    it excludes the richer form for good. camsim's light projection cross-talk case on filmic cameras: a power-law
+    gamma came first, because a shouldered curve without the reflectance term ran its knee to a hard clip, and the
+    reflectance term then had no curve it could pay on (docs/bench/session64.md)."""
+    options = dict(seed=seed, margin=margin, folds=folds, max_train_items=max_train_items)
+    chosen, steps = forward_select(problem, fit_items, withdrawn=withdrawn, **options)
+    first_error = steps[-1].validation_error
+    passes: list[FormPass] = []
+    for simpler in sorted(chosen):
+        richer = [r for r in richer_forms(problem, chosen, simpler) if r not in withdrawn]
+        if not richer:
+            continue
+        other, other_steps = forward_select(problem, fit_items, withdrawn=withdrawn | {simpler}, **options)
+        error = other_steps[-1].validation_error
+        passes.append(
+            FormPass(
+                simpler,
+                sorted(other),
+                error,
+                sorted(chosen),
+                first_error,
+                bool(set(richer) & other) and error <= (1.0 - margin) * first_error,
+                other_steps,
+            )
+        )
+    taken = [p for p in passes if p.taken]
+    if not taken:
+        return chosen, steps, passes
+    best = min(taken, key=lambda p: p.validation_error)
+    for p in taken:
+        p.taken = p is best
+    best.other_steps, best_steps = steps, best.other_steps
+    return frozenset(best.selected), best_steps, passes
 
 
 def scored_groups(

@@ -42,7 +42,9 @@ judged in its place (:func:`simpler_form_result`): rule 2 on its own scores, rul
 Selection is greedy, so an extension that fails the rule has still shaped every step after the one that took it.
 One that fails on its own evidence (not only because an effect it builds on, or was refitted without, failed) is
 withdrawn, and selection and identification run again without it until a pass withdraws nothing
-(:func:`select_and_identify`; ``selection.withdrawn`` in report.json).
+(:func:`select_and_identify`; ``selection.withdrawn`` in report.json). Every pass is
+:func:`core.select_forms`: where it took the simpler of two forms of one term, it runs again without that form
+(``selection.form_passes``).
 """
 
 from __future__ import annotations
@@ -55,17 +57,18 @@ import numpy as np
 
 from lerobot_phantom.calibration.core import (
     Fit,
+    FormPass,
     Problem,
     Step,
     at_bound,
     dependants,
     fit_chain,
-    forward_select,
     group_label,
     own_params,
     physical_limits,
     requirements,
     score_of_totals,
+    select_forms,
     simpler_forms,
 )
 
@@ -445,6 +448,8 @@ class Selection:
     # selected effects that failed the rule on their own evidence, not only because an effect they build on or
     # were refitted without failed (select_and_identify withdraws them)
     rejected: list[str] = field(default_factory=list)
+    # the selection passes repeated without a simpler form of a term (core.select_forms), set by select_and_identify
+    form_passes: list[FormPass] = field(default_factory=list)
 
 
 def identify_selection(
@@ -756,7 +761,7 @@ def select_and_identify(
     0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
     while True:
-        _selected, steps = forward_select(
+        _selected, steps, form_passes = select_forms(
             problem,
             fit_items,
             seed=seed,
@@ -768,6 +773,7 @@ def select_and_identify(
         selection = identify_selection(
             problem, steps, chain, fit_items, draws=draws, rng=np.random.default_rng([seed, 1])
         )
+        selection.form_passes = form_passes
         if not selection.rejected:
             return steps, chain, selection, withdrawn
         number = 1 + max((w.selection_pass for w in withdrawn), default=0)

@@ -13,7 +13,10 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
   rejected, withdrawn [{effect, pass, reasons}]: effects an earlier pass selected and identification rejected on
   their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and ``steps``
-  are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one};
+  are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one,
+  form_passes [{without, selected, validation_error, first_selected, first_validation_error, taken, other_steps}]
+  the last pass repeated without a simpler form of a term it took (core.select_forms; ``other_steps``: the steps
+  of the pass not written)};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
@@ -44,7 +47,7 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_phantom.calibration.core import SELECTION_SCORES, TIE_SHARE, Fit, Problem, Step
+from lerobot_phantom.calibration.core import SELECTION_SCORES, TIE_SHARE, Fit, FormPass, Problem, Step
 from lerobot_phantom.calibration.identify import Interval, Selection, Withdrawal, error_ratio, rmse_interval
 from lerobot_phantom.calibration.structure import MIN_TESTED_ITEMS, residual_structure
 
@@ -230,7 +233,9 @@ def selection_section(
         "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
         "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
         "when the interval of its statistic excludes the null value; an extension a pass selected and "
-        "identification rejected on its own evidence is withdrawn and selection repeated without it"
+        "identification rejected on its own evidence is withdrawn and selection repeated without it; a pass "
+        "that took the simpler of two forms of one term is repeated without that form, and the repeat is taken "
+        f"when it holds a richer form and its last score is >= {100 * margin:.0f}% under the pass's"
     )
     return {
         "score": score_name,
@@ -240,6 +245,20 @@ def selection_section(
         "rejected": dict(steps[-1].tried),
         "withdrawn": [w.as_dict() for w in withdrawn],
         "earlier_passes": earlier_passes(withdrawn),
+        "form_passes": [form_pass_entry(p) for p in selection.form_passes],
+    }
+
+
+def form_pass_entry(form_pass: FormPass) -> dict:
+    """A selection pass repeated without a simpler form, as report.json's ``selection.form_passes`` holds it."""
+    return {
+        "without": form_pass.without,
+        "selected": form_pass.selected,
+        "validation_error": form_pass.validation_error,
+        "first_selected": form_pass.first_selected,
+        "first_validation_error": form_pass.first_validation_error,
+        "taken": form_pass.taken,
+        "other_steps": [step_entry(s) for s in form_pass.other_steps],
     }
 
 
@@ -478,6 +497,17 @@ def _selection_lines(selection: dict) -> list[str]:
             f"- withdrawn after pass {withdrawal['pass']}: `{withdrawal['effect']}`, not identified ("
             + "; ".join(withdrawal["reasons"])
             + ")"
+        )
+    for form_pass in selection.get("form_passes", []):
+        lines.append(
+            f"- repeated without `{form_pass['without']}`, the simpler form of a term: selected "
+            f"{form_pass['selected']} at {form_pass['validation_error']:.4g}, against {form_pass['first_selected']} "
+            f"at {form_pass['first_validation_error']:.4g}; "
+            + (
+                "taken (its steps are below; those of the pass it replaced are in report.json)"
+                if form_pass["taken"]
+                else "not taken"
+            )
         )
     passes = selection.get("earlier_passes", [])
     for earlier in passes:

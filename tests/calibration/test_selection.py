@@ -16,6 +16,7 @@ from lerobot_phantom.calibration.core import (
     exclusive,
     forward_select,
     item_scores,
+    select_forms,
     selection_value,
 )
 from lerobot_phantom.calibration.frame_models.common import Pair
@@ -318,6 +319,88 @@ def test_of_the_groups_that_earn_their_step_the_lowest_scoring_is_taken():
         "light+shoulder": "not 5% under light+power, the same model with the simpler form"
     }
     assert steps[-1].validation_error == pytest.approx(2.07)
+
+
+class ShoulderNeedsReflectance(FixedErrors):
+    """camsim's projection_crosstalk on a filmic camera, in fixed errors: light adds (``light``) through cross-talk
+    (``cross``), under a power-law or a shouldered tone curve, and a reflectance term (``reflect``). Without the
+    reflectance term the shoulder's knee runs to its bound (every fit of it is set aside), so the power law takes
+    the step and excludes the shoulder for good; the shoulder with reflectance is what the camera is."""
+
+    joint_effects = 2
+    candidates = (
+        Effect("light", "light adds in linear irradiance"),
+        Effect("power", "a power-law tone curve"),
+        Effect("shoulder", "a tone curve with a shoulder", excludes=("power",)),
+        Effect("reflect", "reflectance scales the added light", requires=("light",)),
+        Effect("cross", "the projector's primaries mix in the camera's channels", requires=("light",)),
+    )
+
+    def __init__(self, shoulder_end: float = 2.4) -> None:
+        self.errors = {
+            "": 8.0,
+            "light": 4.9,
+            "power": 7.5,
+            "shoulder": 7.0,
+            "light+power": 3.8,
+            "light+shoulder": 3.0,
+            "light+reflect": 4.8,
+            "cross+light": 4.0,
+            "light+power+reflect": 3.75,
+            "cross+light+power": 3.1,
+            "light+reflect+shoulder": 3.2,
+            "cross+light+shoulder": 2.5,
+            "cross+light+reflect": 3.9,
+            "cross+light+power+reflect": 3.05,
+            "cross+light+reflect+shoulder": shoulder_end,
+        }
+
+    def error(self, effects: frozenset[str]) -> float:
+        return self.errors["+".join(sorted(effects))]
+
+    def param_specs(self, effects):
+        return ToneForms({}).param_specs(effects)
+
+    def fit(self, effects, items, start=None) -> Fit:
+        fit = ToneForms({}).fit(effects, items)
+        if "shoulder" in effects and "reflect" not in effects:
+            fit.params["knee_exponent"] = 4.0
+        return fit
+
+
+def test_a_pass_that_took_the_simpler_form_is_repeated_without_it():
+    problem = ShoulderNeedsReflectance()
+    first, first_steps = forward_select(problem, np.arange(20), seed=0, margin=0.05)
+    assert first == {"light", "power", "cross"}, [s.tried for s in first_steps]
+    chosen, steps, passes = select_forms(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"light", "cross", "shoulder", "reflect"}, [s.tried for s in steps]
+    assert steps[-1].validation_error == pytest.approx(2.4)
+    assert all("power" not in s.effects for s in steps)
+    (repeat,) = passes
+    assert (repeat.without, repeat.taken) == ("power", True)
+    assert repeat.first_validation_error == pytest.approx(3.1)
+    # the pass not written is the first one
+    assert [s.effects for s in repeat.other_steps] == [s.effects for s in first_steps]
+
+
+@pytest.mark.parametrize("shoulder_end", [2.95, 3.2])
+def test_a_repeat_not_the_margin_under_the_first_pass_is_not_taken(shoulder_end):
+    """2.95 is 4.8% under the first pass's 3.1; 3.2 is above it."""
+    problem = ShoulderNeedsReflectance(shoulder_end)
+    first, first_steps = forward_select(problem, np.arange(20), seed=0, margin=0.05)
+    chosen, steps, passes = select_forms(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == first == {"light", "power", "cross"}
+    assert [s.effects for s in steps] == [s.effects for s in first_steps]
+    (repeat,) = passes
+    assert not repeat.taken
+    assert repeat.validation_error == pytest.approx(shoulder_end)
+
+
+def test_no_repeat_where_the_pass_took_no_simpler_form():
+    problem = ToneForms({"": 10.0, "power": 5.0, "shoulder": 4.7})
+    chosen, _steps, passes = select_forms(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"shoulder"}
+    assert passes == []
 
 
 def projection_pairs(tone: frozenset[str], tone_params: dict, seed: int) -> list:
