@@ -565,6 +565,7 @@ def test_a_filmic_cross_talk_draw_names_the_reflectance_it_plants(root):
     assert repeat["without"] == "sensor_gamma" and repeat["taken"]
     assert "sensor_gamma" in repeat["first_selected"] and "tone_shoulder" in repeat["selected"]
     assert repeat["validation_error"] <= 0.95 * repeat["first_validation_error"]
+    assert "repeated without `sensor_gamma`" in (result["out"] / "report.md").read_text()
 
 
 @pytest.mark.slow
