@@ -490,13 +490,22 @@ def pinned_members(problem: Problem, model: frozenset[str], members, fits: list[
     return pinned
 
 
-def simpler_forms(problem: Problem, effects: frozenset[str], effect: str) -> list[str]:
-    """The alternative forms of ``effect``'s term (``Effect.excludes``, either direction) with fewer own parameters
-    in ``effects`` with the alternative in ``effect``'s place, by name."""
+def alternative_forms(problem: Problem, effect: str) -> list[str]:
+    """The other forms of ``effect``'s term (``Effect.excludes``, in either direction), by name."""
     alternatives = {o for e in problem.candidates if e.name == effect for o in e.excludes}
     alternatives |= {e.name for e in problem.candidates if effect in e.excludes}
+    return sorted(alternatives)
+
+
+def simpler_forms(problem: Problem, effects: frozenset[str], effect: str) -> list[str]:
+    """The alternative forms of ``effect``'s term with fewer own parameters in ``effects`` with the alternative in
+    ``effect``'s place, by name."""
     mine = len(own_params(problem, effects, effect))
-    return [a for a in sorted(alternatives) if len(own_params(problem, (effects - {effect}) | {a}, a)) < mine]
+    return [
+        a
+        for a in alternative_forms(problem, effect)
+        if len(own_params(problem, (effects - {effect}) | {a}, a)) < mine
+    ]
 
 
 def richer_alternatives(
@@ -630,7 +639,7 @@ def forward_select(
     return chosen, steps
 
 
-@dataclass
+@dataclass(frozen=True)
 class FormPass:
     """A selection pass repeated without the simpler form of a term the first pass took (:func:`select_forms`):
     what it selected and its last score, against the first pass's, and the steps of the pass not written."""
@@ -646,11 +655,13 @@ class FormPass:
 
 
 def richer_forms(problem: Problem, chosen: frozenset[str], effect: str) -> list[str]:
-    """The alternative forms of ``effect``'s term (``Effect.excludes``, either direction) with more own parameters
-    in ``chosen`` with the alternative in ``effect``'s place, by name."""
-    alternatives = {o for e in problem.candidates if e.name == effect for o in e.excludes}
-    alternatives |= {e.name for e in problem.candidates if effect in e.excludes}
-    return [a for a in sorted(alternatives) if effect in simpler_forms(problem, (chosen - {effect}) | {a}, a)]
+    """The alternative forms of ``effect``'s term with more own parameters in ``chosen`` with the alternative in
+    ``effect``'s place, by name."""
+    return [
+        a
+        for a in alternative_forms(problem, effect)
+        if effect in simpler_forms(problem, (chosen - {effect}) | {a}, a)
+    ]
 
 
 def select_forms(
@@ -675,32 +686,36 @@ def select_forms(
     options = dict(seed=seed, margin=margin, folds=folds, max_train_items=max_train_items)
     chosen, steps = forward_select(problem, fit_items, withdrawn=withdrawn, **options)
     first_error = steps[-1].validation_error
-    passes: list[FormPass] = []
+    repeats = {}  # simpler form -> (its richer forms, the repeat's selection, its steps)
     for simpler in sorted(chosen):
-        richer = [r for r in richer_forms(problem, chosen, simpler) if r not in withdrawn]
-        if not richer:
-            continue
-        other, other_steps = forward_select(problem, fit_items, withdrawn=withdrawn | {simpler}, **options)
-        error = other_steps[-1].validation_error
-        passes.append(
-            FormPass(
-                simpler,
-                sorted(other),
-                error,
-                sorted(chosen),
-                first_error,
-                bool(set(richer) & other) and error <= (1.0 - margin) * first_error,
-                other_steps,
+        richer = {r for r in richer_forms(problem, chosen, simpler) if r not in withdrawn}
+        if richer:
+            repeats[simpler] = (
+                richer,
+                *forward_select(problem, fit_items, withdrawn=withdrawn | {simpler}, **options),
             )
+    eligible = {
+        simpler: other_steps[-1].validation_error
+        for simpler, (richer, other, other_steps) in repeats.items()
+        if richer & other and other_steps[-1].validation_error <= (1.0 - margin) * first_error
+    }
+    taken = min(eligible, key=eligible.get, default=None)
+    passes = [
+        FormPass(
+            simpler,
+            sorted(other),
+            other_steps[-1].validation_error,
+            sorted(chosen),
+            first_error,
+            simpler == taken,
+            steps if simpler == taken else other_steps,
         )
-    taken = [p for p in passes if p.taken]
-    if not taken:
+        for simpler, (_, other, other_steps) in repeats.items()
+    ]
+    if taken is None:
         return chosen, steps, passes
-    best = min(taken, key=lambda p: p.validation_error)
-    for p in taken:
-        p.taken = p is best
-    best.other_steps, best_steps = steps, best.other_steps
-    return frozenset(best.selected), best_steps, passes
+    _, other, other_steps = repeats[taken]
+    return other, other_steps, passes
 
 
 def scored_groups(

@@ -1,7 +1,8 @@
 """What repeating a selection pass costs: camsim cases calibrated by this checkout's package, with the process CPU
 seconds of the whole calibration and of each forward selection pass in it (``core.forward_select``, timed by a
 wrapper; the first call of each ``select_forms`` is the first pass, a second one the repeat without a simpler
-form). The repeat's share of the calibration is what a package without repeats saves (the rest is the same work).
+form). Where the repeat is not taken, its share is what a package without repeats saves; where it is taken, the
+written model differs too (identifying it costs what its size costs), so the share is the selection's part only.
 
 Usage: ``PYTHONPATH=. python docs/bench/session64/form_pass_cost.py CASE MASTER_SEED...``
 """
