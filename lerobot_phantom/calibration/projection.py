@@ -24,6 +24,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
+from scipy.spatial import cKDTree
 
 from lerobot_phantom.calibration.core import (
     Effect,
@@ -250,6 +251,25 @@ def projection_kwargs(fit: Fit) -> dict:
     return kwargs
 
 
+def nearest_surface_colour(surface: np.ndarray, projected: np.ndarray) -> np.ndarray:
+    """For each row, the other row nearest to it in surface colour (Euclidean, over the three channels) among the
+    rows under the same projected colour; -1 where no other row has that projected colour. Rows of one object whose
+    surface colours nearly agree are pixels of one material lit alike by the room, so under one projected colour a
+    model that is right leaves them independent errors; errors that agree say the captured colour depends on the
+    inputs in a way the model lacks, or on what those pixels share and the table does not record (where they lie
+    in the projector's beam, their angle to it, a glossy surface)."""
+    nearest = np.full(len(surface), -1)
+    _, group = np.unique(projected, axis=0, return_inverse=True)
+    for members in (np.flatnonzero(group == g) for g in np.unique(group)):
+        if len(members) < 2:
+            continue
+        _, index = cKDTree(surface[members]).query(surface[members], k=2)
+        # a row is its own nearest at distance 0; where two rows share a surface colour either may come first
+        first_other = np.where(index[:, 0] == np.arange(len(members)), index[:, 1], index[:, 0])
+        nearest[members] = members[first_other]
+    return nearest
+
+
 def is_triple_table(columns) -> bool:
     return set(TRIPLE_COLUMNS) <= set(columns)
 
@@ -335,13 +355,17 @@ class TripleProblem(ProjectionTerms, Problem):
         return (self.residual(fit, items) ** 2).sum(1), np.full(len(items), 3.0)
 
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
-        """Per row: the three channels' residuals against channel, surface and projected level."""
+        """Per row: the three channels' residuals against channel, surface and projected level; and each row's
+        residual paired with that of the row among ``items`` nearest to it in surface colour under the same
+        projected colour (:func:`nearest_surface_colour`; none for a row alone under its projected colour)."""
         r = self.residual(fit, items)
         index = torch.as_tensor(items)
         surface = self.surface[index].numpy() * 255
         projected = self.projected[index].numpy() * 255
         channel = np.broadcast_to(np.arange(3.0), r.shape)
         brightness = np.repeat(projected.sum(1, keepdims=True), 3, 1)
+        nearest = nearest_surface_colour(surface, projected)
+        none = np.empty(0)
         return ResidualSample(
             list(r),
             {
@@ -349,6 +373,15 @@ class TripleProblem(ProjectionTerms, Problem):
                 "surface_level": list(surface),
                 "projected_level": list(projected),
                 "projected_brightness": list(brightness),
+            },
+            {
+                "nearest_surface_colour": [
+                    (row, r[j]) if j >= 0 else (none, none) for row, j in zip(r, nearest, strict=True)
+                ]
+            },
+            neighbour_pairing={
+                "nearest_surface_colour": "the residuals of each row and of the row nearest to it in surface "
+                "colour under the same projected colour"
             },
         )
 

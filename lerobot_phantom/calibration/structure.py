@@ -21,8 +21,12 @@ Run on the held-out residual of the model that is written (base + identified eff
   measured frame whose lines hold the predicted content moved by a fraction of a pixel or more leaves a residual of
   zero mean in every bin, largest at edges, which binned means dilute among the flat values;
 - **correlation between neighbours** ``LAG`` values apart along rows and along columns of a frame (a residual
-  that is a smooth image, not noise): structure remains when the interval's lower end exceeds ``MIN_LAG_CORR``.
-  Sensor processing (demosaicing, compression) correlates neighbours at lags of one or two pixels, hence lag 3.
+  that is a smooth image, not noise), or between a table's row and the row nearest to it in the table's inputs
+  (``ResidualSample.neighbour_pairing``; colour triples: ``projection.nearest_surface_colour``): structure remains
+  when the interval's lower end exceeds ``MIN_NEIGHBOUR_CORR``. Sensor processing (demosaicing, compression)
+  correlates neighbours at lags of one or two pixels, hence lag 3. Rows whose inputs nearly agree and whose errors
+  agree too leave a residual that is a function of the inputs, which binned means by one input at a time dilute
+  when it changes faster than a bin or with a combination of inputs (the SLAP bottle: docs/bench/session65.md);
 
 - **items outside the model's error distribution**: a held-out item whose error exceeds ``OUTLIER_FACTOR`` times
   the largest error of any fit item (exchangeable items exceed that largest error with probability 1/(n_fit + 1)
@@ -62,7 +66,7 @@ from lerobot_phantom.calibration.noise import NoiseSample, fit_variance, model_v
 
 BINS = 8
 MIN_EXPLAINED = 0.02
-MIN_LAG_CORR = 0.25
+MIN_NEIGHBOUR_CORR = 0.25
 MIN_SHARE_OF_BASE = 0.005
 LAG = 3
 FAMILY_ALPHA = 0.01
@@ -86,6 +90,8 @@ class ResidualSample:
     noise_position: dict[str, list[np.ndarray]] = field(default_factory=dict)
     # frame pairs: per direction ("rows", "columns"), each item's ``line_terms``
     lines: dict[str, list[np.ndarray]] = field(default_factory=dict)
+    # what a neighbours entry pairs, where it is not two values ``LAG`` apart along a line of a frame (a table's rows)
+    neighbour_pairing: dict[str, str] = field(default_factory=dict)
 
     def joined(self, other: ResidualSample) -> ResidualSample:
         """This sample's items followed by ``other``'s (the same variables)."""
@@ -96,6 +102,7 @@ class ResidualSample:
             self.noise + other.noise,
             {name: values + other.noise_position[name] for name, values in self.noise_position.items()},
             {name: values + other.lines[name] for name, values in self.lines.items()},
+            {**other.neighbour_pairing, **self.neighbour_pairing},
         )
 
 
@@ -192,7 +199,9 @@ def residual_structure(
         f"item-bootstrap interval (frame pairs: also the squared residual over the sensor-noise model's variance, "
         f"minus 1, by row and column; and the share of the residual a displacement of each row along the row, or "
         f"column along the column, explains as read in each half of the line, > {MIN_EXPLAINED} at the low end); "
-        f"neighbours {LAG} values apart correlate > {MIN_LAG_CORR} at its low end; items whose error exceeds "
+        f"neighbours (in a frame {LAG} values apart along a line; in a colour-triple table the row nearest in "
+        f"surface colour under the same projected colour) correlate > {MIN_NEIGHBOUR_CORR} at its low end; items "
+        "whose error exceeds "
         f"{OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the held-out squared "
         f"error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
         "held-out mean squared error",
@@ -484,9 +493,11 @@ def displacement_tests(
 def neighbour_tests(
     sample: ResidualSample, share_of_base: Callable[[float], float], rng: np.random.Generator
 ) -> list[dict]:
-    """Per direction with neighbour pairs: the correlation of residuals ``LAG`` values apart (smooth structure)."""
+    """Per kind of neighbour pairs: the correlation of the two residuals of a pair (smooth structure): ``LAG`` values
+    apart along rows or columns of a frame, or as ``sample.neighbour_pairing`` says (a table's nearest rows)."""
     tests = []
     for name, pairs in sample.neighbours.items():
+        pairing = sample.neighbour_pairing.get(name)
         columns = np.array([moment_columns(a, b) for a, b in pairs])
         totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
         r = percentile_interval(
@@ -495,12 +506,14 @@ def neighbour_tests(
         tests.append(
             {
                 "variable": name,
-                "statistic": f"lag-{LAG} correlation",
+                "statistic": "neighbour correlation" if pairing else f"lag-{LAG} correlation",
                 "value": r.estimate,
                 "interval": r.as_dict(),
                 "share_of_base_mse": share_of_base(r.estimate),
-                "significant": bool(r.low > MIN_LAG_CORR and share_of_base(r.estimate) >= MIN_SHARE_OF_BASE),
-                "where": f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
+                "significant": bool(
+                    r.low > MIN_NEIGHBOUR_CORR and share_of_base(r.estimate) >= MIN_SHARE_OF_BASE
+                ),
+                "where": pairing or f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
             }
         )
     return tests
@@ -569,6 +582,11 @@ def structure_summary(found: list[dict], residual: str = "held-out residual") ->
                 f"residual depends on {t['variable']} (eta2 {t['value']:.3f}, 90% interval "
                 f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}, r = {t['r']['estimate']:+.2f}; "
                 f"{t['where']})"
+            )
+        if t["statistic"] == "neighbour correlation":
+            return (
+                f"neighbours err alike: {t['where']} correlate {t['value']:.3f} (90% interval "
+                f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f})"
             )
         return (
             f"residual is smooth: {t['where']} ({t['statistic']} {t['value']:.3f}, 90% interval "

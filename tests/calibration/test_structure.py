@@ -20,6 +20,7 @@ from lerobot_phantom.calibration.structure import (
     explained_share_of_totals,
     line_terms,
     moment_columns,
+    neighbour_tests,
     residual_structure,
 )
 
@@ -130,6 +131,35 @@ def test_the_reported_estimates_are_the_statistics_of_every_item():
 def test_smooth_residual_is_reported_as_neighbour_correlation():
     result = run(FakeProblem(ramp=0.0, smooth=True))
     assert [t["variable"] for t in result["tests"] if t["significant"]] == ["neighbours_along_rows"]
+    test = next(t for t in result["tests"] if t["variable"] == "neighbours_along_rows")
+    assert test["statistic"] == "lag-3 correlation" and "residual is smooth" in result["summary"]
+
+
+def test_neighbours_paired_otherwise_say_how_and_keep_it_when_joined():
+    """A table's rows are paired by their inputs, not along a line: the pairing is the finding's ``where``."""
+    pairing = "the residuals of each row and of the row nearest to it in its inputs"
+
+    def sample(pairs):
+        return ResidualSample(
+            [np.zeros(1)] * len(pairs),
+            {},
+            {"nearest_inputs": pairs},
+            neighbour_pairing={"nearest_inputs": pairing},
+        )
+
+    rng = np.random.default_rng(3)
+    shared = rng.normal(size=(400, 3))
+    pairs = [(row, row + rng.normal(scale=0.3, size=3)) for row in shared]
+    joined = sample(pairs[:200]).joined(sample(pairs[200:]))
+    assert (
+        joined.neighbour_pairing == {"nearest_inputs": pairing}
+        and len(joined.neighbours["nearest_inputs"]) == 400
+    )
+    (test,) = neighbour_tests(joined, lambda statistic: 1.0, rng)
+    assert test["statistic"] == "neighbour correlation" and test["where"] == pairing
+    assert test["significant"] and test["value"] == pytest.approx(1 / np.sqrt(1 + 0.3**2), abs=0.03)
+    (unrelated,) = neighbour_tests(sample([(row, rng.normal(size=3)) for row in shared]), lambda s: 1.0, rng)
+    assert not unrelated["significant"] and abs(unrelated["value"]) < 0.1
 
 
 class RefitProblem(FakeProblem):
