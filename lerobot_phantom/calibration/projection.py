@@ -383,6 +383,11 @@ class TripleProblem(ProjectionTerms, Problem):
                 "nearest_surface_colour": "the residuals of each row and of the row nearest to it in surface "
                 "colour under the same projected colour"
             },
+            neighbour_groups={
+                "nearest_surface_colour": [
+                    f"projected colour ({', '.join(str(round(v)) for v in colour)})" for colour in projected
+                ]
+            },
         )
 
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:

@@ -26,7 +26,9 @@ Run on the held-out residual of the model that is written (base + identified eff
   when the interval's lower end exceeds ``MIN_NEIGHBOUR_CORR``. Sensor processing (demosaicing, compression)
   correlates neighbours at lags of one or two pixels, hence lag 3. Rows whose inputs nearly agree and whose errors
   agree too leave a residual that is a function of the inputs, which binned means by one input at a time dilute
-  when it changes faster than a bin or with a combination of inputs (the SLAP bottle: docs/bench/session65.md);
+  when it changes faster than a bin or with a combination of inputs (the SLAP bottle: docs/bench/session65.md).
+  Where pairs come in groups (``ResidualSample.neighbour_groups``: a table's projected colours), the finding names
+  the group whose pairs share the most residual;
 
 - **items outside the model's error distribution**: a held-out item whose error exceeds ``OUTLIER_FACTOR`` times
   the largest error of any fit item (exchangeable items exceed that largest error with probability 1/(n_fit + 1)
@@ -92,6 +94,9 @@ class ResidualSample:
     lines: dict[str, list[np.ndarray]] = field(default_factory=dict)
     # what a neighbours entry pairs, where it is not two values ``LAG`` apart along a line of a frame (a table's rows)
     neighbour_pairing: dict[str, str] = field(default_factory=dict)
+    # per neighbours entry, per pair: the part of the inputs the pair shares (a table's projected colour), so that a
+    # finding can say where the pairs agree most
+    neighbour_groups: dict[str, list[str]] = field(default_factory=dict)
 
     def joined(self, other: ResidualSample) -> ResidualSample:
         """This sample's items followed by ``other``'s (the same variables)."""
@@ -103,6 +108,7 @@ class ResidualSample:
             {name: values + other.noise_position[name] for name, values in self.noise_position.items()},
             {name: values + other.lines[name] for name, values in self.lines.items()},
             {**other.neighbour_pairing, **self.neighbour_pairing},
+            {name: groups + other.neighbour_groups[name] for name, groups in self.neighbour_groups.items()},
         )
 
 
@@ -513,10 +519,34 @@ def neighbour_tests(
                 "significant": bool(
                     r.low > MIN_NEIGHBOUR_CORR and share_of_base(r.estimate) >= MIN_SHARE_OF_BASE
                 ),
-                "where": pairing or f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
+                "where": agreeing_group(pairs, sample.neighbour_groups[name])
+                if name in sample.neighbour_groups
+                else f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
             }
         )
+        if pairing:
+            tests[-1]["pairing"] = pairing
     return tests
+
+
+def agreeing_group(pairs: list[tuple[np.ndarray, np.ndarray]], groups: list[str]) -> str:
+    """The group whose pairs share the most residual: the largest mean product of a pair's two residuals, given as
+    the root of it (the residual the two have in common), with the same figure over every pair."""
+    sums: dict[str, float] = {}
+    counts: dict[str, int] = {}
+    for (a, b), group in zip(pairs, groups, strict=True):
+        sums[group] = sums.get(group, 0.0) + float(np.sum(a * b))
+        counts[group] = counts.get(group, 0) + len(a)
+    shared = {g: sums[g] / counts[g] for g in sums if counts[g]}
+    if not shared:
+        return "no pairs"
+    top = max(shared, key=shared.get)
+    overall = sum(sums.values()) / max(sum(counts.values()), 1)
+
+    def root(x: float) -> str:
+        return f"{math.copysign(math.sqrt(abs(x)), x):.3g}"
+
+    return f"the pairs share {root(overall)} (root mean product), most under {top}: {root(shared[top])}"
 
 
 def item_errors(problem, fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -585,8 +615,8 @@ def structure_summary(found: list[dict], residual: str = "held-out residual") ->
             )
         if t["statistic"] == "neighbour correlation":
             return (
-                f"neighbours err alike: {t['where']} correlate {t['value']:.3f} (90% interval "
-                f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f})"
+                f"neighbours err alike: {t['pairing']} correlate {t['value']:.3f} (90% interval "
+                f"{t['interval']['low']:.3f}-{t['interval']['high']:.3f}; {t['where']})"
             )
         return (
             f"residual is smooth: {t['where']} ({t['statistic']} {t['value']:.3f}, 90% interval "

@@ -22,6 +22,7 @@ from lerobot_phantom.calibration.structure import (
     moment_columns,
     neighbour_tests,
     residual_structure,
+    structure_summary,
 )
 
 
@@ -135,30 +136,37 @@ def test_smooth_residual_is_reported_as_neighbour_correlation():
     assert test["statistic"] == "lag-3 correlation" and "residual is smooth" in result["summary"]
 
 
-def test_neighbours_paired_otherwise_say_how_and_keep_it_when_joined():
-    """A table's rows are paired by their inputs, not along a line: the pairing is the finding's ``where``."""
+def test_neighbours_paired_otherwise_say_how_and_where_they_agree_most_and_keep_it_when_joined():
+    """A table's rows are paired by their inputs, not along a line: the finding says how, and in which group of
+    pairs (a table's projected colour) the two residuals share the most."""
     pairing = "the residuals of each row and of the row nearest to it in its inputs"
 
-    def sample(pairs):
+    def sample(pairs, group):
         return ResidualSample(
             [np.zeros(1)] * len(pairs),
             {},
             {"nearest_inputs": pairs},
             neighbour_pairing={"nearest_inputs": pairing},
+            neighbour_groups={"nearest_inputs": [group] * len(pairs)},
         )
 
     rng = np.random.default_rng(3)
     shared = rng.normal(size=(400, 3))
     pairs = [(row, row + rng.normal(scale=0.3, size=3)) for row in shared]
-    joined = sample(pairs[:200]).joined(sample(pairs[200:]))
-    assert (
-        joined.neighbour_pairing == {"nearest_inputs": pairing}
-        and len(joined.neighbours["nearest_inputs"]) == 400
-    )
+    # the second group's residuals are twice the first's: they share four times the mean product
+    joined = sample(pairs[:200], "dim").joined(sample([(2 * a, 2 * b) for a, b in pairs[200:]], "bright"))
+    assert joined.neighbour_pairing == {"nearest_inputs": pairing}
+    assert joined.neighbour_groups["nearest_inputs"] == ["dim"] * 200 + ["bright"] * 200
     (test,) = neighbour_tests(joined, lambda statistic: 1.0, rng)
-    assert test["statistic"] == "neighbour correlation" and test["where"] == pairing
+    assert test["statistic"] == "neighbour correlation" and test["pairing"] == pairing
     assert test["significant"] and test["value"] == pytest.approx(1 / np.sqrt(1 + 0.3**2), abs=0.03)
-    (unrelated,) = neighbour_tests(sample([(row, rng.normal(size=3)) for row in shared]), lambda s: 1.0, rng)
+    bright = np.mean([np.sum(4 * a * b) / 3 for a, b in pairs[200:]])
+    assert test["where"].endswith(f"most under bright: {np.sqrt(bright):.3g}"), test["where"]
+    summary = structure_summary([test])
+    assert summary.startswith(f"unexplained structure: neighbours err alike: {pairing} correlate ")
+    (unrelated,) = neighbour_tests(
+        sample([(row, rng.normal(size=3)) for row in shared], "any"), lambda s: 1.0, rng
+    )
     assert not unrelated["significant"] and abs(unrelated["value"]) < 0.1
 
 

@@ -98,6 +98,7 @@ def test_rows_of_one_surface_colour_that_err_alike_are_reported_and_noise_is_not
     assert found[0.5]["summary"].startswith(
         "unexplained structure: neighbours err alike: the residuals of each row"
     )
+    assert "most under projected colour (" in found[0.5]["summary"]
     assert not found[0.0]["structure_remains"], found[0.0]["summary"]
     assert (
         abs(next(t for t in found[0.0]["tests"] if t["variable"] == "nearest_surface_colour")["value"]) < 0.1
