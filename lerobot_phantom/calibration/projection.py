@@ -259,8 +259,9 @@ def nearest_surface_colour(surface: np.ndarray, projected: np.ndarray) -> np.nda
     inputs in a way the model lacks, or on what those pixels share and the table does not record (where they lie
     in the projector's beam, their angle to it, a glossy surface)."""
     nearest = np.full(len(surface), -1)
-    _, group = np.unique(projected, axis=0, return_inverse=True)
-    for members in (np.flatnonzero(group == g) for g in np.unique(group)):
+    _, group, counts = np.unique(projected, axis=0, return_inverse=True, return_counts=True)
+    by_group = np.argsort(group.ravel(), kind="stable")
+    for members in np.split(by_group, np.cumsum(counts)[:-1]):
         if len(members) < 2:
             continue
         _, index = cKDTree(surface[members]).query(surface[members], k=2)

@@ -112,6 +112,15 @@ def test_each_row_is_paired_with_the_nearest_surface_colour_under_its_projected_
     projected = np.array([[254, 0, 0]] * 3 + [[0, 254, 0]] + [[254, 0, 0]] + [[0, 0, 127]] * 2, dtype=float)
     # row 3 is alone under its projected colour; rows 5 and 6 share one surface colour and pair with each other
     assert nearest_surface_colour(surface, projected).tolist() == [4, 2, 1, -1, 0, 6, 5]
+    rng = np.random.default_rng(5)
+    surface, projected = rng.uniform(0, 20, (300, 3)), rng.choice([0.0, 254.0], (300, 3))
+    nearest = nearest_surface_colour(surface, projected)
+    for row, paired in enumerate(nearest):
+        others = np.flatnonzero(np.all(projected == projected[row], axis=1))
+        others = others[others != row]
+        distance = np.linalg.norm(surface[others] - surface[row], axis=1)
+        assert np.all(projected[paired] == projected[row]) and paired != row
+        assert np.linalg.norm(surface[paired] - surface[row]) == pytest.approx(distance.min())
 
 
 def assert_evidence_quotes_the_compared_steps(report: dict) -> None:
