@@ -11,7 +11,8 @@ Fits on the calibration's fit rows (seed 0, 20% held out: ``core.seeded_split``)
 3. other forms fitted and scored like the written model: the pattern's own transfer curve (a power law for the
    projector), reflectance weighting each projected primary instead of each camera channel, the light from each
    primary into each camera channel a linear function of the surface's three channels (36 numbers), and
-   reflectance at each primary a linear function of the surface's channels (21 numbers).
+   reflectance at each primary a linear function of the surface's channels (21 numbers; also with non-negative
+   weights, as a reflectance must be).
 
 usage: PYTHONPATH=. python docs/bench/session65/slap_residual_probe.py TABLE.csv > out.txt
 """
@@ -58,7 +59,7 @@ class Forms:
             added = torch.einsum("ncj,nj->nc", gain, light)
         else:
             matrix = stack(params, CROSSTALK_NAMES, (3, 3))
-            if form == "primary_reflectance":
+            if form.startswith("primary_reflectance"):
                 reflectance = surf @ stack(params, PRIMARY_WEIGHTS, (3, 3)).T + stack(
                     params, PRIMARY_FLOOR, (3,)
                 )
@@ -83,10 +84,12 @@ class Forms:
             specs = [s for s in specs if not s.name.startswith("crosstalk") and s.name != "reflectance_floor"]
             specs += [Param(n, 0.3 if n[1] == n[2] == n[3] else 0.0, -20, 20, scale=0.3) for n in TENSOR]
             specs += [Param(n, 0.0, -5, 5, scale=0.1) for n in TENSOR_FLOOR]
-        if form == "primary_reflectance":
+        if form.startswith("primary_reflectance"):
+            # non-negative: a reflectance is a non-negative mix of what the surface returns in each channel
+            low, floor_low = (0.0, -0.05) if form.endswith("non_negative") else (-10.0, -2.0)
             specs = [s for s in specs if s.name != "reflectance_floor"]
-            specs += [Param(n, 1.0 if n[1] == n[2] else 0.0, -10, 10, scale=0.3) for n in PRIMARY_WEIGHTS]
-            specs += [Param(n, 0.1, -2, 5, scale=0.1) for n in PRIMARY_FLOOR]
+            specs += [Param(n, 1.0 if n[1] == n[2] else 0.0, low, 10, scale=0.3) for n in PRIMARY_WEIGHTS]
+            specs += [Param(n, 0.1, floor_low, 5, scale=0.1) for n in PRIMARY_FLOOR]
         return specs
 
     def fit_and_score(self, form, effects, fit_items, heldout):
@@ -187,6 +190,8 @@ def main() -> None:
         ("tensor", {"sensor_gamma"}),
         ("primary_reflectance", {"albedo_modulation"}),
         ("primary_reflectance", {"albedo_modulation", "sensor_gamma"}),
+        ("primary_reflectance_non_negative", {"albedo_modulation"}),
+        ("primary_reflectance_non_negative", {"albedo_modulation", "sensor_gamma"}),
     ):
         effects = written | extra
         params, (fit_rmse, held_rmse) = forms.fit_and_score(form, effects, fit_items, heldout)
@@ -198,7 +203,7 @@ def main() -> None:
         print(
             f"  {form} with {sorted(effects - written)}: fit {fit_rmse:.2f}, held-out {held_rmse:.2f} {shown}"
         )
-        if form == "primary_reflectance":
+        if form.startswith("primary_reflectance"):
             print(
                 f"    reflectance weights per primary (rows) on the surface's channels: {np.array([params[n] for n in PRIMARY_WEIGHTS]).reshape(3, 3).round(2).tolist()}"
             )
