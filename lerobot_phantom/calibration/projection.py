@@ -358,7 +358,8 @@ class TripleProblem(ProjectionTerms, Problem):
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         """Per row: the three channels' residuals against channel, surface and projected level; and each row's
         residual paired with that of the row among ``items`` nearest to it in surface colour under the same
-        projected colour (:func:`nearest_surface_colour`; none for a row alone under its projected colour)."""
+        projected colour (:func:`nearest_surface_colour`; none for a row alone under its projected colour, and
+        one pair for two rows that are each other's nearest)."""
         r = self.residual(fit, items)
         index = torch.as_tensor(items)
         surface = self.surface[index].numpy() * 255
@@ -366,6 +367,9 @@ class TripleProblem(ProjectionTerms, Problem):
         channel = np.broadcast_to(np.arange(3.0), r.shape)
         brightness = np.repeat(projected.sum(1, keepdims=True), 3, 1)
         nearest = nearest_surface_colour(surface, projected)
+        # two rows that are each other's nearest are one pair: kept once, the bootstrap does not count it twice
+        order = np.arange(len(nearest))
+        nearest[(nearest >= 0) & (nearest < order) & (nearest[nearest] == order)] = -1
         none = np.empty(0)
         return ResidualSample(
             list(r),

@@ -14,7 +14,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate, main
-from lerobot_phantom.calibration.core import fit_least_squares
+from lerobot_phantom.calibration.core import Fit, fit_least_squares
 from lerobot_phantom.calibration.projection import (
     TRIPLE_COLUMNS,
     TripleProblem,
@@ -121,6 +121,24 @@ def test_each_row_is_paired_with_the_nearest_surface_colour_under_its_projected_
         distance = np.linalg.norm(surface[others] - surface[row], axis=1)
         assert np.all(projected[paired] == projected[row]) and paired != row
         assert np.linalg.norm(surface[paired] - surface[row]) == pytest.approx(distance.min())
+
+
+def test_a_table_residual_sample_holds_each_pair_of_nearest_rows_once(tmp_path):
+    rng = np.random.default_rng(6)
+    surface, projected = rng.uniform(0.1, 0.3, (200, 3)), rng.choice([0.0, 254 / 255], (200, 3))
+    problem = TripleProblem(write_triple_table(tmp_path / "t.csv", surface, projected, surface))
+    items = np.arange(problem.n_items)
+    sample = problem.residual_sample(Fit(frozenset({"additive_light"}), {"strength": 0.3}), items, rng)
+    nearest = nearest_surface_colour(problem.surface.numpy() * 255, problem.projected.numpy() * 255)
+    unordered = {frozenset((i, int(j))) for i, j in enumerate(nearest) if j >= 0}
+    pairs = sample.neighbours["nearest_surface_colour"]
+    assert sum(len(a) > 0 for a, _ in pairs) == len(unordered) < int(np.sum(nearest >= 0))
+    residual = problem.residual(Fit(frozenset({"additive_light"}), {"strength": 0.3}), items)
+    kept = {frozenset((i, int(j))) for i, j in enumerate(nearest) if j >= 0 and len(pairs[i][0])}
+    assert kept == unordered
+    assert all(
+        np.array_equal(pairs[i][1], residual[nearest[i]]) for i in range(len(pairs)) if len(pairs[i][0])
+    )
 
 
 def assert_evidence_quotes_the_compared_steps(report: dict) -> None:
