@@ -14,6 +14,8 @@ Fits on the calibration's fit rows (seed 0, 20% held out: ``core.seeded_split``)
    reflectance at each primary a linear function of the surface's channels (21 numbers; also with non-negative
    weights, as a reflectance must be).
 
+0. the table itself (``table_facts``);
+
 usage: PYTHONPATH=. python docs/bench/session65/slap_residual_probe.py TABLE.csv > out.txt
 """
 
@@ -23,12 +25,14 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
+from scipy.cluster.vq import kmeans2
 from scipy.spatial import cKDTree
 
 from lerobot_phantom.calibration.core import Param, fit_least_squares, seeded_split
 from lerobot_phantom.calibration.projection import (
     CROSSTALK_NAMES,
     TripleProblem,
+    nearest_surface_colour,
     projection_specs,
     tone_curve,
 )
@@ -110,11 +114,51 @@ class Forms:
         return params, rmse
 
 
+def table_facts(path: Path, problem: TripleProblem, heldout: np.ndarray) -> None:
+    """What the write-up quotes of the table itself: the spread of the pixels pooled into a row, how far apart in
+    surface colour the held-out rows' nearest neighbours lie (the pairing of ``projection.nearest_surface_colour``),
+    the surface colours' two k-means clusters, and the largest captured difference between two rows at most 1.5
+    grey levels apart in surface colour under one projected colour."""
+    table = pd.read_csv(path)
+    spread = np.average(table["outcome_std"], weights=table["n_matching_pixels"])
+    surface = problem.surface.numpy() * 255
+    projected = np.round(problem.projected.numpy() * 255)
+    captured = problem.captured.numpy() * 255
+    nearest = nearest_surface_colour(surface[heldout], projected[heldout])
+    paired = nearest >= 0
+    distance = np.linalg.norm(surface[heldout][paired] - surface[heldout][nearest[paired]], axis=1)
+    colours = np.unique(np.round(surface), axis=0)
+    centres, label = kmeans2(colours, 2, seed=1, minit="++")
+    print(
+        f"  pooled pixels' spread (outcome_std weighted by n_matching_pixels) {spread:.2f}; held-out rows' nearest "
+        f"neighbour {np.median(distance):.2f} grey levels apart (median); surface colours, 2-means: "
+        + ", ".join(
+            f"{np.round(c).astype(int).tolist()} ({n})"
+            for c, n in zip(centres, np.bincount(label), strict=True)
+        )
+    )
+    best = (0.0, None)
+    for colour in np.unique(projected, axis=0):
+        rows = np.flatnonzero(np.all(projected == colour, axis=1))
+        for i, j in cKDTree(surface[rows]).query_pairs(1.5):
+            gap = float(np.abs(captured[rows[i]] - captured[rows[j]]).max())
+            if gap > best[0]:
+                best = (gap, (colour, rows[i], rows[j]))
+    colour, i, j = best[1]
+    print(
+        f"  largest captured difference within 1.5 grey levels of surface colour: {best[0]:.0f} under projected "
+        f"{colour.astype(int).tolist()}: {np.round(surface[i]).astype(int).tolist()} -> "
+        f"{np.round(captured[i]).astype(int).tolist()}, {np.round(surface[j]).astype(int).tolist()} -> "
+        f"{np.round(captured[j]).astype(int).tolist()}"
+    )
+
+
 def main() -> None:
     path = Path(sys.argv[1])
     problem = TripleProblem(path)
     forms = Forms(problem)
     fit_items, heldout = seeded_split(problem.n_items, 0.2, 0)
+    table_facts(path, problem, heldout)
     # the written models of both tables at bbe5bab (report.json): the bottle's has no reflectance term
     written = {"additive_light", "channel_crosstalk"} | (
         {"albedo_modulation"} if "stop_sign" in path.name else set()
