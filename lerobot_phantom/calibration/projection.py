@@ -35,7 +35,7 @@ from lerobot_phantom.calibration.core import (
     fit_least_squares,
     further_starts,
 )
-from lerobot_phantom.calibration.structure import ResidualSample
+from lerobot_phantom.calibration.structure import NeighbourPairs, ResidualSample
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     equivalent_power_gamma,
@@ -380,18 +380,15 @@ class TripleProblem(ProjectionTerms, Problem):
                 "projected_brightness": list(brightness),
             },
             {
-                "nearest_surface_colour": [
-                    (row, r[j]) if j >= 0 else (none, none) for row, j in zip(r, nearest, strict=True)
-                ]
-            },
-            neighbour_pairing={
-                "nearest_surface_colour": "the residuals of each row and of the row nearest to it in surface "
-                "colour under the same projected colour"
-            },
-            neighbour_groups={
-                "nearest_surface_colour": [
-                    f"projected colour ({', '.join(str(round(v)) for v in colour)})" for colour in projected
-                ]
+                "nearest_surface_colour": NeighbourPairs(
+                    [(row, r[j]) if j >= 0 else (none, none) for row, j in zip(r, nearest, strict=True)],
+                    pairing="the residuals of each row and of the row nearest to it in surface colour under the "
+                    "same projected colour",
+                    groups=[
+                        f"projected colour ({', '.join(str(round(v)) for v in colour)})"
+                        for colour in projected
+                    ],
+                )
             },
         )
 

@@ -22,12 +22,12 @@ Run on the held-out residual of the model that is written (base + identified eff
   zero mean in every bin, largest at edges, which binned means dilute among the flat values;
 - **correlation between neighbours** ``LAG`` values apart along rows and along columns of a frame (a residual
   that is a smooth image, not noise), or between a table's row and the row nearest to it in the table's inputs
-  (``ResidualSample.neighbour_pairing``; colour triples: ``projection.nearest_surface_colour``): structure remains
+  (``NeighbourPairs.pairing``; colour triples: ``projection.nearest_surface_colour``): structure remains
   when the interval's lower end exceeds ``MIN_NEIGHBOUR_CORR``. Sensor processing (demosaicing, compression)
   correlates neighbours at lags of one or two pixels, hence lag 3. Rows whose inputs nearly agree and whose errors
   agree too leave a residual that is a function of the inputs, which binned means by one input at a time dilute
   when it changes faster than a bin or with a combination of inputs (the SLAP bottle: docs/bench/session65.md).
-  Where pairs come in groups (``ResidualSample.neighbour_groups``: a table's projected colours), the finding names
+  Where pairs come in groups (``NeighbourPairs.groups``: a table's projected colours), the finding names
   the group whose pairs share the most residual;
 
 - **items outside the model's error distribution**: a held-out item whose error exceeds ``OUTLIER_FACTOR`` times
@@ -81,34 +81,46 @@ MIN_TESTED_ITEMS = 5  # fewer held-out items than this are joined by the fit ite
 
 
 @dataclass
+class NeighbourPairs:
+    """One kind of neighbouring residuals: per item, the residuals of its pairs' two sides."""
+
+    pairs: list[tuple[np.ndarray, np.ndarray]] = field(default_factory=list)
+    # what is paired, where it is not two values ``LAG`` apart along a line of a frame (a table's rows)
+    pairing: str | None = None
+    # per item's pairs: the part of the inputs they share (a table's projected colour), so that a finding can say
+    # where the pairs agree most
+    groups: list[str] | None = None
+
+    def joined(self, other: NeighbourPairs) -> NeighbourPairs:
+        return NeighbourPairs(
+            self.pairs + other.pairs,
+            self.pairing,
+            None if self.groups is None else self.groups + other.groups,
+        )
+
+
+@dataclass
 class ResidualSample:
     """Held-out residuals per item, with the variables they may depend on and neighbouring residual pairs."""
 
     residual: list[np.ndarray]
     covariates: dict[str, list[np.ndarray]]
-    neighbours: dict[str, list[tuple[np.ndarray, np.ndarray]]] = field(default_factory=dict)
+    neighbours: dict[str, NeighbourPairs] = field(default_factory=dict)
     # frame pairs: per item, its unclipped values' sensor-noise terms (``noise.NoiseSample``) and their position
     noise: list[NoiseSample] = field(default_factory=list)
     noise_position: dict[str, list[np.ndarray]] = field(default_factory=dict)
     # frame pairs: per direction ("rows", "columns"), each item's ``line_terms``
     lines: dict[str, list[np.ndarray]] = field(default_factory=dict)
-    # what a neighbours entry pairs, where it is not two values ``LAG`` apart along a line of a frame (a table's rows)
-    neighbour_pairing: dict[str, str] = field(default_factory=dict)
-    # per neighbours entry, per pair: the part of the inputs the pair shares (a table's projected colour), so that a
-    # finding can say where the pairs agree most
-    neighbour_groups: dict[str, list[str]] = field(default_factory=dict)
 
     def joined(self, other: ResidualSample) -> ResidualSample:
         """This sample's items followed by ``other``'s (the same variables)."""
         return ResidualSample(
             self.residual + other.residual,
             {name: values + other.covariates[name] for name, values in self.covariates.items()},
-            {name: pairs + other.neighbours[name] for name, pairs in self.neighbours.items()},
+            {name: pairs.joined(other.neighbours[name]) for name, pairs in self.neighbours.items()},
             self.noise + other.noise,
             {name: values + other.noise_position[name] for name, values in self.noise_position.items()},
             {name: values + other.lines[name] for name, values in self.lines.items()},
-            {**other.neighbour_pairing, **self.neighbour_pairing},
-            {name: groups + other.neighbour_groups[name] for name, groups in self.neighbour_groups.items()},
         )
 
 
@@ -205,8 +217,8 @@ def residual_structure(
         f"item-bootstrap interval (frame pairs: also the squared residual over the sensor-noise model's variance, "
         f"minus 1, by row and column; and the share of the residual a displacement of each row along the row, or "
         f"column along the column, explains as read in each half of the line, > {MIN_EXPLAINED} at the low end); "
-        f"neighbours (in a frame {LAG} values apart along a line; in a colour-triple table the row nearest in "
-        f"surface colour under the same projected colour) correlate > {MIN_NEIGHBOUR_CORR} at its low end; items "
+        f"neighbours (in a frame {LAG} values apart along a line; in a table a row and the row nearest to it in "
+        f"the table's inputs, as the finding's pairing says) correlate > {MIN_NEIGHBOUR_CORR} at its low end; items "
         "whose error exceeds "
         f"{OUTLIER_FACTOR:g}x the largest fit item's carry >= {100 * OUTLIER_SHARE:.0f}% of the held-out squared "
         f"error; and the structured part is >= {100 * MIN_SHARE_OF_BASE:.1f}% of the base model's "
@@ -500,11 +512,10 @@ def neighbour_tests(
     sample: ResidualSample, share_of_base: Callable[[float], float], rng: np.random.Generator
 ) -> list[dict]:
     """Per kind of neighbour pairs: the correlation of the two residuals of a pair (smooth structure): ``LAG`` values
-    apart along rows or columns of a frame, or as ``sample.neighbour_pairing`` says (a table's nearest rows)."""
+    apart along rows or columns of a frame, or as its ``pairing`` says (a table's nearest rows)."""
     tests = []
-    for name, pairs in sample.neighbours.items():
-        pairing = sample.neighbour_pairing.get(name)
-        columns = np.array([moment_columns(a, b) for a, b in pairs])
+    for name, neighbours in sample.neighbours.items():
+        columns = np.array([moment_columns(a, b) for a, b in neighbours.pairs])
         totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
         r = percentile_interval(
             float(correlation_of_totals(columns.sum(axis=0, keepdims=True))[0]), correlation_of_totals(totals)
@@ -512,41 +523,42 @@ def neighbour_tests(
         tests.append(
             {
                 "variable": name,
-                "statistic": "neighbour correlation" if pairing else f"lag-{LAG} correlation",
+                "statistic": "neighbour correlation" if neighbours.pairing else f"lag-{LAG} correlation",
                 "value": r.estimate,
                 "interval": r.as_dict(),
                 "share_of_base_mse": share_of_base(r.estimate),
                 "significant": bool(
                     r.low > MIN_NEIGHBOUR_CORR and share_of_base(r.estimate) >= MIN_SHARE_OF_BASE
                 ),
-                "where": agreeing_group(pairs, sample.neighbour_groups[name])
-                if name in sample.neighbour_groups
+                "where": agreeing_group(columns, neighbours.groups)
+                if neighbours.groups is not None
                 else f"neighbouring residuals {LAG} values apart along {name.split('_')[-1]}",
             }
         )
-        if pairing:
-            tests[-1]["pairing"] = pairing
+        if neighbours.pairing:
+            tests[-1]["pairing"] = neighbours.pairing
     return tests
 
 
-def agreeing_group(pairs: list[tuple[np.ndarray, np.ndarray]], groups: list[str]) -> str:
+def agreeing_group(columns: np.ndarray, groups: list[str]) -> str:
     """The group whose pairs share the most residual: the largest mean product of a pair's two residuals, given as
-    the root of it (the residual the two have in common), with the same figure over every pair."""
-    sums: dict[str, float] = {}
-    counts: dict[str, int] = {}
-    for (a, b), group in zip(pairs, groups, strict=True):
-        sums[group] = sums.get(group, 0.0) + float(np.sum(a * b))
-        counts[group] = counts.get(group, 0) + len(a)
-    shared = {g: sums[g] / counts[g] for g in sums if counts[g]}
-    if not shared:
+    the root of it (the residual the two have in common), with the same figure over every pair (``columns``: each
+    item's ``moment_columns``, ``groups`` its group)."""
+    names, group = np.unique(np.asarray(groups, dtype=str), return_inverse=True)
+    counts = np.bincount(group, weights=columns[:, 0], minlength=len(names))
+    products = np.bincount(group, weights=columns[:, 5], minlength=len(names))
+    if not counts.any():
         return "no pairs"
-    top = max(shared, key=shared.get)
-    overall = sum(sums.values()) / max(sum(counts.values()), 1)
+    shared = np.where(counts > 0, products / np.maximum(counts, 1.0), -np.inf)
+    top = int(np.argmax(shared))
+    overall = products.sum() / counts.sum()
 
     def root(x: float) -> str:
         return f"{math.copysign(math.sqrt(abs(x)), x):.3g}"
 
-    return f"the pairs share {root(overall)} (root mean product), most under {top}: {root(shared[top])}"
+    return (
+        f"the pairs share {root(overall)} (root mean product), most under {names[top]}: {root(shared[top])}"
+    )
 
 
 def item_errors(problem, fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -13,6 +13,7 @@ from lerobot_phantom.calibration.frame_models.light_projection import Projection
 from lerobot_phantom.calibration.structure import (
     FAMILY_ALPHA,
     MIN_TESTED_ITEMS,
+    NeighbourPairs,
     ResidualSample,
     binned_columns,
     correlation_of_totals,
@@ -40,14 +41,14 @@ class FakeProblem:
             self.maps.append(noise + ramp * (rows - 0.5))
 
     def residual_sample(self, fit, items, rng):
-        sample = ResidualSample([], {"row": [], "column": []}, {"neighbours_along_rows": []})
+        sample = ResidualSample([], {"row": [], "column": []}, {"neighbours_along_rows": NeighbourPairs()})
         for i in items:
             residual = self.maps[int(i)]
             ys, xs = np.mgrid[0:40, 0:50] / np.array([39.0, 49.0])[:, None, None]
             sample.residual.append(residual.ravel())
             sample.covariates["row"].append(ys.ravel())
             sample.covariates["column"].append(xs.ravel())
-            sample.neighbours["neighbours_along_rows"].append(
+            sample.neighbours["neighbours_along_rows"].pairs.append(
                 (residual[:, :-3].ravel(), residual[:, 3:].ravel())
             )
         return sample
@@ -145,9 +146,7 @@ def test_neighbours_paired_otherwise_say_how_and_where_they_agree_most_and_keep_
         return ResidualSample(
             [np.zeros(1)] * len(pairs),
             {},
-            {"nearest_inputs": pairs},
-            neighbour_pairing={"nearest_inputs": pairing},
-            neighbour_groups={"nearest_inputs": [group] * len(pairs)},
+            {"nearest_inputs": NeighbourPairs(pairs, pairing, [group] * len(pairs))},
         )
 
     rng = np.random.default_rng(3)
@@ -155,8 +154,8 @@ def test_neighbours_paired_otherwise_say_how_and_where_they_agree_most_and_keep_
     pairs = [(row, row + rng.normal(scale=0.3, size=3)) for row in shared]
     # the second group's residuals are twice the first's: they share four times the mean product
     joined = sample(pairs[:200], "dim").joined(sample([(2 * a, 2 * b) for a, b in pairs[200:]], "bright"))
-    assert joined.neighbour_pairing == {"nearest_inputs": pairing}
-    assert joined.neighbour_groups["nearest_inputs"] == ["dim"] * 200 + ["bright"] * 200
+    assert joined.neighbours["nearest_inputs"].pairing == pairing
+    assert joined.neighbours["nearest_inputs"].groups == ["dim"] * 200 + ["bright"] * 200
     (test,) = neighbour_tests(joined, lambda statistic: 1.0, rng)
     assert test["statistic"] == "neighbour correlation" and test["pairing"] == pairing
     assert test["significant"] and test["value"] == pytest.approx(1 / np.sqrt(1 + 0.3**2), abs=0.03)

@@ -131,7 +131,7 @@ def test_a_table_residual_sample_holds_each_pair_of_nearest_rows_once(tmp_path):
     sample = problem.residual_sample(Fit(frozenset({"additive_light"}), {"strength": 0.3}), items, rng)
     nearest = nearest_surface_colour(problem.surface.numpy() * 255, problem.projected.numpy() * 255)
     unordered = {frozenset((i, int(j))) for i, j in enumerate(nearest) if j >= 0}
-    pairs = sample.neighbours["nearest_surface_colour"]
+    pairs = sample.neighbours["nearest_surface_colour"].pairs
     assert sum(len(a) > 0 for a, _ in pairs) == len(unordered) < int(np.sum(nearest >= 0))
     residual = problem.residual(Fit(frozenset({"additive_light"}), {"strength": 0.3}), items)
     kept = {frozenset((i, int(j))) for i, j in enumerate(nearest) if j >= 0 and len(pairs[i][0])}

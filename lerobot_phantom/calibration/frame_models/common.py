@@ -30,7 +30,7 @@ from lerobot_phantom.calibration.core import (
     further_starts,
 )
 from lerobot_phantom.calibration.noise import NoiseSample, noise_sample, tone_curve, unclipped
-from lerobot_phantom.calibration.structure import LAG, ResidualSample, line_terms
+from lerobot_phantom.calibration.structure import LAG, NeighbourPairs, ResidualSample, line_terms
 from lerobot_phantom.transforms.physics import gaussian_spread
 
 REFERENCE_SIZE = 256
@@ -188,7 +188,10 @@ class FrameProblem(Problem):
         sample = ResidualSample(
             [], {k: [] for k in variables + (("pattern_detail",) if with_pattern else ())}
         )
-        sample.neighbours = {"neighbours_along_rows": [], "neighbours_along_columns": []}
+        sample.neighbours = {
+            "neighbours_along_rows": NeighbourPairs(),
+            "neighbours_along_columns": NeighbourPairs(),
+        }
         sample.lines = {"rows": [], "columns": []}
         for i in items:
             pair = self.pairs[int(i)]
@@ -221,7 +224,7 @@ class FrameProblem(Problem):
                 "neighbours_along_columns": (mean[:-LAG], mean[LAG:]),
             }.items():
                 pick = rng.choice(a.size, min(self.structure_values_per_pair, a.size), replace=False)
-                sample.neighbours[name].append((a.ravel()[pick], b.ravel()[pick]))
+                sample.neighbours[name].pairs.append((a.ravel()[pick], b.ravel()[pick]))
         return sample
 
     @staticmethod
