@@ -620,7 +620,7 @@ def test_em_truncation_draws_that_failed(name, seed, root):
     "Session 64: a pass that took sensor_gamma is repeated without it (core.select_forms); projection_crosstalk "
     "named on 3 -> 7 of 9 fresh master seeds, the reflectance term on 4 of 5 filmic cameras (0 before); "
     "whole matrix on two fresh seeds 25 of 26 (docs/bench/session64.md). "
-    "History and measurements: the README, 'Tested against an independent camera simulator', and "
+    "History and measurements: docs/calibration.md, 'Tested against an independent camera simulator', and "
     "docs/bench/camsim_session*.md",
     strict=False,
 )
