@@ -71,12 +71,20 @@ class Camera:
     exposure_target: float = 0.18
     # relative loss of light at the image corner (cos^4-like), an effect the calibration library has no name for
     vignetting: float = 0.0
+    # the ISP's colour correction matrix (row-major 3x3, rows summing to 1 so white stays white), applied to the
+    # demosaiced linear frame: camera RGB filters overlap, and the ISP subtracts the overlap back out with
+    # negative off-diagonals. None: the camera's own RGB is written
+    ccm: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if self.tone not in TONE_CURVES:
             raise ValueError(f"tone {self.tone!r}; valid: {', '.join(TONE_CURVES)}")
         if not 0.0 < self.well_share_of_adc <= 1.0:
             raise ValueError(f"well_share_of_adc {self.well_share_of_adc}; valid: (0, 1]")
+        if self.ccm is not None and (
+            len(self.ccm) != 9 or not np.allclose(np.reshape(self.ccm, (3, 3)).sum(1), 1.0)
+        ):
+            raise ValueError(f"ccm {self.ccm}; valid: 9 numbers, a row-major 3x3 matrix whose rows sum to 1")
 
 
 @dataclass
@@ -223,8 +231,20 @@ def sensor(
 
 
 def develop(raw: np.ndarray, cam: Camera) -> np.ndarray:
-    """ISP: demosaic and tone curve, float output in [0, 1] before encoding."""
-    return tone_curve(demosaic(raw), cam)
+    """ISP: demosaic, colour correction (``Camera.ccm``) and tone curve, float output in [0, 1] before encoding."""
+    rgb = demosaic(raw)
+    if cam.ccm is not None:
+        rgb = rgb @ np.reshape(cam.ccm, (3, 3)).T
+    return tone_curve(rgb, cam)
+
+
+def random_ccm(rng: np.random.Generator) -> tuple[float, ...]:
+    """A colour correction matrix like those of consumer cameras: each off-diagonal -0.45 to 0, the diagonal
+    what makes its row sum to 1 (1.0-1.9)."""
+    off = rng.uniform(-0.45, 0.0, (3, 3))
+    np.fill_diagonal(off, 0.0)
+    matrix = off + np.diag(1.0 - off.sum(1))
+    return tuple(float(v) for v in matrix.ravel())
 
 
 def encode(image01: np.ndarray, cam: Camera) -> np.ndarray:

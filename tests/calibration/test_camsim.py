@@ -23,6 +23,29 @@ def test_well_share_outside_its_range_is_rejected():
         cs.Camera(well_share_of_adc=1.2)
 
 
+def test_the_colour_correction_keeps_grey_grey_and_takes_the_filters_overlap_back_out():
+    rng = np.random.default_rng(4)
+    ccm = cs.random_ccm(rng)
+    matrix = np.reshape(ccm, (3, 3))
+    assert np.allclose(matrix.sum(1), 1.0) and np.all(matrix[~np.eye(3, dtype=bool)] <= 0.0)
+    plain, corrected = (
+        cs.Camera(tone="power", tone_gamma=1.0),
+        cs.Camera(tone="power", tone_gamma=1.0, ccm=ccm),
+    )
+    grey = cs.mosaic(np.full((8, 8, 3), 0.4))
+    assert np.allclose(cs.develop(grey, corrected), cs.develop(grey, plain))
+    # a pure red seen through overlapping filters (some of it in green and blue) comes out more saturated
+    overlapped = np.zeros((8, 8, 3))
+    overlapped[..., 0], overlapped[..., 1:] = 0.5, 0.1
+    red = cs.develop(cs.mosaic(overlapped), corrected)[4, 4]
+    assert red[0] > 0.5 and np.all(red[1:] < 0.1)
+
+
+def test_a_colour_correction_that_does_not_keep_white_is_rejected():
+    with pytest.raises(ValueError, match="rows sum to 1"):
+        cs.Camera(ccm=(1.2, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0))
+
+
 def test_unknown_lost_line_mode_is_rejected():
     with pytest.raises(ValueError, match="lost_lines 'twice'; valid: banded, single"):
         cs.em_strip_pairs(np.random.default_rng(0), cs.Camera(), 2, lost_lines="twice")

@@ -11,10 +11,13 @@ Acceptance (issue 12, "How it will be checked"): planted effects named in >= 90%
 unplanted named cause in any case, null cases keep the base model. The run's master seed is printed in every failure;
 ``CAMSIM_SEED=<seed>`` replays a run. A run calibrates a share of each kind of case, drawn from the master seed
 (``sampled_cases``, tests/sampling.py): ``CAMSIM_CASES=all`` or ``SAMPLED_SHARE=all`` runs the whole matrix.
+``CAMSIM_CCM=1`` gives every camera an ISP colour correction matrix (``camsim.random_ccm``), a camera the library
+does not model yet: a measurement (docs/bench/session66.md), not part of the suite.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from functools import cache
@@ -72,6 +75,11 @@ def random_camera(rng: np.random.Generator, **fixed) -> cs.Camera:
         tone=str(rng.choice(["srgb", "filmic"])),
         jpeg_quality=int(rng.integers(88, 97)),
     )
+    if os.environ.get("CAMSIM_CCM") == "1":
+        # a measurement, not the suite's default (docs/bench/session66.md): every camera mixes its clipped raw
+        # channels with a colour correction matrix, drawn from a stream of its own so that every other draw of the
+        # case is the one without it
+        drawn["ccm"] = cs.random_ccm(np.random.default_rng(rng.bit_generator.state["state"]["state"]))
     return cs.Camera(**{**drawn, **fixed})
 
 
@@ -483,6 +491,16 @@ def replay(case: Case, result: dict) -> str:
         f"case {case.name} (case seed {result['seed']}); replay with CAMSIM_SEED={MASTER_SEED}; "
         f"camera {result['camera']}"
     )
+
+
+def test_a_colour_correction_changes_the_camera_and_no_other_draw(monkeypatch):
+    plain_rng, ccm_rng = np.random.default_rng(11), np.random.default_rng(11)
+    plain = random_camera(plain_rng)
+    monkeypatch.setenv("CAMSIM_CCM", "1")
+    corrected = random_camera(ccm_rng)
+    assert plain.ccm is None and corrected.ccm is not None
+    assert dataclasses.replace(corrected, ccm=None) == plain
+    assert plain_rng.random() == ccm_rng.random()
 
 
 def test_a_run_draws_a_share_of_each_kind_of_case_and_at_least_one_effect_case():
