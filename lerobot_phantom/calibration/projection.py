@@ -24,6 +24,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 import torch
+from scipy.sparse import coo_matrix
+from scipy.sparse.csgraph import connected_components
 from scipy.spatial import cKDTree
 
 from lerobot_phantom.calibration.core import (
@@ -359,7 +361,7 @@ class TripleProblem(ProjectionTerms, Problem):
         """Per row: the three channels' residuals against channel, surface and projected level; and each row's
         residual paired with that of the row among ``items`` nearest to it in surface colour under the same
         projected colour (:func:`nearest_surface_colour`; none for a row alone under its projected colour, and
-        one pair for two rows that are each other's nearest)."""
+        one pair for two rows that are each other's nearest), clustered by the rows nearest-neighbour links join."""
         r = self.residual(fit, items)
         index = torch.as_tensor(items)
         surface = self.surface[index].numpy() * 255
@@ -367,6 +369,11 @@ class TripleProblem(ProjectionTerms, Problem):
         channel = np.broadcast_to(np.arange(3.0), r.shape)
         brightness = np.repeat(projected.sum(1, keepdims=True), 3, 1)
         nearest = nearest_surface_colour(surface, projected)
+        linked = nearest >= 0
+        graph = coo_matrix(
+            (np.ones(int(linked.sum())), (np.flatnonzero(linked), nearest[linked])), shape=(len(nearest),) * 2
+        )
+        _, cluster = connected_components(graph, directed=False)
         # two rows that are each other's nearest are one pair: kept once, the bootstrap does not count it twice
         order = np.arange(len(nearest))
         nearest[(nearest >= 0) & (nearest < order) & (nearest[nearest] == order)] = -1
@@ -388,6 +395,7 @@ class TripleProblem(ProjectionTerms, Problem):
                         f"projected colour ({', '.join(str(round(v)) for v in colour)})"
                         for colour in projected
                     ],
+                    clusters=cluster.tolist(),
                 )
             },
         )

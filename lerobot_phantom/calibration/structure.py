@@ -28,7 +28,9 @@ Run on the held-out residual of the model that is written (base + identified eff
   agree too leave a residual that is a function of the inputs, which binned means by one input at a time dilute
   when it changes faster than a bin or with a combination of inputs (the SLAP bottle: docs/bench/session65.md).
   Where pairs come in groups (``NeighbourPairs.groups``: a table's projected colours), the finding names
-  the group whose pairs share the most residual;
+  the group whose pairs share the most residual. Pairs that share a row (two rows nearest to one third) are not
+  independent: the bootstrap resamples each cluster of rows linked as nearest neighbours whole
+  (``NeighbourPairs.clusters``);
 
 - **items outside the model's error distribution**: a held-out item whose error exceeds ``OUTLIER_FACTOR`` times
   the largest error of any fit item (exchangeable items exceed that largest error with probability 1/(n_fit + 1)
@@ -90,13 +92,32 @@ class NeighbourPairs:
     # per item's pairs: the part of the inputs they share (a table's projected colour), so that a finding can say
     # where the pairs agree most
     groups: list[str] | None = None
+    # per item's pairs: the cluster of pairs it shares residuals with (a table's rows linked as nearest neighbours:
+    # two rows nearest to one third share its residual), resampled together by the interval's bootstrap; None: the
+    # items are independent
+    clusters: list[int] | None = None
 
     def joined(self, other: NeighbourPairs) -> NeighbourPairs:
+        clusters = None
+        if self.clusters is not None:
+            offset = max(self.clusters, default=-1) + 1
+            clusters = self.clusters + [offset + c for c in other.clusters]
         return NeighbourPairs(
             self.pairs + other.pairs,
             self.pairing,
             None if self.groups is None else self.groups + other.groups,
+            clusters,
         )
+
+    def resampled_columns(self, columns: np.ndarray) -> np.ndarray:
+        """What the interval's bootstrap draws: each item's ``moment_columns`` (``columns``), or their sums per
+        cluster."""
+        if self.clusters is None:
+            return columns
+        cluster, index = np.unique(np.asarray(self.clusters), return_inverse=True)
+        sums = np.zeros((len(cluster), columns.shape[1]))
+        np.add.at(sums, index, columns)
+        return sums
 
 
 @dataclass
@@ -516,7 +537,7 @@ def neighbour_tests(
     tests = []
     for name, neighbours in sample.neighbours.items():
         columns = np.array([moment_columns(a, b) for a, b in neighbours.pairs])
-        totals = resummed_totals(columns, draws=RESUMMED_DRAWS, rng=rng)
+        totals = resummed_totals(neighbours.resampled_columns(columns), draws=RESUMMED_DRAWS, rng=rng)
         r = percentile_interval(
             float(correlation_of_totals(columns.sum(axis=0, keepdims=True))[0]), correlation_of_totals(totals)
         )

@@ -169,6 +169,32 @@ def test_neighbours_paired_otherwise_say_how_and_where_they_agree_most_and_keep_
     assert not unrelated["significant"] and abs(unrelated["value"]) < 0.1
 
 
+def test_pairs_that_share_rows_are_resampled_as_one_cluster():
+    """Stars of rows nearest to one centre: each leaf's pair holds the centre's residual, so 200 pairs are 20
+    clusters' worth of evidence; the interval that resamples clusters is wider (1.32x here), the estimate the same."""
+    rng = np.random.default_rng(8)
+    pairs, clusters = [], []
+    for star in range(20):
+        centre = rng.normal(size=3)
+        for _ in range(10):
+            pairs.append((centre + rng.normal(scale=1.5, size=3), centre))
+            clusters.append(star)
+    independent = NeighbourPairs(pairs, "leaf and centre")
+    clustered = NeighbourPairs(pairs, "leaf and centre", clusters=clusters)
+    widths, values = [], []
+    for neighbours in (independent, clustered):
+        sample = ResidualSample([np.zeros(3)] * len(pairs), {}, {"stars": neighbours})
+        (test,) = neighbour_tests(sample, lambda statistic: 1.0, np.random.default_rng(0))
+        widths.append(test["interval"]["high"] - test["interval"]["low"])
+        values.append(test["value"])
+    assert values[0] == values[1]
+    assert widths[1] > 1.2 * widths[0], widths
+    columns = np.array([moment_columns(a, b) for a, b in pairs])
+    assert np.allclose(clustered.resampled_columns(columns).sum(0), columns.sum(0))
+    joined = clustered.joined(clustered)
+    assert joined.clusters == clusters + [20 + c for c in clusters]
+
+
 class RefitProblem(FakeProblem):
     """Per-item ramps (``ramps[i]``); fits remember the items they were fitted on, and every residual asked for
     is checked against them."""
