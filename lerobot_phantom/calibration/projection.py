@@ -376,7 +376,7 @@ class TripleProblem(ProjectionTerms, Problem):
         _, cluster = connected_components(graph, directed=False)
         # two rows that are each other's nearest are one pair: kept once, the bootstrap does not count it twice
         order = np.arange(len(nearest))
-        nearest[(nearest >= 0) & (nearest < order) & (nearest[nearest] == order)] = -1
+        nearest[linked & (nearest < order) & (nearest[nearest] == order)] = -1
         none = np.empty(0)
         return ResidualSample(
             list(r),
