@@ -15,24 +15,30 @@ from camsim_case_cameras import case_draws
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 
 
-def main() -> None:
-    name, out, seeds = sys.argv[1], Path(sys.argv[2]), [int(s) for s in sys.argv[3:]]
+def render_and_calibrate(out: Path, name: str, master: int, case, seed: int, rng, camera) -> None:
+    """Render one drawn case into ``OUTDIR/bt_SEED/camsim0/CASE/pairs``, calibrate it as the test does, print the
+    named effects and the calibration's time."""
     import camsim
 
+    folder = out / f"bt_{master}" / "camsim0" / name
+    folder.mkdir(parents=True)
+    camsim.write_pairs(folder / "pairs", case.render(rng, camera))
+    began = time.perf_counter()
+    report = calibrate(
+        CalibrateConfig(
+            attack=case.attack, measured=str(folder / "pairs"), out=str(folder / "out"), seed=seed % 2**31
+        )
+    )
+    print(
+        f"{master} {name} (case seed {seed}): {report['extended']['effects']} {time.perf_counter() - began:.1f} s",
+        flush=True,
+    )
+
+
+def main() -> None:
+    name, out, seeds = sys.argv[1], Path(sys.argv[2]), [int(s) for s in sys.argv[3:]]
     for master, _sim, case, seed, rng, camera in case_draws(name, seeds):
-        folder = out / f"bt_{master}" / "camsim0" / name
-        folder.mkdir(parents=True)
-        camsim.write_pairs(folder / "pairs", case.render(rng, camera))
-        began = time.perf_counter()
-        report = calibrate(
-            CalibrateConfig(
-                attack=case.attack, measured=str(folder / "pairs"), out=str(folder / "out"), seed=seed % 2**31
-            )
-        )
-        print(
-            f"{master} {name} (case seed {seed}): {report['extended']['effects']} {time.perf_counter() - began:.1f} s",
-            flush=True,
-        )
+        render_and_calibrate(out, name, master, case, seed, rng, camera)
 
 
 if __name__ == "__main__":

@@ -11,15 +11,14 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "session64"))
 from camsim_case_cameras import case_draws
-
-from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from run_camsim_case import render_and_calibrate
 
 
 def noiseless_sensor(camsim):
@@ -55,20 +54,7 @@ def main() -> None:
     for master, sim, case, seed, rng, camera in case_draws(args.case, args.seeds):
         if args.pairs is not None:
             sim.N_PAIRS = args.pairs
-        folder = args.out / f"bt_{master}" / "camsim0" / args.case
-        folder.mkdir(parents=True)
-        camsim.write_pairs(folder / "pairs", case.render(rng, camera))
-        began = time.perf_counter()
-        report = calibrate(
-            CalibrateConfig(
-                attack=case.attack, measured=str(folder / "pairs"), out=str(folder / "out"), seed=seed % 2**31
-            )
-        )
-        print(
-            f"{master} {args.case} (case seed {seed}): {report['extended']['effects']} "
-            f"{time.perf_counter() - began:.1f} s",
-            flush=True,
-        )
+        render_and_calibrate(args.out, args.case, master, case, seed, rng, camera)
 
 
 if __name__ == "__main__":
