@@ -21,22 +21,29 @@ from camsim_case_cameras import case_draws
 from run_camsim_case import render_and_calibrate
 
 
-def noiseless_sensor(camsim):
-    """camsim's ``sensor`` drawing the same shot and read noise from the generator (so every later draw of the
-    case is unchanged) and leaving it out of the frame."""
+class Noiseless:
+    """A generator that draws camsim's shot and read noise as the real one does (so every later draw of the case is
+    unchanged) and hands back their means: Poisson counts at their expectation, read noise 0."""
 
-    def sensor(irradiance, exposure, cam, rng, *, extra_exposure=None):
-        signal = exposure * irradiance
-        if extra_exposure is not None:
-            signal = signal + extra_exposure
-        electrons = camsim.mosaic(signal) * cam.full_well_e
-        rng.poisson(np.clip(electrons, 0, 50 * cam.full_well_e))
-        rng.normal(0.0, cam.read_noise_e, electrons.shape)
-        levels = 2**cam.adc_bits - 1
-        code = np.clip(electrons / cam.full_well_e, 0.0, 1.0) * cam.well_share_of_adc
-        return np.round(code * levels) / levels
+    def __init__(self, rng: np.random.Generator) -> None:
+        self.rng = rng
 
-    return sensor
+    def poisson(self, lam):
+        self.rng.poisson(lam)
+        return np.asarray(lam, dtype=float)
+
+    def normal(self, loc=0.0, scale=1.0, size=None):
+        self.rng.normal(loc, scale, size)
+        return np.full(size, loc, dtype=float)
+
+
+def noiseless_sensor(sensor):
+    """camsim's own ``sensor``, fed a :class:`Noiseless` generator."""
+
+    def quiet(irradiance, exposure, cam, rng, **kwargs):
+        return sensor(irradiance, exposure, cam, Noiseless(rng), **kwargs)
+
+    return quiet
 
 
 def main() -> None:
@@ -50,7 +57,7 @@ def main() -> None:
     import camsim
 
     if args.noiseless:
-        camsim.sensor = noiseless_sensor(camsim)
+        camsim.sensor = noiseless_sensor(camsim.sensor)
     for master, sim, case, seed, rng, camera in case_draws(args.case, args.seeds):
         if args.pairs is not None:
             sim.N_PAIRS = args.pairs
