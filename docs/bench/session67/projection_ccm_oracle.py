@@ -33,11 +33,6 @@ def srgb_decode(v: torch.Tensor) -> torch.Tensor:
     return torch.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
 
 
-def srgb_encode(x: torch.Tensor) -> torch.Tensor:
-    x = x.clamp(0, 1)
-    return torch.where(x <= 0.0031308, 12.92 * x, 1.055 * x.clamp(min=1e-12) ** (1 / 2.4) - 0.055)
-
-
 def aces(v):
     return v * (2.51 * v + 0.03) / (v * (2.43 * v + 0.59) + 0.14)
 
@@ -50,10 +45,6 @@ def filmic_decode(v: torch.Tensor) -> torch.Tensor:
     a = (srgb_decode(v) * ACES_4).clamp(max=ACES_4 * 0.9999)
     qa, qb, qc = 2.51 - 2.43 * a, 0.03 - 0.59 * a, -0.14 * a
     return ((-qb + torch.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa)) / 4
-
-
-def filmic_encode(x: torch.Tensor) -> torch.Tensor:
-    return srgb_encode(aces(4 * x.clamp(0, 1)) / ACES_4)
 
 
 def regions(pair) -> dict[str, np.ndarray]:
@@ -88,6 +79,11 @@ def main() -> None:
     print(
         f"{case} {seed}: camera tone {camera.tone}, colour correction {None if truth is None else truth.round(3).tolist()}"
     )
+    import camsim
+
+    def filmic_encode(x: torch.Tensor) -> torch.Tensor:
+        return torch.from_numpy(camsim.tone_curve(x.numpy(), camera))
+
     exact = lambda effects, params: (filmic_decode, filmic_encode)  # noqa: E731
     projection.tone_curve = frames.tone_curve = exact
     specs = projection.projection_specs
