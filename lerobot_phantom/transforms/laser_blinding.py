@@ -25,7 +25,9 @@ position are random; the pattern is fixed per instance.
 
 ``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of
 blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"`` (what it
-was calibrated with).
+was calibrated with). With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``,
+``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
+(``frame_exposure`` in the calibration).
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
@@ -93,16 +95,19 @@ class LaserPhysics:
     glare_scale_ref_px: float = 8.0
     auto_exposure: float = 0.0
     gamma: float | None = None
+    # deviation of the log of each sample's laser power factor (the frames' exposures; module docstring)
+    exposure_spread: float = 0.0
 
     def __post_init__(self) -> None:
         if (
             self.gain < 0
             or self.glare_amplitude < 0
             or self.auto_exposure < 0
+            or self.exposure_spread < 0
             or self.glare_scale_ref_px <= 0
         ):
             raise ValueError(
-                "gain, glare_amplitude and auto_exposure must be >= 0 and glare_scale_ref_px > 0"
+                "gain, glare_amplitude, auto_exposure and exposure_spread must be >= 0 and glare_scale_ref_px > 0"
             )
 
 
@@ -283,7 +288,16 @@ class LaserBlinding(CameraAttack):
             position = (low + (high - low) * u).to(device)
         else:
             position = torch.tensor(self._fixed_position, dtype=torch.float32, device=device).expand(batch, 2)
-        return {"alpha": interpolate_levels(s, self.levels), "position": position.clone()}
+        params = {"alpha": interpolate_levels(s, self.levels), "position": position.clone()}
+        if self.model == "physical" and self.physics.exposure_spread > 0:
+            if generator is None:
+                raise ValueError(
+                    "exposure_spread > 0 draws each sample's exposure and needs a torch.Generator (pass "
+                    "generator= or seed=)"
+                )
+            z = torch.randn(batch, generator=generator, device=generator.device)
+            params["exposure"] = torch.exp(self.physics.exposure_spread * z).to(device)
+        return params
 
     # -- pattern ---------------------------------------------------------------------------------------------------
     def _resized_user_pattern(self, height: int, width: int, device: torch.device) -> torch.Tensor:
@@ -434,7 +448,7 @@ class LaserBlinding(CameraAttack):
         return physics.laser_injection(
             x,
             pattern,
-            params["intensity"].to(x.device) * p.gain,
+            params["intensity"].to(x.device) * p.gain * params.get("exposure", torch.ones(())).to(x.device),
             centre=pixels.flip(1).to(x.dtype),
             color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
             halo_amplitude=p.glare_amplitude,

@@ -117,11 +117,17 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
         "auto_exposure": rng.uniform(0.7, 1.5),  # power of the meter's exposure (1: a uniform meter)
     }
     glare = "halo_power_law" in effects
-    if glare:
+    # frames' own exposures are rendered with the beam-profile capture too: with the plain case's capture, whose
+    # clipped core lights the frames flat, the core's width sits at its bound and linear light is never named
+    attenuated = glare or "frame_exposure" in effects
+    if attenuated:
         # the glare is the laser's light, so the capture records it too; a beam profile is captured through an
         # attenuator (tens of times weaker than the attack), where the glare far from the spot sinks below the
         # capture's 8-bit floor while the frames show it. Drawn apart, so the other draws stay as they were
         truth["gain"] *= np.random.default_rng([seed, 1]).uniform(20.0, 60.0)
+    # frame_exposure: each frame's laser light times exp(spread z), drawn apart so the other draws stay as they were
+    exposure_rng = np.random.default_rng([seed, 2])
+    truth["exposure_spread"] = exposure_rng.uniform(0.3, 0.6)
     rows = []
     for i, (height, width) in enumerate(sizes(rng, n_pairs)):
         clean = scene(rng, height, width)
@@ -133,14 +139,21 @@ def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: i
             laser = laser + halo[..., None] * colour / truth["gain"]
         pattern = srgb_encode(laser)
         s = rng.uniform(0.3, 1.0)
+        frame_log_exposure = truth["exposure_spread"] * exposure_rng.standard_normal()
+        s_light = s * np.exp(frame_log_exposure) if "frame_exposure" in effects else s
+        truth.setdefault("frame_log_exposure", []).append(
+            frame_log_exposure if "frame_exposure" in effects else 0.0
+        )
         linear = "linear_light_saturation" in effects
         decode = srgb_decode if linear else (lambda v: v)
         encode = srgb_encode if linear else (lambda v: np.clip(v, 0, 1))
         x, p = decode(clean), decode(pattern)
-        if glare:  # the attack's power lights the frames with the whole glare, not only what the capture kept
-            light, weight = s * truth["gain"] * laser, 1.0
+        if (
+            attenuated
+        ):  # the attack's power lights the frames with the whole beam and glare, not the capture's
+            light, weight = s_light * truth["gain"] * laser, 1.0
         elif linear:
-            light, weight = s * truth["gain"] * p, 1.0
+            light, weight = s_light * truth["gain"] * p, 1.0
         else:
             light, weight = truth["alpha"] * s * p, 1.0 - truth["alpha"] * s
         total = weight * x + light

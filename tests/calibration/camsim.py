@@ -360,7 +360,8 @@ def laser_blinding_pairs(
     """Laser blinding frame pairs and the laser pattern recorded without a scene.
 
     Physical (``digital_alpha=None``): attacked irradiance = scene + power * spot; the sensor saturates and, when the
-    camera has auto-exposure, the metered exposure drops as the laser gets brighter. The pattern is one capture of
+    camera has auto-exposure, the metered exposure drops as the laser gets brighter (and every clean scene is metered
+    for itself, so the laser's light stands in another ratio to each clean frame). The pattern is one capture of
     the laser alone (dark room, the first clean scene's exposure, kept for the session unless the camera has
     auto-exposure) at a reference power: the peak power of the pairs without a glare tail; with one, the power at
     which the capture's core fills 50-90% of the full well, as a beam-profile measurement is exposed (a

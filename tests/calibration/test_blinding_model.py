@@ -5,16 +5,21 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 import pytest
 import torch
 
+from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_blinding import (
+    EXPOSURE_NODES,
     GLARE_INNER_SCALE_REF_PX,
     GLARE_REFERENCE_PX,
+    MIN_METER_REACTION,
     BlindingFrames,
     dark_level,
     dark_level_radius,
+    exposure_nodes,
     halo_amplitude,
     laser_gain,
 )
@@ -38,6 +43,8 @@ def test_glare_and_tone_shoulder_build_on_linear_light():
     assert requires["halo_power_law"] == ("linear_light_saturation",)
     assert requires["tone_shoulder"] == ("linear_light_saturation",)
     assert requires["linear_light_saturation"] == ()
+    # frames' own exposures are an auto-exposing camera's
+    assert requires["frame_exposure"] == ("linear_light_saturation", "auto_exposure")
     # two tone curves, not a curve and its refinement: never in one model
     excludes = {e.name: e.excludes for e in BlindingFrames.candidates}
     assert excludes["tone_shoulder"] == ("sensor_gamma",)
@@ -177,3 +184,70 @@ def test_the_dark_level_holds_the_glare_at_its_own_distance(centre, exponent):
     # outer half's median distance
     outer_half = radius.reshape(-1)[radius.reshape(-1) >= radius.median()]
     assert read < 0.8 * float(physics.power_law_halo(outer_half.median(), 0.3, exponent, 2.0))
+
+
+def kit_blinding(tmp_path, effects: set[str], seed: int) -> tuple[BlindingFrames, dict]:
+    import calibration_testkit as kit
+
+    from lerobot_phantom.calibration.cli import CalibrateConfig
+    from lerobot_phantom.calibration.frame_models.common import load_pairs
+
+    truth = kit.render_laser_blinding(tmp_path, effects, seed)
+    return BlindingFrames(load_pairs(tmp_path, max_side=CalibrateConfig().max_side), seed), truth
+
+
+def test_exposure_nodes_are_the_normal_quantiles_of_the_spread():
+    assert torch.equal(exposure_nodes(0.0), torch.ones(EXPOSURE_NODES, dtype=torch.float64))
+    logs = torch.log(exposure_nodes(0.4))
+    assert len(logs) == EXPOSURE_NODES and bool((logs[1:] > logs[:-1]).all())
+    assert float(logs.sum()) == pytest.approx(0.0, abs=1e-12)  # symmetric about the median gain
+    # equally likely quantiles of N(0, 0.4^2): their spread is the deviation, less the share beyond the outer ones
+    assert 0.85 * 0.4 < float(logs.std(correction=0)) < 0.4
+
+
+def test_each_fit_frames_exposure_is_registered_and_its_spread_estimated(tmp_path):
+    """Frames whose laser light is the gain times exp(u), u drawn per frame: the fit registers every frame's u
+    (centred: the gain is their geometric mean) and reports their deviation as the spread."""
+    frames, truth = kit_blinding(tmp_path, {"linear_light_saturation", "frame_exposure"}, seed=3)
+    items = np.arange(frames.n_items)
+    fit = frames.fit(frozenset({"linear_light_saturation", "frame_exposure"}), items)
+    drawn = np.array(truth["frame_log_exposure"])
+    assert np.abs(np.array(fit.extra["frame_log_exposure"]) - (drawn - drawn.mean())).max() < 0.05
+    assert fit.params["exposure_spread"] == pytest.approx(drawn.std(ddof=1), abs=0.03)
+    # the gain is the drawn frames' geometric mean, not the median of the law they were drawn from
+    assert float(laser_gain(fit.params)) == pytest.approx(truth["gain"] * np.exp(drawn.mean()), rel=0.05)
+    # a held-out frame is scored over the nodes of that spread, never with its own u: its registered error (the
+    # best node) is the least, and the predictive (marginal) one lies between it and the expected one
+    registered, _ = frames.registered_squared_errors(fit, items[:3])
+    predictive, _ = frames.item_squared_errors(fit, items[:3])
+    expected, _ = frames.expected_squared_errors(fit, items[:3])
+    assert (registered <= predictive + 1e-9).all() and (predictive <= expected + 1e-9).all()
+    # with one gain for every frame the same frames fit far worse
+    one_gain = frames.fit(frozenset({"linear_light_saturation"}), items)
+    assert frames.rmse(one_gain, items) > 2.0 * frames.rmse(fit, items)
+
+
+def test_frames_of_one_exposure_leave_the_spread_near_zero(tmp_path):
+    frames, _ = kit_blinding(tmp_path, {"linear_light_saturation"}, seed=3)
+    items = np.arange(frames.n_items)
+    fit = frames.fit(frozenset({"linear_light_saturation", "frame_exposure"}), items)
+    assert fit.params["exposure_spread"] < 0.03
+    plain = frames.fit(frozenset({"linear_light_saturation"}), items)
+    assert frames.rmse(fit, items) == pytest.approx(frames.rmse(plain, items), rel=0.05)
+
+
+@pytest.mark.parametrize(
+    ("reaction", "named"), [(0.07, False), (MIN_METER_REACTION - 1e-6, False), (1.3, True)]
+)
+def test_frames_exposures_are_named_only_beside_a_meter_that_reacts_to_the_laser(reaction, named):
+    effects = frozenset({"linear_light_saturation", "auto_exposure", "frame_exposure"})
+    fit = Fit(
+        effects,
+        {"log10_gain": 0.0, "core_sigma_ref_px": 20.0, "auto_exposure": reaction, "exposure_spread": 0.2},
+    )
+    reasons = one_pair_problem().identification_checks("frame_exposure", fit, np.arange(1))
+    assert (not reasons) == named
+    if not named:
+        assert f"{reaction:.3f}" in reasons[0] and "misfit" in reasons[0]
+    # the check is frame_exposure's alone
+    assert one_pair_problem().identification_checks("auto_exposure", fit, np.arange(1)) == []

@@ -13,6 +13,7 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+from lerobot_phantom.calibration.core import seeded_split
 from lerobot_phantom.calibration.structure import MIN_TESTED_ITEMS
 from lerobot_phantom.transforms.registry import make_attack
 
@@ -20,6 +21,10 @@ SAMPLED = [pytest.mark.slow, pytest.mark.sampled]  # 60-145 s each on 2 cores (s
 CASES = [
     pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SAMPLED),
     pytest.param("laser_blinding", {"auto_exposure"}, 12, marks=SAMPLED),
+    # a metering camera that exposes every frame for itself, the beam captured through an attenuator
+    pytest.param(
+        "laser_blinding", {"linear_light_saturation", "auto_exposure", "frame_exposure"}, 13, marks=SAMPLED
+    ),
     # an expected failure until session 37 (additive_light not named next to channel_crosstalk); it passed in every
     # recorded suite run from session 30 on (docs/bench/session3*/suite_*.log)
     pytest.param("light_projection", {"additive_light", "channel_crosstalk"}, 21, marks=SAMPLED),
@@ -49,6 +54,11 @@ def test_planted_effects_are_found(tmp_path, attack, planted, seed):
     assert planted <= named, f"planted {planted}, named {named}"
     if "auto_exposure" in planted:  # the kit renders the library's own meter: its power is recovered
         assert report["extended"]["params"]["auto_exposure"] == pytest.approx(truth["auto_exposure"], rel=0.1)
+    if "frame_exposure" in planted:
+        # the deviation of the fit frames' registered exposures, against that of their draws
+        fit_items, _ = seeded_split(len(truth["frame_log_exposure"]), 0.2, seed)
+        drawn = torch.tensor(truth["frame_log_exposure"], dtype=torch.float64)[fit_items]
+        assert report["extended"]["params"]["exposure_spread"] == pytest.approx(float(drawn.std()), rel=0.25)
     if attack == "laser_color_strip" and "sensor_gamma" in planted:
         assert report["extended"]["params"]["gamma"] == pytest.approx(truth["gamma"], rel=0.1)
     assert len(named - planted) <= 1, f"unplanted effects added: {named - planted}"

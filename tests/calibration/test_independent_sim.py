@@ -110,7 +110,9 @@ CASES = [
         "laser_blinding",
         "effect",
         lambda rng, cam: cs.laser_blinding_pairs(rng, cam, N_PAIRS),
-        planted=frozenset({"linear_light_saturation", "auto_exposure"}),
+        # the camera meters every clean scene too, while the laser was captured once: against each clean frame the
+        # laser's light differs by that frame's exposure (1.6-3.6x over a case's scenes, docs/bench/session68.md)
+        planted=frozenset({"linear_light_saturation", "auto_exposure", "frame_exposure"}),
         tolerated=LINEAR_LIGHT,
         camera={"auto_exposure": True},
     ),

@@ -284,3 +284,27 @@ def test_resize_pattern_is_pil_lanczos():
     assert np.array_equal(_hwc(torch.round(as_float * 255).to(torch.uint8)), expected)
     smooth = torch.rand(3, 9, 13, generator=torch.Generator().manual_seed(1))  # off the 8-bit grid
     assert resize_pattern(smooth, 20, 31).shape == (3, 20, 31)
+
+
+def test_exposure_spread_scales_each_samples_laser_power_by_a_lognormal_factor():
+    attack = LaserBlinding("medium", model="physical", gain=0.5, exposure_spread=0.4)
+    logs = torch.log(
+        attack.sample_params(4000, 16, 16, generator=torch.Generator().manual_seed(0))["exposure"]
+    )
+    assert float(logs.std()) == pytest.approx(0.4, rel=0.05) and abs(float(logs.mean())) < 0.03
+    # without a spread nothing is drawn: every other draw stays as it was
+    plain = LaserBlinding("medium", model="physical", gain=0.5)
+    assert "exposure" not in plain.sample_params(2, 16, 16, generator=torch.Generator().manual_seed(0))
+    # the factor multiplies the laser's power: each sample is the plain model at that sample's gain
+    img = torch.rand(2, 3, 16, 16, generator=torch.Generator().manual_seed(2))
+    params = attack.sample_params(2, 16, 16, generator=torch.Generator().manual_seed(1))
+    out = attack.apply_params(img, params)
+    assert not torch.allclose(params["exposure"][0], params["exposure"][1])
+    for b in range(2):
+        one = {k: v[b : b + 1] for k, v in params.items() if k != "exposure"}
+        at_gain = LaserBlinding("medium", model="physical", gain=0.5 * float(params["exposure"][b]))
+        assert torch.allclose(out[b : b + 1], at_gain.apply_params(img[b : b + 1], one), atol=1e-6)
+    with pytest.raises(ValueError, match="Generator"):
+        attack.sample_params(2, 16, 16)
+    with pytest.raises(ValueError, match="exposure_spread"):
+        LaserPhysics(exposure_spread=-0.1)

@@ -380,6 +380,19 @@ class PixelProblem(FrameProblem):
     ) -> Fit:
         """The model ``effects`` fitted on ``pixels`` of ``items`` (one index tensor per item, in ``items``'
         order); ``fit`` passes each item's seeded sample."""
+        stacked, target = self.stacked_pixels(items, pixels)
+        params = fit_least_squares(
+            self.param_specs(effects),
+            lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
+            warm=self.warm(start, effects),
+            starts=further_starts(start, effects),
+        )
+        return Fit(effects, params)
+
+    def stacked_pixels(
+        self, items: np.ndarray, pixels: list[torch.Tensor]
+    ) -> tuple[dict[str, torch.Tensor], torch.Tensor]:
+        """(features of ``pixels`` of ``items`` stacked in ``items``' order, the attacked values there (n, 3))."""
         feats = [self.features(int(i), rows) for i, rows in zip(items, pixels, strict=True)]
         stacked = {k: torch.cat([f[k] for f in feats]) for k in feats[0]}
         target = torch.cat(
@@ -388,13 +401,7 @@ class PixelProblem(FrameProblem):
                 for i, rows in zip(items, pixels, strict=True)
             ]
         )
-        params = fit_least_squares(
-            self.param_specs(effects),
-            lambda p: (self.predict_features(effects, p, stacked) - target).ravel(),
-            warm=self.warm(start, effects),
-            starts=further_starts(start, effects),
-        )
-        return Fit(effects, params)
+        return stacked, target
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return None if start is None else start.params

@@ -39,6 +39,21 @@ the curve can stretch the light's scale freely, so the laser's gain is no longer
 1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
 ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
 average, as centre-weighted meters do when the spot is central).
+
+``frame_exposure`` is the light's ratio to the scene changing from frame to frame. An auto-exposing camera exposes
+each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
+power then adds more light, against the clean frame's scale, to a frame exposed longer, by the clean frame's
+exposure over the capture's, which no pair records (on the independent simulator's auto-exposure case that ratio
+spans 1.6-3.6x over eight scenes, and with it known the planted model's error falls from 10.1-11.5 to 5.8-6.3 grey
+levels: docs/bench/session68.md). It is a per-frame latent, the laser's gain times ``exp(u)``, ``u`` normal with
+standard deviation ``exposure_spread``: fits register ``u`` on each fit frame (they are fit data; the gain is their
+geometric mean and the spread their sample deviation), and held-out frames are scored with ``u`` marginalised over
+``EXPOSURE_NODES`` equally likely quantiles of that normal (``LatentFrameProblem``), never fitted on the frame.
+Registered per frame, ``u`` would also absorb any misfit that differs between frames, so it is the auto-exposure's
+(it requires ``auto_exposure``) and named only beside a meter that reacts to the laser as a camera re-exposing every
+scene does (``identification_checks``): on the simulator's glare case, a fixed exposure, a meter reacting with a
+power of 0.07-0.09 was named with frames' exposures spread by 0.10-0.18, where its auto-exposure case gives
+1.27-1.67 and 0.41-0.63 (docs/bench/session68.md).
 """
 
 from __future__ import annotations
@@ -50,8 +65,15 @@ import numpy as np
 import torch
 from scipy import ndimage, stats
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param
-from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, Pair, PixelProblem, flat_pixels
+from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, fit_least_squares, further_starts
+from lerobot_phantom.calibration.frame_models.common import (
+    SENSOR_GAMMA,
+    FrameProblem,
+    LatentFrameProblem,
+    Pair,
+    PixelProblem,
+    flat_pixels,
+)
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     decode_encode,
@@ -92,11 +114,37 @@ BLINDING_EFFECTS = (
         # scale and the laser's gain runs to its bound (camsim halo case, docs/bench/camsim_session16.md)
         excludes=("sensor_gamma",),
     ),
+    Effect(
+        "frame_exposure",
+        "the laser's light stands in another ratio to the scene in every frame, by a factor the pair does not "
+        "record: an auto-exposing camera exposed each clean frame for its own scene (a dark scene longer), so one "
+        "laser power adds more light to some frames than to others",
+        requires=("linear_light_saturation", "auto_exposure"),
+    ),
 )
 
 
 # the laser gain's top: a spot of ten thousand full wells over a beam-profile capture's unsaturated core
 MAX_LOG10_GAIN = 4.0
+# frame_exposure: the latent's quantiles a held-out frame is marginalised over (its gain's steps at a spread of 0.4
+# are 5-10% near the median), the largest spread searched (a factor of e^3 between frames two deviations apart,
+# beyond any scene's range of exposures), and a fit frame's largest registered departure from the median
+EXPOSURE_NODES = 12
+MAX_EXPOSURE_SPREAD = 1.5
+MAX_FRAME_LOG_EXPOSURE = 3.0
+# pixels of each frame the exposure meter reads
+METER_PROBES = 1024
+# the least power of the meter's exposure factor (``auto_exposure``) beside which frames' own exposures are named: a
+# camera that re-exposes every scene meters the laser's light as a scene's (1 for a uniform meter, more for a
+# centre-weighted one and a spot near the centre; half of it for a spot far out in a strongly centre-weighted one)
+MIN_METER_REACTION = 0.5
+
+
+def exposure_nodes(spread: float) -> torch.Tensor:
+    """The ``EXPOSURE_NODES`` multipliers of the laser's gain a held-out frame is marginalised over, equally likely:
+    ``exp(spread z)`` at the standard normal's quantile midpoints."""
+    shares = (np.arange(EXPOSURE_NODES) + 0.5) / EXPOSURE_NODES
+    return torch.from_numpy(np.exp(spread * stats.norm.ppf(shares)))
 
 
 def laser_gain(params: dict):
@@ -297,7 +345,10 @@ def halo_amplitude(params: dict):
     )
 
 
-class BlindingFrames(PixelProblem):
+class BlindingFrames(LatentFrameProblem, PixelProblem):
+    """Pixel-wise blinding models; with ``frame_exposure``, a latent problem (module docstring): the methods below
+    score and predict through ``LatentFrameProblem`` for those fits and as a plain ``PixelProblem`` for the rest."""
+
     attack = "laser_blinding"
     base_model = "alpha blend of the scene and the laser pattern (the paper's laser blinding)"
     extended_model = "physical laser injection"
@@ -306,6 +357,8 @@ class BlindingFrames(PixelProblem):
     # alone it fits no better than the blend, and only the three together do (camsim: 23.7 -> 12.5 grey levels,
     # docs/bench/camsim_session16.md)
     joint_effects = 3
+    latent = "each frame's exposure over the laser capture's, in models with frame_exposure (none otherwise)"
+    heldout_definition = f"{Problem.heldout_definition}; in models with frame_exposure, {LatentFrameProblem.heldout_definition}"
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
         if any(p.pattern is None for p in pairs):
@@ -330,7 +383,9 @@ class BlindingFrames(PixelProblem):
         ]
         # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
         probe_rng = np.random.default_rng(seed + 7)
-        self.probes = [torch.as_tensor(np.sort(probe_rng.choice(p.height * p.width, 1024))) for p in pairs]
+        self.probes = [
+            torch.as_tensor(np.sort(probe_rng.choice(p.height * p.width, METER_PROBES))) for p in pairs
+        ]
         self.colours = []
         for p in pairs:
             lin = physics.srgb_to_linear(p.pattern).reshape(3, -1)
@@ -376,6 +431,8 @@ class BlindingFrames(PixelProblem):
             "strength": torch.full((n, 1), pair.intensity, dtype=torch.float64),
             "pair": torch.full((n,), index, dtype=torch.long),
             "colour": self.colours[index].reshape(1, 3).expand(n, 3),
+            # the laser gain's factor in this frame (frame_exposure's latent; 1 elsewhere)
+            "exposure": torch.ones((n, 1), dtype=torch.float64),
         }
 
     def param_specs(self, effects):
@@ -411,13 +468,18 @@ class BlindingFrames(PixelProblem):
             specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
         if "tone_shoulder" in effects:
             specs += list(SHOULDER_PARAMS)
+        if "frame_exposure" in effects:
+            # not searched: the sample deviation of the fit frames' registered latents (fit_frame_exposure)
+            specs.append(Param("exposure_spread", 0.3, 0.0, MAX_EXPOSURE_SPREAD, scale=0.3))
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
         # the tone curve has no null here: the base composes encoded values, the linear model sRGB
-        return {"halo_power_law": {"halo_level": 0.0}, "auto_exposure": {"auto_exposure": 0.0}}.get(
-            effect, {}
-        )
+        return {
+            "halo_power_law": {"halo_level": 0.0},
+            "auto_exposure": {"auto_exposure": 0.0},
+            "frame_exposure": {"exposure_spread": 0.0},
+        }.get(effect, {})
 
     @staticmethod
     def tone(effects, params):
@@ -446,7 +508,7 @@ class BlindingFrames(PixelProblem):
                 f["core_radius"],
                 params,
             )
-            light, scene_weight = s * laser_gain(params) * laser, 1.0
+            light, scene_weight = s * f["exposure"] * laser_gain(params) * laser, 1.0
         else:
             opacity = (params["alpha"] * s).clamp(0.0, 1.0)
             light, scene_weight = opacity * decode(f["pattern"]), 1.0 - opacity
@@ -463,16 +525,17 @@ class BlindingFrames(PixelProblem):
             halo = physics.power_law_halo(
                 glare_at, halo_amplitude(params), params["halo_exponent"], GLARE_INNER_SCALE_REF_PX
             )
-            glare = s * halo * f["colour"]
+            glare = s * f["exposure"] * halo * f["colour"]
             light = torch.where(unmeasured, torch.maximum(light, glare), light + glare)
         return scene_weight * scene + light
 
-    def exposure_factor(self, effects, params, decode) -> torch.Tensor:
-        """Per pair: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
-        steps on the concave, piecewise-linear meter reading; differentiable through the iterations)."""
-        f = self.probe_features
-        n = len(self.pairs)
-        total = self.compose(effects, params, f, decode).mean(1).reshape(n, -1)
+    def exposure_factor(self, effects, params, decode, probes: dict | None = None) -> torch.Tensor:
+        """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
+        steps on the concave, piecewise-linear meter reading; differentiable through the iterations). ``probes``:
+        the meter's pixels, ``METER_PROBES`` per frame in frame order (default: every pair's, in pair order)."""
+        f = self.probe_features if probes is None else probes
+        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
+        n = len(total)
         target = decode(f["scene"]).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
         k = torch.ones(n, dtype=total.dtype)
         for _ in range(12):
@@ -482,12 +545,134 @@ class BlindingFrames(PixelProblem):
             k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
         return k ** params["auto_exposure"]
 
-    def predict_features(self, effects, params, f):
+    def predict_features(self, effects, params, f, probes: dict | None = None):
+        """Encoded prediction at the features ``f``; ``f["pair"]`` indexes the frames of ``probes`` (the meter's
+        pixels, :meth:`exposure_factor`)."""
         decode, encode = self.tone_curve(effects, params)
         total = self.compose(effects, params, f, decode)
         if "auto_exposure" in effects:
-            total = total * self.exposure_factor(effects, params, decode)[f["pair"]].unsqueeze(1)
+            total = total * self.exposure_factor(effects, params, decode, probes)[f["pair"]].unsqueeze(1)
         return encode(total.clamp(0.0, 1.0))
+
+    def probe_slots(self, indices: list[int]) -> dict[str, torch.Tensor]:
+        """The meter's pixels of the pairs ``indices`` (repeats kept), as frames 0..len-1 of one probe set."""
+        rows = torch.cat([torch.arange(i * METER_PROBES, (i + 1) * METER_PROBES) for i in indices])
+        probes = {k: v[rows] for k, v in self.probe_features.items()}
+        probes["pair"] = torch.arange(len(indices)).repeat_interleave(METER_PROBES)
+        return probes
+
+    def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
+        if "frame_exposure" in effects:
+            return self.fit_frame_exposure(effects, items, start)
+        return PixelProblem.fit(self, effects, items, start)
+
+    def fit_frame_exposure(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
+        """Least squares on the fit frames' pixel samples with each frame's latent ``u`` registered (the first
+        frame's held at 0: the gain is free), then the gain moved to their geometric mean and ``exposure_spread``
+        set to their sample deviation (module docstring). A resample's repeated frame is registered once per copy."""
+        stacked, target = self.stacked_pixels(items, [self.samples[int(i)] for i in items])
+        slots = torch.cat(
+            [torch.full((len(self.samples[int(i)]),), k, dtype=torch.long) for k, i in enumerate(items)]
+        )
+        stacked["pair"] = slots
+        probes = self.probe_slots([int(i) for i in items])
+        names = [f"frame_log_exposure_{k}" for k in range(1, len(items))]
+        specs = [s for s in self.param_specs(effects) if s.name != "exposure_spread"] + [
+            Param(name, 0.0, -MAX_FRAME_LOG_EXPOSURE, MAX_FRAME_LOG_EXPOSURE, scale=0.3) for name in names
+        ]
+
+        def residuals(p):
+            latent = torch.stack([torch.zeros((), dtype=torch.float64)] + [p[name] for name in names])
+            factor = torch.exp(latent).unsqueeze(1)
+            f = {**stacked, "exposure": factor[slots]}
+            meter = {**probes, "exposure": factor[probes["pair"]]}
+            return (self.predict_features(effects, p, f, meter) - target).ravel()
+
+        params = fit_least_squares(
+            specs, residuals, warm=self.warm(start, effects), starts=further_starts(start, effects)
+        )
+        latent = np.array([0.0] + [params.pop(name) for name in names])
+        params["log10_gain"] = float(
+            np.clip(params["log10_gain"] + latent.mean() / np.log(10.0), -3.0, MAX_LOG10_GAIN)
+        )
+        params["exposure_spread"] = (
+            float(min(np.std(latent, ddof=1), MAX_EXPOSURE_SPREAD)) if len(latent) > 1 else 0.0
+        )
+        fit = Fit(effects, params)
+        fit.extra["frame_log_exposure"] = (latent - latent.mean()).tolist()
+        fit.extra["noise_variance"] = self.noise_variance(fit, items)
+        return fit
+
+    def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
+        """Frames' own exposures are the auto-exposure's: named only where the meter reacts to the laser's light
+        with a power of at least ``MIN_METER_REACTION``, as a camera re-exposing every scene does."""
+        if effect != "frame_exposure" or fit.params["auto_exposure"] >= MIN_METER_REACTION:
+            return []
+        return [
+            f"the meter reacts to the laser's light with a power of {fit.params['auto_exposure']:.3f}, under "
+            f"{MIN_METER_REACTION:g}: a camera that exposes every scene for itself meters the laser's light as a "
+            "scene's, so the frames' spread stands for a misfit that differs between frames, not their exposures"
+        ]
+
+    def predict_at_nodes(self, fit: Fit, index: int) -> torch.Tensor:
+        """(EXPOSURE_NODES, 3, H, W): pair ``index`` predicted at each of the latent's nodes."""
+        pair = self.pairs[index]
+        f = self.features(index, None)
+        probes = self.probe_slots([index])
+        out = []
+        with torch.no_grad():
+            for factor in exposure_nodes(fit.params["exposure_spread"]):
+                flat = self.predict_features(
+                    fit.effects,
+                    fit.params,
+                    {
+                        **f,
+                        "pair": torch.zeros_like(f["pair"]),
+                        "exposure": torch.full_like(f["exposure"], factor),
+                    },
+                    {**probes, "exposure": torch.full_like(probes["exposure"], factor)},
+                )
+                out.append(flat.T.reshape(3, pair.height, pair.width))
+        return torch.stack(out)
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        predicted = self.predict_at_nodes(fit, index)
+        sse = ((predicted - self.pairs[index].attacked) ** 2).sum(dim=(1, 2, 3)).numpy()
+        return sse, np.full(len(sse), 1.0 / len(sse))
+
+    def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
+        predicted = self.predict_at_nodes(fit, index)
+        sse = ((predicted - self.pairs[index].attacked) ** 2).sum(dim=(1, 2, 3))
+        return predicted[int(sse.argmin())]
+
+    # fits without frame_exposure have no latent: scored and predicted as any pixel problem
+
+    def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
+        if "frame_exposure" in fit.effects:
+            return LatentFrameProblem.predict_pair(self, fit, index)
+        return PixelProblem.predict_pair(self, fit, index)
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        if "frame_exposure" in fit.effects:
+            return LatentFrameProblem.squared_errors(self, fit, items)
+        return FrameProblem.squared_errors(self, fit, items)
+
+    def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if "frame_exposure" in fit.effects:
+            return LatentFrameProblem.item_squared_errors(self, fit, items)
+        return Problem.item_squared_errors(self, fit, items)
+
+    # without a latent, a frame's registered and expected errors are its predictive error (the report lists all three)
+
+    def registered_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if "frame_exposure" in fit.effects:
+            return LatentFrameProblem.registered_squared_errors(self, fit, items)
+        return Problem.item_squared_errors(self, fit, items)
+
+    def expected_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if "frame_exposure" in fit.effects:
+            return LatentFrameProblem.expected_squared_errors(self, fit, items)
+        return Problem.item_squared_errors(self, fit, items)
 
     def divisor_auto_exposure(self, fit: Fit) -> float:
         """The transform's auto-exposure ``1 / (1 + a * mean injected light)`` (``physics.inject_linear_light``)
@@ -518,6 +703,7 @@ class BlindingFrames(PixelProblem):
             "glare_exponent": p.get("halo_exponent", 2.0),
             "glare_scale_ref_px": GLARE_INNER_SCALE_REF_PX,
             "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
+            "exposure_spread": p["exposure_spread"] if "frame_exposure" in effects else 0.0,
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); the
             # transform knows power laws only, so a fitted shoulder gives it the closest one
             "gamma": equivalent_power_gamma(p)
