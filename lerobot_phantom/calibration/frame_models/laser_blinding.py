@@ -44,16 +44,16 @@ average, as centre-weighted meters do when the spot is central).
 each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
 power then adds more light, against the clean frame's scale, to a frame exposed longer, by the clean frame's
 exposure over the capture's, which no pair records (on the independent simulator's auto-exposure case that ratio
-spans 1.6-3.6x over eight scenes, and with it known the planted model's error falls from 10.1-11.5 to 5.8-6.3 grey
-levels: docs/bench/session68.md). It is a per-frame latent, the laser's gain times ``exp(u)``, ``u`` normal with
+spans 1.6-3.6x over a draw's eight scenes, docs/bench/session68/exposures.txt; with it known, the planted model's
+error falls from 10.1-11.5 to 5.8-6.3 grey levels, docs/bench/session68/exposure_oracle.txt). It is a per-frame latent, the laser's gain times ``exp(u)``, ``u`` normal with
 standard deviation ``exposure_spread``: fits register ``u`` on each fit frame (they are fit data; the gain is their
 geometric mean and the spread their sample deviation), and held-out frames are scored with ``u`` marginalised over
 ``EXPOSURE_NODES`` equally likely quantiles of that normal (``LatentFrameProblem``), never fitted on the frame.
 Registered per frame, ``u`` would also absorb any misfit that differs between frames, so it is the auto-exposure's
 (it requires ``auto_exposure``) and named only beside a meter that reacts to the laser as a camera re-exposing every
-scene does (``identification_checks``): on the simulator's glare case, a fixed exposure, a meter reacting with a
-power of 0.07-0.09 was named with frames' exposures spread by 0.10-0.18, where its auto-exposure case gives
-1.27-1.67 and 0.41-0.63 (docs/bench/session68.md).
+scene does (``identification_checks``). Fitted on the fit pairs of the independent simulator's glare case (a fixed
+exposure), a model with both finds a meter power of 0.015-0.086 and a spread of 0.03-0.18 on four draws, against
+1.27-1.80 and 0.41-0.63 on five draws of its auto-exposure case (docs/bench/session68/meter_and_spread_*.txt).
 """
 
 from __future__ import annotations
