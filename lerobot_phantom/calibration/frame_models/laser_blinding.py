@@ -635,14 +635,17 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
                 out.append(flat.T.reshape(3, pair.height, pair.width))
         return torch.stack(out)
 
-    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+    def node_errors(self, fit: Fit, index: int) -> tuple[torch.Tensor, np.ndarray]:
+        """(pair ``index`` predicted at each node, each prediction's SSE in [0, 1] units)."""
         predicted = self.predict_at_nodes(fit, index)
-        sse = ((predicted - self.pairs[index].attacked) ** 2).sum(dim=(1, 2, 3)).numpy()
+        return predicted, ((predicted - self.pairs[index].attacked) ** 2).sum(dim=(1, 2, 3)).numpy()
+
+    def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
+        _, sse = self.node_errors(fit, index)
         return sse, np.full(len(sse), 1.0 / len(sse))
 
     def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
-        predicted = self.predict_at_nodes(fit, index)
-        sse = ((predicted - self.pairs[index].attacked) ** 2).sum(dim=(1, 2, 3))
+        predicted, sse = self.node_errors(fit, index)
         return predicted[int(sse.argmin())]
 
     # fits without frame_exposure have no latent: scored and predicted as any pixel problem
