@@ -23,6 +23,7 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from camsim_case_cameras import case_draws
+from session67.projection_ccm_oracle import ACES_4, aces, filmic_decode
 
 from lerobot_phantom.calibration.core import Param
 from lerobot_phantom.calibration.frame_models.common import load_pairs
@@ -36,32 +37,9 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
 from lerobot_phantom.transforms import physics
 
 
-def srgb_decode(v: torch.Tensor) -> torch.Tensor:
-    v = v.clamp(0, 1)
-    return torch.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
-
-
-def srgb_encode(x: torch.Tensor) -> torch.Tensor:
-    x = x.clamp(0, 1)
-    return torch.where(x <= 0.0031308, 12.92 * x, 1.055 * x.clamp(min=1e-12) ** (1 / 2.4) - 0.055)
-
-
-def aces(v):
-    return v * (2.51 * v + 0.03) / (v * (2.43 * v + 0.59) + 0.14)
-
-
-ACES_4 = float(aces(torch.tensor(4.0, dtype=torch.float64)))
-
-
-def filmic_decode(v: torch.Tensor) -> torch.Tensor:
-    """camsim's filmic curve (ACES on a 4x pre-gain, normalised, then sRGB) inverted: a quadratic in the pre-gain."""
-    a = (srgb_decode(v) * ACES_4).clamp(max=ACES_4 * 0.9999)
-    qa, qb, qc = 2.51 - 2.43 * a, 0.03 - 0.59 * a, -0.14 * a
-    return ((-qb + torch.sqrt(qb * qb - 4 * qa * qc)) / (2 * qa)) / 4
-
-
 def filmic_encode(x: torch.Tensor) -> torch.Tensor:
-    return srgb_encode(aces(4 * x.clamp(0, 1)) / ACES_4)
+    """camsim's filmic curve in torch (the fits differentiate through it; ``camsim.tone_curve`` is numpy)."""
+    return physics.linear_to_srgb(aces(4 * x.clamp(0, 1)) / ACES_4)
 
 
 def oracle_class(camera, composed_in: str, laser_colour=None):
@@ -70,7 +48,7 @@ def oracle_class(camera, composed_in: str, laser_colour=None):
     if camera.tone == "filmic":
         curve = (filmic_decode, filmic_encode)
     elif camera.tone == "srgb":
-        curve = (srgb_decode, srgb_encode)
+        curve = (physics.srgb_to_linear, physics.linear_to_srgb)
     else:
         raise SystemExit(f"camera tone {camera.tone}: this oracle knows camsim's filmic and srgb curves")
     matrix = torch.tensor(np.reshape(camera.ccm, (3, 3)), dtype=torch.float64)

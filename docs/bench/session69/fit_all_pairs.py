@@ -2,6 +2,7 @@
 starting from the one before it, and prints each one's RMSE over all pixels and its parameters.
 
 Usage: ``PYTHONPATH=. python docs/bench/session69/fit_all_pairs.py PAIRS_DIR MAX_SIDE EFFECTS[,EFFECT...]...``
+(``colour_correction`` models need a checkout with ``colour_correction_attempt.patch`` applied: main reverted it.)
 """
 
 import sys
