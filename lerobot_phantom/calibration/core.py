@@ -332,6 +332,11 @@ class Problem:
         """Physical quantities derived from the fitted parameters (e.g. a saturation radius)."""
         return {}
 
+    def unoffered(self, fit_items: np.ndarray) -> dict[str, str]:
+        """Candidates the fit items show no sign of, each with the measured reason: selection does not try them
+        (``identify.select_and_identify``) and the report lists them. Read from the fit items only, as selection is."""
+        return {}
+
     def figures(self, base: Fit, extended: Fit, items: np.ndarray, out_dir) -> list[str]:
         return []
 
@@ -580,7 +585,7 @@ def forward_select(
 ) -> tuple[frozenset[str], list[Step]]:
     """Forward selection of extensions by the inner k-fold validation score, each step needing a ``margin`` gain.
     ``withdrawn`` effects are not candidates (identify.select_and_identify: an earlier pass selected them and they
-    were not identified).
+    were not identified, or the fit items show no sign of them, ``Problem.unoffered``).
 
     Only ``fit_items`` are used. Every step keeps each fit item's term of the score, so the effect size of a step
     can be bootstrapped over items (``identify.error_ratio``).

@@ -760,6 +760,7 @@ def select_and_identify(
     auto-exposure (master seed 3986568970), where a power law at its bound 4 beat the meter with linear light by
     0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
+    unoffered = frozenset(problem.unoffered(fit_items))
     while True:
         _selected, steps, form_passes = select_forms(
             problem,
@@ -767,7 +768,7 @@ def select_and_identify(
             seed=seed,
             margin=margin,
             folds=folds,
-            withdrawn=frozenset(w.effect for w in withdrawn),
+            withdrawn=unoffered | frozenset(w.effect for w in withdrawn),
         )
         chain = fit_chain(problem, steps, fit_items)
         selection = identify_selection(

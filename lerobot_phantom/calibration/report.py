@@ -11,9 +11,10 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
-  rejected, withdrawn [{effect, pass, reasons}]: effects an earlier pass selected and identification rejected on
-  their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and ``steps``
-  are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one,
+  rejected, not_offered {effect: reason}: candidates the fit items show no sign of, never tried
+  (``Problem.unoffered``), withdrawn [{effect, pass, reasons}]: effects an earlier pass selected and identification
+  rejected on their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and
+  ``steps`` are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one,
   form_passes [{without, selected, validation_error, first_selected, first_validation_error, taken, other_steps}]
   the last pass repeated without a simpler form of a term it took (core.select_forms; ``other_steps``: the steps
   of the pass not written)};
@@ -139,7 +140,10 @@ def build_report(
             "rmse_reduction": 1.0 - ext_scores["heldout_rmse"] / max(base_scores["heldout_rmse"], 1e-12),
             "selection_margin": margin,
         },
-        "selection": selection_section(problem, selection, steps, withdrawn, margin=margin, folds=folds),
+        "selection": {
+            **selection_section(problem, selection, steps, withdrawn, margin=margin, folds=folds),
+            "not_offered": problem.unoffered(fit_items),
+        },
         "unexplained_structure": residual_structure(
             problem,
             extended,
@@ -492,6 +496,8 @@ def _noise_lines(noise: dict) -> list[str]:
 def _selection_lines(selection: dict) -> list[str]:
     """The criterion, what was withdrawn, and every step with the candidates it tried."""
     lines = ["", "## Selection", "", selection["criterion"] + ".", ""]
+    for effect, reason in selection.get("not_offered", {}).items():
+        lines.append(f"- not offered: `{effect}` ({reason})")
     for withdrawal in selection["withdrawn"]:
         lines.append(
             f"- withdrawn after pass {withdrawal['pass']}: `{withdrawal['effect']}`, not identified ("

@@ -27,7 +27,10 @@ position are random; the pattern is fixed per instance.
 blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"`` (what it
 was calibrated with). With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``,
 ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
-(``frame_exposure`` in the calibration).
+(``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
+1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
+light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well, not
+its light, is taken out of the others (``colour_correction`` in the calibration).
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
@@ -97,6 +100,9 @@ class LaserPhysics:
     gamma: float | None = None
     # deviation of the log of each sample's laser power factor (the frames' exposures; module docstring)
     exposure_spread: float = 0.0
+    # the camera's colour correction matrix (9 numbers, row-major, rows summing to 1) mixing its clipped raw
+    # channels; the laser's pattern and colour are then raw light
+    colour_correction: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         if (
@@ -109,6 +115,16 @@ class LaserPhysics:
             raise ValueError(
                 "gain, glare_amplitude, auto_exposure and exposure_spread must be >= 0 and glare_scale_ref_px > 0"
             )
+        if self.colour_correction is not None:
+            matrix = torch.tensor(self.colour_correction, dtype=torch.float64)
+            if matrix.numel() != 9 or not torch.allclose(
+                matrix.reshape(3, 3).sum(1), torch.ones(3, dtype=torch.float64), atol=1e-6
+            ):
+                raise ValueError(
+                    f"colour_correction {self.colour_correction}; valid: None or 9 numbers, a row-major 3x3 matrix "
+                    "whose rows sum to 1"
+                )
+            object.__setattr__(self, "colour_correction", tuple(float(v) for v in self.colour_correction))
 
 
 def _options(kind: type, given: Any, flat: dict[str, Any]) -> Any:
@@ -456,6 +472,9 @@ class LaserBlinding(CameraAttack):
             halo_scale_px=p.glare_scale_ref_px * max(height, width) / 256.0,
             auto_exposure=p.auto_exposure,
             gamma=p.gamma,
+            colour_correction=None
+            if p.colour_correction is None
+            else torch.tensor(p.colour_correction, dtype=torch.float64).reshape(3, 3),
         )
 
     def extra_repr(self) -> str:

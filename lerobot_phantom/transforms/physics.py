@@ -68,18 +68,31 @@ def inject_linear_light(
     metered_light: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
     gamma: float | torch.Tensor | None = None,
+    colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Add ``light`` (linear irradiance, broadcastable to ``x``) to the scene in linear light, clip, re-encode.
 
     ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean(metered_light))`` (default: the injected
     light), darkening the whole frame; ``white``: linear level at which the sensor saturates; ``gamma``: None =
-    the sRGB tone curve, a number = a power law (1 = compose the encoded values).
+    the sRGB tone curve, a number = a power law (1 = compose the encoded values); ``colour_correction``: a (3, 3)
+    matrix the camera mixes its clipped raw channels with (``light`` is then raw light, the scene is taken to the
+    raw channels by its inverse).
     """
     scene = decode(x, gamma)
+    if colour_correction is not None:
+        scene = mix_channels(torch.linalg.inv(colour_correction.to(torch.float64)), scene)
     metered = light if metered_light is None else metered_light
     mean_light = metered.reshape(metered.shape[0], -1).mean(dim=1).reshape(-1, *([1] * (x.ndim - 1)))
     total = (scene + light) / (1.0 + _as(auto_exposure, scene) * mean_light)
-    return encode(torch.minimum(total.clamp(min=0.0), _as(white, total)), gamma)
+    total = torch.minimum(total.clamp(min=0.0), _as(white, total))
+    if colour_correction is not None:
+        total = mix_channels(colour_correction.to(torch.float64), total).clamp(0.0, 1.0)
+    return encode(total, gamma)
+
+
+def mix_channels(matrix: torch.Tensor, image: torch.Tensor) -> torch.Tensor:
+    """``matrix`` (3, 3) applied to every pixel of a ``(..., 3, H, W)`` image, in the image's dtype."""
+    return torch.einsum("ij,...jhw->...ihw", matrix.to(image.dtype), image)
 
 
 def radial_distance(
@@ -228,11 +241,13 @@ def laser_injection(
     halo_scale_px: float = 1.0,
     auto_exposure: float = 0.0,
     gamma: float | None = None,
+    colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """A laser shone into the camera, physically: the recorded ``pattern`` (encoded, ``(B or 1, 3, H, W)``) is
     linear light scaled by ``power`` (per sample), plus an optional power-law glare around ``centre`` (``(B, 2)``
     pixel (x, y)) in the laser's ``color``; the sum adds to the scene in linear light, the auto-exposure meters
-    the pattern's light, and the sensor clips before the tone curve."""
+    the pattern's light, and the sensor clips before the tone curve (and before ``colour_correction``, a camera's
+    (3, 3) matrix, mixes its raw channels: the pattern and the colour are then raw light)."""
     height, width = x.shape[-2:]
     power = torch.as_tensor(power, dtype=x.dtype, device=x.device).reshape(-1, 1, 1, 1)
     light = power * decode(pattern.to(x.dtype), gamma)
@@ -243,7 +258,14 @@ def laser_injection(
         radius = radial_distance(height, width, centre, dtype=x.dtype, device=x.device)
         glare = power_law_halo(radius, halo_amplitude, halo_exponent, halo_scale_px)
         light = light + power * glare * color.to(x.dtype).reshape(1, 3, 1, 1)
-    return inject_linear_light(x, light, auto_exposure=auto_exposure, metered_light=metered, gamma=gamma)
+    return inject_linear_light(
+        x,
+        light,
+        auto_exposure=auto_exposure,
+        metered_light=metered,
+        gamma=gamma,
+        colour_correction=colour_correction,
+    )
 
 
 # ---------------------------------------------------------------------------------------------------------------

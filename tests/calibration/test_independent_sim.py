@@ -468,11 +468,19 @@ def run_case(name: str, root: str, seed: int | None = None) -> dict:
 
 
 def tolerated(case: Case, camera: cs.Camera) -> frozenset:
-    """The effects a case may name besides its planted ones: the case's own, and the tone curve's shoulder when
-    the camera's curve has one and the case composes light in linear irradiance (the same cases as sensor_gamma)."""
+    """The effects a case may name besides its planted ones: the case's own, the tone curve's shoulder when the
+    camera's curve has one and the case composes light in linear irradiance (the same cases as sensor_gamma), and
+    a colour correction where the camera has one and a laser's light adds in its raw channels."""
+    allowed = case.tolerated
     if camera.tone in SHOULDERED_TONES and "sensor_gamma" in case.tolerated:
-        return case.tolerated | {"tone_shoulder"}
-    return case.tolerated
+        allowed = allowed | {"tone_shoulder"}
+    if (
+        camera.ccm is not None
+        and case.attack == "laser_blinding"
+        and "linear_light_saturation" in case.planted
+    ):
+        allowed = allowed | {"colour_correction"}
+    return allowed
 
 
 def passes(case: Case, report: dict, camera: cs.Camera) -> bool:
@@ -611,6 +619,27 @@ def test_em_truncation_draws_that_failed(name, seed, root):
     attack = make_attack("em_truncation", calibration=str(result["out"]))
     assert attack.ratio_per_intensity == report["extended"]["params"]["ratio_per_intensity"]
     assert attack.free_band_position == ("free_band_position" in case.planted)
+
+
+@pytest.mark.slow
+def test_a_colour_correcting_cameras_blinding_halo_names_the_matrix(monkeypatch, root):
+    # session 69: camsim's halo case on a camera mixing its clipped raw channels (CAMSIM_CCM=1, master seed
+    # 1834494070, session 66's matrix) named linear light alone, the glare missed and 41 grey levels left over all
+    # pairs; the laser's light clips in the raw channels and the matrix takes the clipped channel's excess out of the
+    # others, whose capture stores 0 (docs/bench/session69.md)
+    monkeypatch.setenv("CAMSIM_CCM", "1")
+    case = CASE_BY_NAME["blinding_halo"]
+    result = run_case("blinding_halo", root, seed=1835569645)
+    assert result["camera"].ccm is not None
+    named = named_causes(result["report"])
+    where = replay(case, result)
+    assert case.planted | {"colour_correction"} <= named, where
+    assert len(named - case.planted - tolerated(case, result["camera"])) == 0, where
+    params = result["report"]["extended"]["params"]
+    attack = make_attack("laser_blinding", calibration=str(result["out"]))
+    matrix = np.reshape(attack.physics.colour_correction, (3, 3))
+    assert np.allclose(matrix.sum(1), 1.0)
+    assert np.allclose(-matrix[1, 0], params["ccm_red"]) and np.allclose(-matrix[0, 2], params["ccm_blue"])
 
 
 @pytest.mark.slow

@@ -308,3 +308,22 @@ def test_exposure_spread_scales_each_samples_laser_power_by_a_lognormal_factor()
         attack.sample_params(2, 16, 16)
     with pytest.raises(ValueError, match="exposure_spread"):
         LaserPhysics(exposure_spread=-0.1)
+
+
+def test_colour_correction_is_validated_and_reaches_the_physical_model():
+    matrix = (1.4, -0.2, -0.2, -0.3, 1.5, -0.2, -0.1, -0.3, 1.4)
+    img = torch.rand(2, 3, 16, 16, generator=torch.Generator().manual_seed(4))
+    params = LaserBlinding("strong", model="physical", gain=3.0).sample_params(
+        2, 16, 16, generator=torch.Generator().manual_seed(5)
+    )
+    plain = LaserBlinding("strong", model="physical", gain=3.0).apply_params(img, params)
+    corrected = LaserBlinding("strong", model="physical", gain=3.0, colour_correction=list(matrix))
+    assert corrected.physics.colour_correction == matrix
+    assert not torch.allclose(corrected.apply_params(img, params), plain, atol=1e-3)
+    identity = LaserBlinding(
+        "strong", model="physical", gain=3.0, colour_correction=(1, 0, 0, 0, 1, 0, 0, 0, 1)
+    )
+    assert torch.allclose(identity.apply_params(img, params), plain, atol=1e-5)
+    for bad in ((1.0, 0.0), (1.5, 0, 0, 0, 1, 0, 0, 0, 1)):
+        with pytest.raises(ValueError, match="rows sum to 1"):
+            LaserPhysics(colour_correction=bad)

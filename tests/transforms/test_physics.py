@@ -37,6 +37,28 @@ def test_linear_light_injection_adds_clips_and_auto_exposure_darkens():
     assert (darker[..., 3, 3] < plain[..., 3, 3]).all()  # far from the light, the scene got darker
 
 
+def test_a_colour_correction_mixes_the_raw_channels_after_they_clip():
+    scene = torch.rand(2, 3, 6, 6, generator=torch.Generator().manual_seed(3), dtype=torch.float64) * 0.6
+    matrix = torch.tensor([[1.6, -0.3, -0.3], [-0.2, 1.5, -0.3], [-0.1, -0.4, 1.5]], dtype=torch.float64)
+    # no light: the scene goes to the raw channels and back unchanged; the identity is the model without a matrix
+    unlit = physics.inject_linear_light(scene, torch.zeros_like(scene), colour_correction=matrix)
+    assert torch.allclose(unlit, scene, atol=1e-9)
+    red = torch.zeros_like(scene)
+    red[:, 0] = 3.0
+    plain = physics.inject_linear_light(scene, red)
+    assert torch.allclose(
+        physics.inject_linear_light(scene, red, colour_correction=torch.eye(3, dtype=torch.float64)), plain
+    )
+    # a red overload clips the raw red channel at the full well, and the matrix then takes that full well's share
+    # out of green and blue: they end darker than the scene, which light added to the stored channels never does
+    mixed = physics.inject_linear_light(scene, red, colour_correction=matrix)
+    raw = physics.mix_channels(torch.linalg.inv(matrix), physics.decode(scene, None))
+    expected_green = (-0.2 + 1.5 * raw[:, 1] - 0.3 * raw[:, 2]).clamp(0, 1)
+    assert torch.allclose(physics.decode(mixed, None)[:, 1], expected_green, atol=1e-9)
+    assert (mixed[:, 1:] < scene[:, 1:] + 1e-9).all() and (mixed[:, 1:] < scene[:, 1:] - 0.01).any()
+    assert torch.allclose(plain[:, 1:], scene[:, 1:])
+
+
 def test_laser_injection_adds_pattern_light_and_glare():
     scene = torch.full((2, 3, 16, 16), 0.3)
     pattern = torch.zeros(1, 3, 16, 16)

@@ -54,6 +54,32 @@ Registered per frame, ``u`` would also absorb any misfit that differs between fr
 scene does (``identification_checks``). Fitted on the fit pairs of the independent simulator's glare case (a fixed
 exposure), a model with both finds a meter power of 0.015-0.086 and a spread of 0.03-0.18 on four draws, against
 1.27-1.80 and 0.41-0.63 on five draws of its auto-exposure case (docs/bench/session68/meter_and_spread_*.txt).
+
+``colour_correction`` is a camera's ISP mixing its raw channels with a colour correction matrix after the sensor
+clipped them (consumer cameras' matrices undo the colour filters' overlap: a diagonal above 1, negative
+off-diagonals, rows summing to 1). The laser's light then adds and clips in the raw channels, and the matrix takes
+the clipped channel's full well, not its light, out of the others; its capture stores its faint channels at 0 (the
+matrix pushed them below it), so the laser's raw colour is fitted (``laser_colour_<channel>``, its light there over
+its own channel's) and the beam is read from the laser's channel alone, over that channel's share of the mixed
+colour. The scene goes to the raw channels by the matrix's inverse (a channel it stored at 0 held an amount the frame
+does not record, which this leaves as the inverse reads it). The matrix
+has one parameter per raw channel, ``ccm_<channel>``: that channel's light taken out of each of the other two. With
+its six off-diagonals free, a calibration on the independent simulator's colour-correcting halo case ran one to its
+bound (-1) and withdrew the term; the per-channel form fits all pairs to within 6% of the six (13.13 and 11.94
+against 12.35 and 11.33 grey levels, docs/bench/session69/six_offdiagonals.txt, column_form_*.txt). With the
+camera's true matrix and tone curve, the laser's true colour takes that case from 41.5 and 35.0 to 17.8 and 14.2
+grey levels over all pairs, the capture's colour only to 39.4 and 34.1: the colour is what the capture loses
+(docs/bench/session69/ccm_oracle_*.txt).
+
+That loss is also the matrix's sign, and the term is offered only where the fit pairs' laser captures show it
+(``unoffered``): among the beam's lit pixels that did not clip white (the laser's channel stored at >= 128 of 255, some
+channel under 250), at least ``MIN_MIXED_SHARE`` store a fainter channel at <= 2. A camera storing its raw channels
+keeps a narrowband laser's faint light in proportion there (tens of grey levels); a term fitted without the sign
+absorbs other misfits (named on 3 of 6 physical blinding draws of matrix-free cameras, docs/bench/session69.md). On
+20 master seeds of the independent simulator's five blinding cases the share is 0.000 on all 100 matrix-free draws
+(the faintest channel's median 36-184 grey levels) and above 0.05 on 94 of the same 100 draws with a matrix
+(docs/bench/session70/ccm_signature.txt). A laser with no light at all in the other channels would show it without a
+matrix; selection then still has to take the term.
 """
 
 from __future__ import annotations
@@ -115,6 +141,14 @@ BLINDING_EFFECTS = (
         excludes=("sensor_gamma",),
     ),
     Effect(
+        "colour_correction",
+        "the camera's ISP mixes its raw channels with a colour correction matrix after the sensor clipped them: the "
+        "laser's light adds and clips in the raw channels, the matrix (negative off-diagonals) then takes the "
+        "clipped channel's excess out of the others, and the capture's faint channels, pushed below 0, store none "
+        "of the laser's colour",
+        requires=("linear_light_saturation",),
+    ),
+    Effect(
         "frame_exposure",
         "the laser's light stands in another ratio to the scene in every frame, by a factor the pair does not "
         "record: an auto-exposing camera exposed each clean frame for its own scene (a dark scene longer), so one "
@@ -138,6 +172,33 @@ METER_PROBES = 1024
 # camera that re-exposes every scene meters the laser's light as a scene's (1 for a uniform meter, more for a
 # centre-weighted one and a spot near the centre; half of it for a spot far out in a strongly centre-weighted one)
 MIN_METER_REACTION = 0.5
+# colour_correction's sign in the laser captures (module docstring): the laser channel's least stored level of a lit
+# beam pixel, the level under which no channel clipped white, the most a channel the matrix pushed below 0 stores
+# (JPEG's ringing lifts a few to 1-2), and the least share of lit pixels showing it
+LIT_STORED = 128 / 255
+UNCLIPPED_STORED = 250 / 255
+STORED_AT_ZERO = 2.5 / 255
+MIN_MIXED_SHARE = 0.05
+
+
+CHANNELS = ("red", "green", "blue")
+
+
+def correction_matrix(params: dict) -> torch.Tensor:
+    """(3, 3) colour correction matrix: channel j's raw light taken out of each other channel by ``ccm_<j>``, each
+    row summing to 1 (white stays white)."""
+    take = torch.stack([torch.as_tensor(params[f"ccm_{c}"], dtype=torch.float64) for c in CHANNELS])
+    return torch.diag(take.sum() - take + 1.0) - (1.0 - torch.eye(3, dtype=torch.float64)) * take
+
+
+def faint_channels_at_zero(pattern: torch.Tensor, channel: int) -> tuple[int, int]:
+    """(lit beam pixels, those storing a fainter channel at 0) of a laser capture ``pattern`` (3, H, W) in [0, 1]
+    whose laser light is in ``channel``: lit is the channel at >= ``LIT_STORED`` with some channel under
+    ``UNCLIPPED_STORED``."""
+    lit = (pattern[channel] >= LIT_STORED) & (pattern.amin(0) < UNCLIPPED_STORED)
+    others = [c for c in range(3) if c != channel]
+    at_zero = lit & (pattern[others].amin(0) <= STORED_AT_ZERO)
+    return int(lit.sum()), int(at_zero.sum())
 
 
 def exposure_nodes(spread: float) -> torch.Tensor:
@@ -392,6 +453,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             weight = lin.mean(0)
             colour = (lin * weight).sum(1) / weight.sum().clamp(min=1e-9)
             self.colours.append(colour / colour.max().clamp(min=1e-9))
+        # the channel holding most of the captures' laser light: colour_correction reads the beam from it alone
+        self.laser_channel = int(torch.stack(self.colours).sum(0).argmax())
 
         self.probe_features = {
             k: torch.cat([self.features(i, self.probes[i])[k] for i in range(len(pairs))])
@@ -468,6 +531,33 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
         if "tone_shoulder" in effects:
             specs += list(SHOULDER_PARAMS)
+        if "colour_correction" in effects:
+            specs += [
+                Param(
+                    f"ccm_{c}",
+                    0.1,
+                    0.0,
+                    1.0,
+                    scale=0.1,
+                    low_limit=f"the matrix takes none of the {c} channel's light out of the others",
+                )
+                for c in CHANNELS
+            ]
+            # the laser's raw light in each other channel over its own: the capture stores none of it (the matrix
+            # pushed those channels below 0), so it is fitted; a narrowband laser holds a few to tens of percent
+            specs += [
+                Param(
+                    f"laser_colour_{CHANNELS[c]}",
+                    0.1,
+                    0.0,
+                    1.0,
+                    scale=0.1,
+                    low_limit=f"the laser holds no {CHANNELS[c]} light",
+                    high_limit=f"the {CHANNELS[c]} channel holds as much laser light as the laser's own",
+                )
+                for c in range(3)
+                if c != self.laser_channel
+            ]
         if "frame_exposure" in effects:
             # not searched: the sample deviation of the fit frames' registered latents (fit_frame_exposure)
             specs.append(Param("exposure_spread", 0.3, 0.0, MAX_EXPOSURE_SPREAD, scale=0.3))
@@ -479,6 +569,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "halo_power_law": {"halo_level": 0.0},
             "auto_exposure": {"auto_exposure": 0.0},
             "frame_exposure": {"exposure_spread": 0.0},
+            "colour_correction": {f"ccm_{c}": 0.0 for c in CHANNELS},
         }.get(effect, {})
 
     @staticmethod
@@ -495,9 +586,31 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         shoulder (``calibration/tone.py``, the convention the noise model reads), else a power law or sRGB."""
         return decode_encode(params, "tone_shoulder" in effects, cls.tone(effects, params))
 
+    @staticmethod
+    def scene_light(effects, params, f, decode) -> torch.Tensor:
+        """The clean scene's light in the channels the model composes in: the stored ones, or under
+        ``colour_correction`` the raw ones (the matrix inverted)."""
+        scene = decode(f["scene"])
+        if "colour_correction" in effects:
+            return scene @ torch.linalg.inv(correction_matrix(params)).T
+        return scene
+
+    def raw_laser_colour(self, params) -> torch.Tensor:
+        """(3,) the laser's raw colour under ``colour_correction``: 1 in its own channel, fitted in the others."""
+        return torch.stack(
+            [
+                torch.ones((), dtype=torch.float64)
+                if c == self.laser_channel
+                else torch.as_tensor(params[f"laser_colour_{CHANNELS[c]}"], dtype=torch.float64)
+                for c in range(3)
+            ]
+        )
+
     def compose(self, effects, params, f, decode) -> torch.Tensor:
         """Scene plus laser light (linear in the tone curve ``decode`` inverts), before exposure changes and
-        clipping."""
+        clipping; under ``colour_correction``, in the raw channels (:meth:`compose_raw`)."""
+        if "colour_correction" in effects:
+            return self.compose_raw(effects, params, f, decode)
         scene = decode(f["scene"])
         s = f["strength"]
         if "linear_light_saturation" in effects:
@@ -529,6 +642,33 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             light = torch.where(unmeasured, torch.maximum(light, glare), light + glare)
         return scene_weight * scene + light
 
+    def compose_raw(self, effects, params, f, decode) -> torch.Tensor:
+        """Scene plus laser light in the raw channels a colour correction matrix mixes (module docstring). The
+        capture's laser channel stores the raw beam times that channel's share of the mixed colour; the beam's raw
+        light in every channel is that, over the share, times the laser's fitted raw colour (the glare likewise)."""
+        colour = self.raw_laser_colour(params)
+        channel = slice(self.laser_channel, self.laser_channel + 1)
+        stored_share = (correction_matrix(params) @ colour)[self.laser_channel].clamp(min=1e-6)
+        beam = laser_irradiance(
+            decode(f["beam"])[:, channel],
+            decode(f["dark"])[:, channel],
+            f["core_depth"][:, channel],
+            f["core_radius"][:, channel],
+            params,
+        )
+        s = f["strength"]
+        light = s * f["exposure"] * laser_gain(params) * beam * (colour / stored_share)
+        if "halo_power_law" in effects:
+            # as in compose: the beam's measured light holds the glare, below the capture's floor the larger counts
+            unmeasured = f["unmeasured"] > 0
+            glare_at = torch.where(unmeasured, f["radius"], f["dark_radius"])
+            halo = physics.power_law_halo(
+                glare_at, halo_amplitude(params), params["halo_exponent"], GLARE_INNER_SCALE_REF_PX
+            )
+            glare = s * f["exposure"] * halo * (colour / stored_share)
+            light = torch.where(unmeasured, torch.maximum(light, glare), light + glare)
+        return self.scene_light(effects, params, f, decode) + light
+
     def exposure_factor(self, effects, params, decode, probes: dict | None = None) -> torch.Tensor:
         """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
         steps on the concave, piecewise-linear meter reading; differentiable through the iterations). ``probes``:
@@ -536,7 +676,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         f = self.probe_features if probes is None else probes
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         n = len(total)
-        target = decode(f["scene"]).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
+        target = self.scene_light(effects, params, f, decode).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
         k = torch.ones(n, dtype=total.dtype)
         for _ in range(12):
             lit = (k[:, None] * total < 1.0).to(total.dtype)
@@ -552,7 +692,10 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         total = self.compose(effects, params, f, decode)
         if "auto_exposure" in effects:
             total = total * self.exposure_factor(effects, params, decode, probes)[f["pair"]].unsqueeze(1)
-        return encode(total.clamp(0.0, 1.0))
+        total = total.clamp(0.0, 1.0)
+        if "colour_correction" in effects:
+            total = (total @ correction_matrix(params).T).clamp(0.0, 1.0)
+        return encode(total)
 
     def probe_slots(self, indices: list[int]) -> dict[str, torch.Tensor]:
         """The meter's pixels of the pairs ``indices`` (repeats kept), as frames 0..len-1 of one probe set."""
@@ -602,6 +745,26 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         fit.extra["frame_log_exposure"] = (latent - latent.mean()).tolist()
         fit.extra["noise_variance"] = self.noise_variance(fit, items)
         return fit
+
+    def unoffered(self, fit_items: np.ndarray) -> dict[str, str]:
+        """``colour_correction`` where the fit pairs' laser captures do not show a matrix (module docstring)."""
+        counts = [
+            faint_channels_at_zero(self.pairs[i].pattern, self.laser_channel) for i in np.unique(fit_items)
+        ]
+        lit, at_zero = (sum(c) for c in zip(*counts, strict=True))
+        if lit == 0:
+            return {
+                "colour_correction": f"the fit pairs' laser captures hold no lit beam pixel ({CHANNELS[self.laser_channel]} "
+                f"stored at >= {LIT_STORED * 255:.0f} with some channel under {UNCLIPPED_STORED * 255:.0f}) to show a "
+                "colour correction matrix"
+            }
+        if at_zero < MIN_MIXED_SHARE * lit:
+            return {
+                "colour_correction": f"{at_zero} of the fit pairs' laser captures' {lit} lit beam pixels store a "
+                f"fainter channel at 0, under {MIN_MIXED_SHARE:g}: the camera stores the laser's faint raw light, "
+                "no matrix pushed it below 0"
+            }
+        return {}
 
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """Frames' own exposures are the auto-exposure's: named only where the meter reacts to the laser's light
@@ -707,6 +870,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "glare_scale_ref_px": GLARE_INNER_SCALE_REF_PX,
             "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
             "exposure_spread": p["exposure_spread"] if "frame_exposure" in effects else 0.0,
+            "colour_correction": correction_matrix(p).reshape(-1).tolist()
+            if "colour_correction" in effects
+            else None,
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); the
             # transform knows power laws only, so a fitted shoulder gives it the closest one
             "gamma": equivalent_power_gamma(p)
