@@ -16,10 +16,12 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     GLARE_INNER_SCALE_REF_PX,
     GLARE_REFERENCE_PX,
     MIN_METER_REACTION,
+    MIN_MIXED_SHARE,
     BlindingFrames,
     dark_level,
     dark_level_radius,
     exposure_nodes,
+    faint_channels_at_zero,
     halo_amplitude,
     laser_gain,
 )
@@ -251,3 +253,51 @@ def test_frames_exposures_are_named_only_beside_a_meter_that_reacts_to_the_laser
         assert f"{reaction:.3f}" in reasons[0] and "misfit" in reasons[0]
     # the check is frame_exposure's alone
     assert one_pair_problem().identification_checks("auto_exposure", fit, np.arange(1)) == []
+
+
+# a consumer camera's colour correction matrix (negative off-diagonals, rows summing to 1)
+MIXING = torch.tensor([[1.6, -0.4, -0.2], [-0.3, 1.5, -0.2], [-0.1, -0.4, 1.5]], dtype=torch.float64)
+
+
+def red_laser_capture(power: float, mixed: bool) -> torch.Tensor:
+    """An 8-bit sRGB capture (3, 48, 64) of a red laser of raw colour (1, 0.08, 0.03) on a dark room, its beam
+    clipping at the core; ``mixed``: through ``MIXING`` after the raw channels clipped."""
+    ys, xs = torch.meshgrid(torch.arange(48.0), torch.arange(64.0), indexing="ij")
+    beam = power * torch.exp(-((xs - 30.0) ** 2 + (ys - 22.0) ** 2) / (2 * 6.0**2)).double()
+    raw = (beam * torch.tensor([1.0, 0.08, 0.03], dtype=torch.float64).reshape(3, 1, 1) + 0.004).clamp(
+        max=1.0
+    )
+    if mixed:
+        raw = torch.einsum("ij,jhw->ihw", MIXING, raw)
+    return torch.round(physics.linear_to_srgb(raw.clamp(0.0, 1.0)) * 255) / 255
+
+
+def capture_pairs(mixed: list[bool], power: float = 3.0) -> BlindingFrames:
+    black = torch.zeros((3, 48, 64), dtype=torch.float64)
+    pairs = [Pair(f"pair{i}", black, black, red_laser_capture(power, m), 1.0) for i, m in enumerate(mixed)]
+    return BlindingFrames(pairs, seed=0)
+
+
+def test_a_matrix_stores_a_narrowband_lasers_faint_channels_at_zero():
+    # the beam's lit ring: red stored at >= 128 and not clipped white (here nothing clips white: green and blue stay
+    # under 250 at three full wells)
+    lit, at_zero = faint_channels_at_zero(red_laser_capture(3.0, mixed=False), 0)
+    assert lit > 100 and at_zero == 0
+    mixed_lit, mixed_at_zero = faint_channels_at_zero(red_laser_capture(3.0, mixed=True), 0)
+    assert mixed_lit > 100 and mixed_at_zero == mixed_lit
+    # where the raw channels all clip, the spot is stored white with or without a matrix: it shows nothing
+    assert faint_channels_at_zero(torch.ones(3, 48, 64, dtype=torch.float64), 0) == (0, 0)
+
+
+def test_colour_correction_is_offered_only_where_the_fit_pairs_captures_show_a_matrix():
+    assert capture_pairs([True, True]).unoffered(np.arange(2)) == {}
+    (reason,) = capture_pairs([False, False]).unoffered(np.arange(2)).values()
+    assert reason.startswith("0 of") and f"under {MIN_MIXED_SHARE:g}" in reason
+    assert "colour_correction" in capture_pairs([False, False]).unoffered(np.arange(2))
+    # read from the fit pairs alone: held-out captures change nothing
+    frames = capture_pairs([False, False, True, True])
+    assert "colour_correction" in frames.unoffered(np.array([0, 1]))
+    assert frames.unoffered(np.array([2, 3])) == {}
+    # a capture with no lit beam shows nothing either way
+    (dark,) = capture_pairs([True], power=0.05).unoffered(np.arange(1)).values()
+    assert "no lit beam pixel" in dark

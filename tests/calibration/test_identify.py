@@ -891,6 +891,35 @@ def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tm
     )
 
 
+def test_an_effect_the_fit_items_show_no_sign_of_is_never_tried_and_the_report_says_why(tmp_path):
+    """The power law the first pass of ``GreedyPowerLaw`` takes, not offered from the start: no pass tries it, so
+    nothing is withdrawn, and the one pass is the one that took the meter and light together."""
+
+    class NoPowerOffered(GreedyPowerLaw):
+        def __init__(self) -> None:
+            self.asked: list[list[int]] = []
+
+        def unoffered(self, fit_items):
+            self.asked.append(sorted(int(i) for i in fit_items))
+            return {"power": "the fit items show no sign of it"}
+
+    problem = NoPowerOffered()
+    items = np.arange(20)
+    steps, _chain, selection, withdrawn = select_and_identify(
+        problem, items, seed=0, margin=0.05, folds=4, draws=20
+    )
+    assert problem.asked and all(asked == list(range(20)) for asked in problem.asked)
+    assert withdrawn == []
+    assert all("power" not in name for step in steps for name in step.tried)
+    assert selection.selected == ["light", "meter"] and selection.identified == ["light", "meter"]
+    report = report_on_twenty_items(problem, selection, steps, withdrawn)
+    assert report["selection"]["not_offered"] == {"power": "the fit items show no sign of it"}
+    write_markdown(report, [], tmp_path / "report.md")
+    assert "- not offered: `power` (the fit items show no sign of it)" in (tmp_path / "report.md").read_text()
+    # a problem with nothing to hold back offers every candidate
+    assert GreedyPowerLaw().unoffered(items) == {}
+
+
 def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
     """``child`` builds on ``parent``, whose rate sits at its bound: ``parent`` is rejected on its own evidence and
     ``child``, which passes on its own, only with it. Only ``parent`` is withdrawn (without it ``child`` cannot be

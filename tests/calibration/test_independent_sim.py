@@ -544,6 +544,10 @@ def test_case(name, root):
     allowed = tolerated(case, result["camera"])
     unplanted = named - case.planted - allowed
     where = replay(case, result)
+    if case.attack == "laser_blinding" and result["camera"].ccm is None:
+        # a camera without a matrix stores a narrowband laser's faint channels in proportion: its captures never
+        # offer the matrix (100 of 100 draws, docs/bench/session70/ccm_signature.txt)
+        assert "colour_correction" in report["selection"]["not_offered"], where
     if case.kind == "null":
         assert not report["extended"]["effects"], f"null case gained {report['extended']['effects']}: {where}"
     elif case.kind == "unexplained":

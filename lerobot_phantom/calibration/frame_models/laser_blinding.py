@@ -748,21 +748,21 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def unoffered(self, fit_items: np.ndarray) -> dict[str, str]:
         """``colour_correction`` where the fit pairs' laser captures do not show a matrix (module docstring)."""
-        counts = [
-            faint_channels_at_zero(self.pairs[i].pattern, self.laser_channel) for i in np.unique(fit_items)
-        ]
+        pairs = np.unique(fit_items)
+        counts = [faint_channels_at_zero(self.pairs[i].pattern, self.laser_channel) for i in pairs]
         lit, at_zero = (sum(c) for c in zip(*counts, strict=True))
+        captures = f"the laser captures of the {len(pairs)} fit pairs (each pair's own)"
         if lit == 0:
             return {
-                "colour_correction": f"the fit pairs' laser captures hold no lit beam pixel ({CHANNELS[self.laser_channel]} "
-                f"stored at >= {LIT_STORED * 255:.0f} with some channel under {UNCLIPPED_STORED * 255:.0f}) to show a "
-                "colour correction matrix"
+                "colour_correction": f"{captures} hold no lit beam pixel (the {CHANNELS[self.laser_channel]} "
+                f"channel stored at >= {LIT_STORED * 255:.0f} with some channel under {UNCLIPPED_STORED * 255:.0f}) "
+                "to show a colour correction matrix"
             }
         if at_zero < MIN_MIXED_SHARE * lit:
             return {
-                "colour_correction": f"{at_zero} of the fit pairs' laser captures' {lit} lit beam pixels store a "
-                f"fainter channel at 0, under {MIN_MIXED_SHARE:g}: the camera stores the laser's faint raw light, "
-                "no matrix pushed it below 0"
+                "colour_correction": f"{at_zero} of the {lit} lit beam pixels in {captures} store a fainter channel "
+                f"at 0, a share under {MIN_MIXED_SHARE:g}: the camera stores the laser's faint raw light in "
+                "proportion, no matrix pushed it below 0"
             }
         return {}
 
