@@ -450,6 +450,8 @@ class Selection:
     rejected: list[str] = field(default_factory=list)
     # the selection passes repeated without a simpler form of a term (core.select_forms), set by select_and_identify
     form_passes: list[FormPass] = field(default_factory=list)
+    # candidates never tried, with the reason (Problem.unoffered on the fit items), set by select_and_identify
+    unoffered: dict[str, str] = field(default_factory=dict)
 
 
 def identify_selection(
@@ -760,7 +762,7 @@ def select_and_identify(
     auto-exposure (master seed 3986568970), where a power law at its bound 4 beat the meter with linear light by
     0.6% at the first step."""
     withdrawn: list[Withdrawal] = []
-    unoffered = frozenset(problem.unoffered(fit_items))
+    unoffered = problem.unoffered(fit_items)
     while True:
         _selected, steps, form_passes = select_forms(
             problem,
@@ -768,13 +770,14 @@ def select_and_identify(
             seed=seed,
             margin=margin,
             folds=folds,
-            withdrawn=unoffered | frozenset(w.effect for w in withdrawn),
+            withdrawn=frozenset(unoffered) | frozenset(w.effect for w in withdrawn),
         )
         chain = fit_chain(problem, steps, fit_items)
         selection = identify_selection(
             problem, steps, chain, fit_items, draws=draws, rng=np.random.default_rng([seed, 1])
         )
         selection.form_passes = form_passes
+        selection.unoffered = unoffered
         if not selection.rejected:
             return steps, chain, selection, withdrawn
         number = 1 + max((w.selection_pass for w in withdrawn), default=0)

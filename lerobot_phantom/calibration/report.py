@@ -140,10 +140,7 @@ def build_report(
             "rmse_reduction": 1.0 - ext_scores["heldout_rmse"] / max(base_scores["heldout_rmse"], 1e-12),
             "selection_margin": margin,
         },
-        "selection": {
-            **selection_section(problem, selection, steps, withdrawn, margin=margin, folds=folds),
-            "not_offered": problem.unoffered(fit_items),
-        },
+        "selection": selection_section(problem, selection, steps, withdrawn, margin=margin, folds=folds),
         "unexplained_structure": residual_structure(
             problem,
             extended,
@@ -247,6 +244,7 @@ def selection_section(
         "selected": selection.selected,
         "steps": [step_entry(s) for s in steps],
         "rejected": dict(steps[-1].tried),
+        "not_offered": dict(selection.unoffered),
         "withdrawn": [w.as_dict() for w in withdrawn],
         "earlier_passes": earlier_passes(withdrawn),
         "form_passes": [form_pass_entry(p) for p in selection.form_passes],

@@ -291,9 +291,9 @@ def test_a_matrix_stores_a_narrowband_lasers_faint_channels_at_zero():
 
 def test_colour_correction_is_offered_only_where_the_fit_pairs_captures_show_a_matrix():
     assert capture_pairs([True, True]).unoffered(np.arange(2)) == {}
-    (reason,) = capture_pairs([False, False]).unoffered(np.arange(2)).values()
+    ((effect, reason),) = capture_pairs([False, False]).unoffered(np.arange(2)).items()
+    assert effect == "colour_correction"
     assert reason.startswith("0 of") and f"under {MIN_MIXED_SHARE:g}" in reason
-    assert "colour_correction" in capture_pairs([False, False]).unoffered(np.arange(2))
     # read from the fit pairs alone: held-out captures change nothing
     frames = capture_pairs([False, False, True, True])
     assert "colour_correction" in frames.unoffered(np.array([0, 1]))

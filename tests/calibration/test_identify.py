@@ -908,7 +908,8 @@ def test_an_effect_the_fit_items_show_no_sign_of_is_never_tried_and_the_report_s
     steps, _chain, selection, withdrawn = select_and_identify(
         problem, items, seed=0, margin=0.05, folds=4, draws=20
     )
-    assert problem.asked and all(asked == list(range(20)) for asked in problem.asked)
+    # asked once, on the fit items; the report writes what selection used
+    assert problem.asked == [list(range(20))]
     assert withdrawn == []
     assert all("power" not in name for step in steps for name in step.tried)
     assert selection.selected == ["light", "meter"] and selection.identified == ["light", "meter"]
