@@ -1,8 +1,7 @@
 #!/bin/bash
 # The camsim core selection (tests/calibration/test_independent_sim.py) on several master seeds, one after another.
 # usage: [CAMSIM_CASES=a,b] [CAMSIM_TIMEOUT=s] [CAMSIM_TESTS=expr] docs/bench/camsim_core_batch.sh TREE OUTDIR SEED...
-# (TREE: a checkout;
-# its package is what is tested; CAMSIM_CASES: the cases, default the core selection; CAMSIM_TIMEOUT: seconds per
+# (TREE: a checkout; its package is what is tested; CAMSIM_CASES: the cases, default the core selection; CAMSIM_TIMEOUT: seconds per
 # seed, default 5400: CAMSIM_CASES=all took 1592-1942 s per seed in session 56, two seeds side by side; CAMSIM_TESTS:
 # a pytest -k expression, e.g. test_case for the drawn cases without the file's fixed-seed tests)
 # Per seed: OUTDIR/log_SEED.txt (pytest -rA output, --runxfail), OUTDIR/bt_SEED (pytest's basetemp, with every

@@ -15,7 +15,10 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import torch
 from PIL import Image
+
+from lerobot_phantom.calibration.frame_models.laser_blinding import faint_channels_at_zero
 
 CASES = (
     "blinding_null",
@@ -27,15 +30,16 @@ CASES = (
 
 
 def signature(pattern: np.ndarray) -> tuple[str, int, float, float]:
-    """(laser channel, lit beam pixels, share with a faint channel <= 2, median faintest channel there)."""
+    """(laser channel, lit beam pixels, share with a faint channel at 0, median faintest channel there), the counts
+    by the package's own check (``faint_channels_at_zero``)."""
     lin = (pattern.astype(float) / 255.0) ** 2.2
     laser = int(lin.reshape(-1, 3).sum(0).argmax())
-    others = [c for c in range(3) if c != laser]
-    lit = (pattern[..., laser] >= 128) & (pattern.min(-1) < 250)
-    faint = pattern[..., others].min(-1)[lit]
-    if faint.size == 0:
+    lit, at_zero = faint_channels_at_zero(torch.tensor(pattern).permute(2, 0, 1).double() / 255.0, laser)
+    if lit == 0:
         return "rgb"[laser], 0, float("nan"), float("nan")
-    return "rgb"[laser], int(lit.sum()), float((faint <= 2).mean()), float(np.median(faint))
+    others = [c for c in range(3) if c != laser]
+    lit_mask = (pattern[..., laser] >= 128) & (pattern.min(-1) < 250)
+    return "rgb"[laser], lit, at_zero / lit, float(np.median(pattern[..., others].min(-1)[lit_mask]))
 
 
 def main() -> None:
