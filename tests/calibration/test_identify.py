@@ -921,6 +921,51 @@ def test_an_effect_the_fit_items_show_no_sign_of_is_never_tried_and_the_report_s
     assert GreedyPowerLaw().unoffered(items) == {}
 
 
+def test_groups_set_aside_though_ahead_of_the_kept_model_are_reported_not_named(tmp_path):
+    """``GreedyPowerLaw`` with its exponent at the bound in every fit and the meter with light under the margin:
+    every group holding the power law is set aside, nothing is selected, and the report lists those that scored the
+    margin under the base (best first, with the pin), without naming a cause."""
+
+    class PowerAlwaysPinned(GreedyPowerLaw):
+        errors: typing.ClassVar[dict[str, float]] = {
+            **GreedyPowerLaw.errors,
+            "meter": 20.5,
+            "light+meter": 20.4,
+            "light+meter+power": 25.0,
+        }
+
+        def fit(self, effects, items, start=None) -> Fit:
+            return Fit(effects, {"gamma": 4.0} if "power" in effects else {})
+
+    problem = PowerAlwaysPinned()
+    steps, _chain, selection, withdrawn = select_and_identify(
+        problem, np.arange(20), seed=0, margin=0.05, folds=4, draws=20
+    )
+    assert selection.selected == [] and withdrawn == []
+    report = report_on_twenty_items(problem, selection, steps, withdrawn)
+    ahead = report["selection"]["set_aside_ahead"]
+    # power alone (13.88) and beside the meter (12.8) are under 0.95 x 21; beside light (29.4) or both (25.0) not
+    assert [(a["group"], a["validation_error"]) for a in ahead] == [
+        ("meter+power", pytest.approx(12.8)),
+        ("power", pytest.approx(13.88)),
+    ]
+    assert all(a["kept_validation_error"] == pytest.approx(21.0) for a in ahead)
+    assert ahead[1]["reason"] == "power: gamma at its high bound 4 in 4 of 4 folds"
+    assert report["findings"] == []
+    write_markdown(report, [], tmp_path / "report.md")
+    text = (tmp_path / "report.md").read_text()
+    assert "Set aside although they fit the items better than the selected model" in text
+    assert "- `power`: 13.9; power: gamma at its high bound 4 in 4 of 4 folds" in text
+    # where selection keeps a model no set-aside group beats by the margin, nothing is listed
+    steps, _chain, selection, withdrawn = select_and_identify(
+        GreedyPowerLaw(), np.arange(20), seed=0, margin=0.05, folds=4, draws=20
+    )
+    report = report_on_twenty_items(GreedyPowerLaw(), selection, steps, withdrawn)
+    assert report["selection"]["set_aside_ahead"] == []
+    write_markdown(report, [], tmp_path / "report.md")
+    assert "Set aside although" not in (tmp_path / "report.md").read_text()
+
+
 def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
     """``child`` builds on ``parent``, whose rate sits at its bound: ``parent`` is rejected on its own evidence and
     ``child``, which passes on its own, only with it. Only ``parent`` is withdrawn (without it ``child`` cannot be
