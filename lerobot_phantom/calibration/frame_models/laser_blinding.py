@@ -42,8 +42,9 @@ frame average, as centre-weighted meters do when the spot is central). ``Y`` wei
 by ``METER_WEIGHTS`` (Rec. 709 luminance; under ``colour_correction``, of the raw channels), as exposure meters
 weigh green most: with the channels' plain mean (until session 71), how much a red laser darkens a frame depended on
 the scene's colours as no luminance meter does, and on a colour-correcting camera the matrix's green take ran to
-its bound to bend the meter (camsim's auto-exposure draw 1538857946: 0.99 with the mean, 0.41 with luminance, 0.01
-true; docs/bench/session71/probe_1538857946_auto_exposure.txt).
+its bound to bend the meter (camsim's auto-exposure draw 1538857946, fitted with the meter, linear light, the
+matrix and a shoulder on all pairs: 0.93 with the mean, 0.41 with luminance, 0.01 true;
+docs/bench/session71/probe_1538857946_auto_exposure.txt).
 
 ``frame_exposure`` is the light's ratio to the scene changing from frame to frame. An auto-exposing camera exposes
 each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
