@@ -13,8 +13,6 @@ import numpy as np
 from PIL import Image
 from scipy import ndimage, optimize
 
-from lerobot_phantom.calibration.frame_models.laser_blinding import METER_WEIGHTS
-
 
 def srgb_decode(v: np.ndarray) -> np.ndarray:
     v = np.clip(v, 0.0, 1.0)
@@ -103,10 +101,8 @@ def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np
 
 def metered_exposure(blinded: np.ndarray, clean: np.ndarray) -> float:
     """The library's auto-exposure meter (``frame_models/laser_blinding.py``): the exposure ``k`` at which the
-    blinded frame's clipped mean luminance (the channels weighed by ``METER_WEIGHTS``, clipped at white) equals the
-    clean frame's."""
-    weights = np.asarray(METER_WEIGHTS)
-    level, target = blinded @ weights, np.minimum(clean @ weights, 1.0).mean()
+    blinded frame's clipped mean level (channel means, clipped at white) equals the clean frame's."""
+    level, target = blinded.mean(-1), np.minimum(clean.mean(-1), 1.0).mean()
     return optimize.brentq(lambda k: np.minimum(k * level, 1.0).mean() - target, 1e-4, 10.0)
 
 

@@ -35,16 +35,10 @@ a refinement of it: the shoulder alone follows a filmic curve to half a grey lev
 the curve can stretch the light's scale freely, so the laser's gain is no longer pinned by the frames.
 
 ``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
-*clipped* mean luminance (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k Y(scene +
-light), 1)) = mean(min(Y(scene), 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a``
-applies ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the
-frame average, as centre-weighted meters do when the spot is central). ``Y`` weighs the composed light's channels
-by ``METER_WEIGHTS`` (Rec. 709 luminance; under ``colour_correction``, of the raw channels), as exposure meters
-weigh green most: with the channels' plain mean (until session 71), how much a red laser darkens a frame depended on
-the scene's colours as no luminance meter does, and on a colour-correcting camera the matrix's green take ran to
-its bound to bend the meter (camsim's auto-exposure draw 1538857946, fitted with the meter, linear light, the
-matrix and a shoulder on all pairs: 0.93 with the mean, 0.41 with luminance, 0.01 true;
-docs/bench/session71/probe_1538857946_auto_exposure.txt).
+*clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
+1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
+``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
+average, as centre-weighted meters do when the spot is central).
 
 ``frame_exposure`` is the light's ratio to the scene changing from frame to frame. An auto-exposing camera exposes
 each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
@@ -174,8 +168,6 @@ MAX_EXPOSURE_SPREAD = 1.5
 MAX_FRAME_LOG_EXPOSURE = 3.0
 # pixels of each frame the exposure meter reads
 METER_PROBES = 1024
-# the exposure meter's weight of each channel of the composed light: Rec. 709 luminance (module docstring)
-METER_WEIGHTS = (0.2126, 0.7152, 0.0722)
 # the least power of the meter's exposure factor (``auto_exposure``) beside which frames' own exposures are named: a
 # camera that re-exposes every scene meters the laser's light as a scene's (1 for a uniform meter, more for a
 # centre-weighted one and a spot near the centre; half of it for a spot far out in a strongly centre-weighted one)
@@ -682,12 +674,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         steps on the concave, piecewise-linear meter reading; differentiable through the iterations). ``probes``:
         the meter's pixels, ``METER_PROBES`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
-        weights = torch.tensor(METER_WEIGHTS, dtype=torch.float64)
-        total = (self.compose(effects, params, f, decode) @ weights).reshape(-1, METER_PROBES)
+        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         n = len(total)
-        target = (
-            (self.scene_light(effects, params, f, decode) @ weights).clamp(max=1.0).reshape(n, -1).mean(1)
-        )
+        target = self.scene_light(effects, params, f, decode).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
         k = torch.ones(n, dtype=total.dtype)
         for _ in range(12):
             lit = (k[:, None] * total < 1.0).to(total.dtype)
