@@ -9,13 +9,13 @@ channel, ``--form six`` every off-diagonal its own; ``--pixels unclipped`` fits 
 frame stores every channel above 2.5/255 (their raw scene is known through the matrix's inverse); ``--core faint``
 reads the beam inside the capture's saturated laser channel from a fainter channel the capture measured there
 unsaturated (stored_c = M[c,L] + (M[c,c] col_c + M[c,k] col_k) B), instead of the Gaussian continuation alone;
-``--high H`` widens the takes' range to [0, H]; ``--meter mean`` has the auto-exposure meter read its three channels' mean,
-the package's meter before session 71, instead of ``METER_WEIGHTS`` (Rec. 709 luminance; camsim's meter reads
-luminance, centre-weighted).
+``--high H`` widens the takes' range to [0, H]; ``--meter luma`` has the auto-exposure meter read Rec. 709 luminance
+of the composed light (``LUMA``; camsim's meter reads luminance, centre-weighted) instead of its three channels'
+mean, the package's meter (``luminance_meter_attempt.patch`` made that the package's form; reverted).
 
 Usage: ``CAMSIM_CCM=1 PYTHONPATH=. python docs/bench/session71/ccm_take_probe.py CASE PAIRS_DIR MASTER_SEED GROUP[,GROUP]
 [--takes free|true] [--form column|split|six] [--pixels all|unclipped] [--core package|faint] [--high H]
-[--meter luma|mean] [--zones]``
+[--meter mean|luma] [--zones]``
 (PAIRS_DIR: a case's ``pairs`` folder as ``session64/run_camsim_case.py`` or ``ccm_take_variants.py`` wrote it; the
 camera's true matrix is drawn again from MASTER_SEED)."""
 
@@ -36,6 +36,8 @@ from camsim_case_cameras import case_draws
 
 from lerobot_phantom.calibration.frame_models import laser_blinding as lb
 from lerobot_phantom.calibration.frame_models.common import load_pairs
+
+LUMA = (0.2126, 0.7152, 0.0722)  # Rec. 709 luminance weights
 
 
 def take_names(form: str, laser: int) -> dict[tuple[int, int], str]:
@@ -60,7 +62,7 @@ def main() -> None:
     parser.add_argument("--pixels", choices=("all", "unclipped"), default="all")
     parser.add_argument("--core", choices=("package", "faint"), default="package")
     parser.add_argument("--high", type=float, default=1.0)
-    parser.add_argument("--meter", choices=("luma", "mean"), default="luma")
+    parser.add_argument("--meter", choices=("mean", "luma"), default="mean")
     parser.add_argument("--zones", action="store_true")
     args = parser.parse_args()
     ((*_, camera),) = list(case_draws(args.case, [args.master]))
@@ -128,10 +130,27 @@ def main() -> None:
         beam = f["strength"] * f["exposure"] * lb.laser_gain(params) * raw.unsqueeze(1) * colour
         return self.scene_light(effects, params, f, decode) + beam
 
+    def exposure_factor_luminance(self, effects, params, decode, probes=None):
+        # the package's exposure_factor with the channels weighed by LUMA instead of averaged
+        weights = torch.tensor(LUMA, dtype=torch.float64)
+        f = self.probe_features if probes is None else probes
+        total = (self.compose(effects, params, f, decode) @ weights).reshape(-1, lb.METER_PROBES)
+        n = len(total)
+        target = (
+            (self.scene_light(effects, params, f, decode) @ weights).clamp(max=1.0).reshape(n, -1).mean(1)
+        )
+        k = torch.ones(n, dtype=total.dtype)
+        for _ in range(12):
+            lit = (k[:, None] * total < 1.0).to(total.dtype)
+            reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+            slope = (total * lit).mean(1).clamp(min=1e-9)
+            k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+        return k ** params["auto_exposure"]
+
     lb.BlindingFrames.param_specs = specs
     lb.correction_matrix = matrix
-    if args.meter == "mean":
-        lb.METER_WEIGHTS = (1 / 3, 1 / 3, 1 / 3)
+    if args.meter == "luma":
+        lb.BlindingFrames.exposure_factor = exposure_factor_luminance
     if args.core == "faint":
         lb.BlindingFrames.compose_raw = compose_raw_faint
     known = [p.clean.reshape(3, -1).amin(0) > 2.5 / 255 for p in pairs]
