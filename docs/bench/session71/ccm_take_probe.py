@@ -130,22 +130,27 @@ def main() -> None:
         beam = f["strength"] * f["exposure"] * lb.laser_gain(params) * raw.unsqueeze(1) * colour
         return self.scene_light(effects, params, f, decode) + beam
 
+    package_exposure_factor = lb.BlindingFrames.exposure_factor
+
+    class LuminanceMeter:
+        """What the package's meter reads of ``problem``, each pixel's light replaced by its luminance in all three
+        channels, so that the meter's channel mean is the luminance."""
+
+        def __init__(self, problem) -> None:
+            self.problem, self.probe_features = problem, problem.probe_features
+
+        @staticmethod
+        def luminance(light: torch.Tensor) -> torch.Tensor:
+            return (light @ torch.tensor(LUMA, dtype=torch.float64)).unsqueeze(1).expand(-1, 3)
+
+        def compose(self, *args):
+            return self.luminance(self.problem.compose(*args))
+
+        def scene_light(self, *args):
+            return self.luminance(self.problem.scene_light(*args))
+
     def exposure_factor_luminance(self, effects, params, decode, probes=None):
-        # the package's exposure_factor with the channels weighed by LUMA instead of averaged
-        weights = torch.tensor(LUMA, dtype=torch.float64)
-        f = self.probe_features if probes is None else probes
-        total = (self.compose(effects, params, f, decode) @ weights).reshape(-1, lb.METER_PROBES)
-        n = len(total)
-        target = (
-            (self.scene_light(effects, params, f, decode) @ weights).clamp(max=1.0).reshape(n, -1).mean(1)
-        )
-        k = torch.ones(n, dtype=total.dtype)
-        for _ in range(12):
-            lit = (k[:, None] * total < 1.0).to(total.dtype)
-            reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
-            slope = (total * lit).mean(1).clamp(min=1e-9)
-            k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
-        return k ** params["auto_exposure"]
+        return package_exposure_factor(LuminanceMeter(self), effects, params, decode, probes)
 
     lb.BlindingFrames.param_specs = specs
     lb.correction_matrix = matrix
