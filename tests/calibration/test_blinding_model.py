@@ -12,6 +12,7 @@ import torch
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_blinding import (
+    DECODE_MEMO_SIZE,
     EXPOSURE_NODES,
     GLARE_INNER_SCALE_REF_PX,
     GLARE_REFERENCE_PX,
@@ -26,6 +27,7 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     laser_gain,
 )
 from lerobot_phantom.calibration.identify import at_bound
+from lerobot_phantom.calibration.tone import TONE_PARAMS
 from lerobot_phantom.transforms import physics
 
 
@@ -301,3 +303,47 @@ def test_colour_correction_is_offered_only_where_the_fit_pairs_captures_show_a_m
     # a capture with no lit beam shows nothing either way
     (dark,) = capture_pairs([True], power=0.05).unoffered(np.arange(1)).values()
     assert "no lit beam pixel" in dark
+
+
+@pytest.mark.parametrize(
+    "effects",
+    [
+        {"linear_light_saturation", "auto_exposure", "tone_shoulder", "halo_power_law", "colour_correction"},
+        {"linear_light_saturation", "auto_exposure", "sensor_gamma"},
+        {"linear_light_saturation"},
+        set(),
+    ],
+)
+def test_kept_decodes_change_no_prediction_along_a_finite_difference_jacobian(tmp_path, effects):
+    """The decoded features a fit reuses between the columns of a finite-difference Jacobian
+    (``BlindingFrames.memoised_tone_curve``) must give the prediction computed afresh for every parameter step,
+    including steps of the tone curve, which change them; features are decoded anew only at those steps."""
+    kept, _ = kit_blinding(tmp_path, {"linear_light_saturation", "auto_exposure"}, seed=4)
+    fresh = BlindingFrames(kept.pairs, seed=4)
+    effects = frozenset(effects)
+    items = np.arange(kept.n_items)
+    feats, _ = kept.stacked_pixels(items, [kept.samples[int(i)] for i in items])
+    point = {spec.name: spec.init for spec in kept.param_specs(effects)}
+    steps = [point] + [{**point, name: value * 1.01 + 1e-3} for name, value in point.items()] + [point]
+    decoded = []
+    tone_curve = kept.tone_curve
+
+    def counting_tone_curve(effects, params):
+        decode, encode = tone_curve(effects, params)
+        return (lambda values: decoded.append(values) or decode(values)), encode
+
+    kept.tone_curve = counting_tone_curve
+    with torch.no_grad():
+        for params in steps:
+            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+            fresh.decode_memo.clear()
+            torch.testing.assert_close(
+                kept.predict_features(effects, values, feats),
+                fresh.predict_features(effects, values, feats),
+                rtol=0,
+                atol=0,
+            )
+    # each feature tensor decoded once at the first point and once at each step of a tone parameter
+    tone_steps = sum(name in TONE_PARAMS for name in point)
+    assert len(decoded) == len({id(v) for v in decoded}) * (1 + tone_steps)
+    assert len(kept.decode_memo) <= DECODE_MEMO_SIZE

@@ -97,17 +97,25 @@ from lerobot_phantom.calibration.frame_models.common import (
     FrameProblem,
     LatentFrameProblem,
     Pair,
+    ParameterMemo,
     PixelProblem,
     flat_pixels,
+    parameter_values,
 )
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
+    TONE_PARAMS,
     decode_encode,
     equivalent_power_gamma,
 )
 from lerobot_phantom.transforms import physics
 
 logger = logging.getLogger(__name__)
+
+# a feature decoded under the tone curve, kept at the fitted point and at a step of each tone parameter for each
+# feature tensor a prediction decodes (scene, beam, dark and pattern; the meter's probes likewise): a
+# finite-difference column that moves any other parameter decodes the same values again
+DECODE_MEMO_SIZE = 2 * (1 + len(TONE_PARAMS)) * 8
 
 BLINDING_EFFECTS = (
     Effect(
@@ -427,6 +435,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
                 "laser_blinding frame pairs need a 'pattern' column: a capture of the laser alone (no scene)"
             )
         super().__init__(pairs, seed)
+        self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
         self.dark_levels = [dark_level(p.pattern, c) for p, c in zip(pairs, self.centres, strict=True)]
         self.dark_radii = [
@@ -586,6 +595,17 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         shoulder (``calibration/tone.py``, the convention the noise model reads), else a power law or sRGB."""
         return decode_encode(params, "tone_shoulder" in effects, cls.tone(effects, params))
 
+    def memoised_tone_curve(self, effects, params):
+        """:meth:`tone_curve` whose decode is kept per feature tensor and tone curve (``ParameterMemo``)."""
+        decode, encode = self.tone_curve(effects, params)
+        shoulder = "tone_shoulder" in effects
+
+        def key() -> tuple:
+            gamma = self.tone(effects, params)
+            return (shoulder, None if gamma is None else float(gamma), *parameter_values(params, TONE_PARAMS))
+
+        return (lambda values: self.decode_memo.get(values, key, lambda: decode(values))), encode
+
     @staticmethod
     def scene_light(effects, params, f, decode) -> torch.Tensor:
         """The clean scene's light in the channels the model composes in: the stored ones, or under
@@ -688,7 +708,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
     def predict_features(self, effects, params, f, probes: dict | None = None):
         """Encoded prediction at the features ``f``; ``f["pair"]`` indexes the frames of ``probes`` (the meter's
         pixels, :meth:`exposure_factor`)."""
-        decode, encode = self.tone_curve(effects, params)
+        decode, encode = self.memoised_tone_curve(effects, params)
         total = self.compose(effects, params, f, decode)
         if "auto_exposure" in effects:
             total = total * self.exposure_factor(effects, params, decode, probes)[f["pair"]].unsqueeze(1)
