@@ -397,3 +397,26 @@ def projection_pairs_with_spread_light(spread_px: float, seed: int = 0) -> list:
             Pair(f"p{index}", *(torch.from_numpy(a) for a in (clean, attacked.clip(0, 1), pattern)), 1.0)
         )
     return pairs
+
+
+def assert_kept_values_change_no_prediction(
+    kept, fresh, memo: str, effects: frozenset[str], feats: dict
+) -> list[dict]:
+    """A frame problem's values kept between the columns of a finite-difference Jacobian (its ``memo``) change no
+    prediction: along a path through every parameter of ``effects`` (each moved once from its start value, then all
+    back), ``kept``'s predictions at ``feats`` equal ``fresh``'s, whose memo is cleared at every step. The path."""
+    import torch
+
+    point = {spec.name: spec.init for spec in kept.param_specs(effects)}
+    steps = [point] + [{**point, name: value * 1.01 + 1e-3} for name, value in point.items()] + [point]
+    with torch.no_grad():
+        for params in steps:
+            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
+            getattr(fresh, memo).clear()
+            torch.testing.assert_close(
+                kept.predict_features(effects, values, feats),
+                fresh.predict_features(effects, values, feats),
+                rtol=0,
+                atol=0,
+            )
+    return steps

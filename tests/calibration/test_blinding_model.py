@@ -318,13 +318,13 @@ def test_kept_decodes_change_no_prediction_along_a_finite_difference_jacobian(tm
     """The decoded features a fit reuses between the columns of a finite-difference Jacobian
     (``BlindingFrames.memoised_tone_curve``) must give the prediction computed afresh for every parameter step,
     including steps of the tone curve, which change them; features are decoded anew only at those steps."""
+    from calibration_testkit import assert_kept_values_change_no_prediction
+
     kept, _ = kit_blinding(tmp_path, {"linear_light_saturation", "auto_exposure"}, seed=4)
     fresh = BlindingFrames(kept.pairs, seed=4)
     effects = frozenset(effects)
     items = np.arange(kept.n_items)
     feats, _ = kept.stacked_pixels(items, [kept.samples[int(i)] for i in items])
-    point = {spec.name: spec.init for spec in kept.param_specs(effects)}
-    steps = [point] + [{**point, name: value * 1.01 + 1e-3} for name, value in point.items()] + [point]
     decoded = []
     tone_curve = kept.tone_curve
 
@@ -333,17 +333,8 @@ def test_kept_decodes_change_no_prediction_along_a_finite_difference_jacobian(tm
         return (lambda values: decoded.append(values) or decode(values)), encode
 
     kept.tone_curve = counting_tone_curve
-    with torch.no_grad():
-        for params in steps:
-            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
-            fresh.decode_memo.clear()
-            torch.testing.assert_close(
-                kept.predict_features(effects, values, feats),
-                fresh.predict_features(effects, values, feats),
-                rtol=0,
-                atol=0,
-            )
+    steps = assert_kept_values_change_no_prediction(kept, fresh, "decode_memo", effects, feats)
     # each feature tensor decoded once at the first point and once at each step of a tone parameter
-    tone_steps = sum(name in TONE_PARAMS for name in point)
+    tone_steps = sum(name in TONE_PARAMS for name in steps[0])
     assert len(decoded) == len({id(v) for v in decoded}) * (1 + tone_steps)
     assert len(kept.decode_memo) <= DECODE_MEMO_SIZE

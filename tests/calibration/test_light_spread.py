@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import torch
-from calibration_testkit import projection_pairs_with_spread_light
+from calibration_testkit import assert_kept_values_change_no_prediction, projection_pairs_with_spread_light
 
 from lerobot_phantom.calibration.frame_models.light_projection import (
     LIGHT_MEMO_SIZE,
@@ -58,24 +58,13 @@ def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
     # the features of all pairs stacked, as a fit stacks them
     per_pair = [kept.features(i, kept.samples[i]) for i in range(len(pairs))]
     feats = {k: torch.cat([f[k] for f in per_pair]) for k in per_pair[0]}
-    point = {spec.name: spec.init for spec in kept.param_specs(effects)}
-    steps = [point] + [{**point, name: value * 1.01 + 1e-3} for name, value in point.items()] + [point]
     spreads = []
     spread_light = kept.spread_light
     kept.spread_light = lambda *args: spreads.append(args) or spread_light(*args)
-    with torch.no_grad():
-        for params in steps:
-            values = {k: torch.tensor(v, dtype=torch.float64) for k, v in params.items()}
-            fresh.light_memo.clear()
-            torch.testing.assert_close(
-                kept.predict_features(effects, values, feats),
-                fresh.predict_features(effects, values, feats),
-                rtol=0,
-                atol=0,
-            )
+    steps = assert_kept_values_change_no_prediction(kept, fresh, "light_memo", effects, feats)
     # the light was spread anew only for the steps that move the tone curve or the spread (and the first point),
     # and the memo stays bounded while the steps run through every parameter
-    moving = sum(name in SPREAD_PARAMS for name in point)
+    moving = sum(name in SPREAD_PARAMS for name in steps[0])
     assert len(spreads) == 1 + moving < len(steps)
     assert len(kept.light_memo) <= LIGHT_MEMO_SIZE
 
