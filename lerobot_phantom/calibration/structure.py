@@ -391,15 +391,15 @@ def variance_tests(
     places that the model leaves out with zero mean (laser speckle, a rotation's blur growing from its centre). The
     dependence test runs on Levene's absolute form ``y = a / mean(a) - 1``, ``a = |residual| / modelled sd`` (0 in
     every bin when the noise model holds up to a common scale). Squared residuals leave a sample's largest values to
-    carry eta2, so an item bootstrap without the strongest pair loses it: on camsim's strip speckle (four master
-    seeds) their low end was 0.014-0.038, two under the floor, the absolute form's 0.068-0.091; over 28 null cases
-    one is above the floor with the absolute form (an EM colour strip, 0.0205: the colour map multiplies the noise
-    of the rows it decodes, which a noise model of the signal alone does not place), none with squares
-    (docs/bench/session73/variance_statistic.txt). Only position is tested, since the paper's digital forms scale
+    carry eta2, so an item bootstrap without the strongest pair loses it: on camsim's strip speckle (ten master
+    seeds) their low end was 0.0135-0.0376, four under the floor, the absolute form's 0.0619-0.1107; of 70 null
+    cases two are above the floor with the absolute form, one with squares, all EM colour strips (the colour map
+    multiplies the noise of the rows it decodes, which a noise model of the signal alone does not place;
+    docs/bench/session73/variance_statistic*.txt). Only position is tested, since the paper's digital forms scale
     the attacked frame's noise with the intensity (a blend by 1 - a) and demosaicing gives green less noise than
     red and blue (eta2 up to 0.04 by intensity or channel on the independent simulator's null cases, at most 0.008
     by row or column: docs/bench/session46/variance_probe.txt, squared form). The size of a finding: a bin whose
-    residuals are ``1 + d`` times the model's in size holds ``(1 + d)^2 - 1`` times its variance more; the bins'
+    ``a`` is ``1 + d`` times the sample's mean holds ``(1 + d)^2 - 1`` times the variance more; the bins'
     root-mean-square ``d`` turned into that excess, times the mean modelled variance (grey levels^2).
     An ISP's lens-shading correction (a digital gain rising toward the corners) also makes noise grow with position
     at a given output level; the test reports that as well, as what it is: variance the noise model does not place."""
