@@ -428,6 +428,9 @@ def test_zero_mean_noise_in_a_band_of_rows_is_reported_as_variance_by_row(band_n
         # rows 10-19 of 40 are 0.26-0.49 of the frame's height
         assert "for values 0.2" in by_row["where"] or "for values 0.3" in by_row["where"], by_row["where"]
         assert "variance beyond sensor noise depends on row" in result["summary"]
+        # the finding's size (grey levels^2, base MSE 1): the band's extra variance, (0.016 * 255)^2, held by two of
+        # the eight row bins, is 16.6 * sqrt(2 / 8) = 8.3 as the bins' root mean square
+        assert 8.3 / 2 < by_row["share_of_base_mse"] < 8.3 * 2, by_row
 
 
 @pytest.mark.parametrize("strength, lowest", [(0.0, None), (0.016, 0.02), (0.03, 0.06)])
