@@ -15,26 +15,28 @@ from lerobot_phantom.calibration import structure
 from lerobot_phantom.calibration.noise import NoiseSample, fit_variance, model_variance
 
 
-def excess(noise: list, form: str) -> list[np.ndarray]:
+def squared_excess(noise: list) -> list[np.ndarray]:
+    """The statistic before session 73: residual^2 / modelled variance - 1 (the package's noise model)."""
     joined = NoiseSample.join(noise)
-    variance = model_variance(joined, fit_variance(joined, True))
-    if form == "squared":
-        values = joined.residual**2 / variance - 1.0
-    else:
-        size = np.abs(joined.residual) / np.sqrt(variance)
-        values = size / size.mean() - 1.0
+    values = joined.residual**2 / model_variance(joined, fit_variance(joined, True)) - 1.0
     return np.split(values, np.cumsum([len(p.residual) for p in noise])[:-1])
 
 
 def cells(call: dict, form: str) -> str:
-    sample = structure.ResidualSample(excess(call["noise"], form), call["position"])
-    tests = structure.dependence_tests(sample, lambda s: s, np.random.default_rng(0), family=call["family"])
+    """Low ends by row and column: the squared form through the package's dependence test, the absolute form by
+    the package's own ``variance_tests``."""
+    rng = np.random.default_rng(0)
+    if form == "squared":
+        sample = structure.ResidualSample(squared_excess(call["noise"]), call["position"])
+        tests = structure.dependence_tests(sample, lambda s: s, rng, family=call["family"])
+    else:
+        sample = structure.ResidualSample([], {}, noise=call["noise"], noise_position=call["position"])
+        tests = structure.variance_tests(sample, call["base_mse"], rng, family=call["family"])
     out = []
     for t in tests:
         bar = max(structure.MIN_EXPLAINED, t["chance"])
-        out.append(
-            f"{t['variable'][:3]} {t['interval']['low']:.4f}{'*' if t['interval']['low'] > bar else ' '}"
-        )
+        name = t["variable"].removeprefix("variance_by_")[:3]
+        out.append(f"{name} {t['interval']['low']:.4f}{'*' if t['interval']['low'] > bar else ' '}")
     return " ".join(out)
 
 
