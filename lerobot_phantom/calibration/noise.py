@@ -147,8 +147,8 @@ def local_detail(image: np.ndarray) -> np.ndarray:
 
 
 def residual_samples(problem, fit: Fit, items: np.ndarray, seed: int) -> dict[int, NoiseSample]:
-    """Per pair: residuals on a seeded pixel sample at their predicted signal in linear light and their local
-    detail, clipped pixels left out."""
+    """Per pair: residuals on a seeded pixel sample at their sources' signal in linear light (the problem's
+    ``noise_sources``) and their local detail, clipped pixels left out."""
     rng = np.random.default_rng(seed)
     curve = tone_curve(fit)
     out = {}
@@ -159,7 +159,7 @@ def residual_samples(problem, fit: Fit, items: np.ndarray, seed: int) -> dict[in
         usable = np.flatnonzero(unclipped(image, measured))
         if len(usable) > SAMPLES_PER_PAIR:
             usable = np.sort(rng.choice(usable, SAMPLES_PER_PAIR, replace=False))
-        out[int(i)] = noise_sample(image, measured, usable, curve)
+        out[int(i)] = noise_sample(image, measured, usable, curve, problem.noise_sources(fit, int(i)))
     return out
 
 
@@ -169,13 +169,38 @@ def unclipped(predicted: np.ndarray, measured: np.ndarray) -> np.ndarray:
     return (predicted > CLIP_GUARD) & (predicted < 255.0 - CLIP_GUARD) & (measured > 0.5) & (measured < 254.5)
 
 
+# Where a predicted frame's sensor noise comes from: sensor values (grey levels, the frame's shape) and the weight
+# each carries into the frame's value there (a number or an array of the frame's shape). None: every value is its
+# own source, weight 1.
+NoiseSources = tuple[tuple[np.ndarray, np.ndarray | float], ...] | None
+
+
 def noise_sample(
-    predicted: np.ndarray, measured: np.ndarray, index: np.ndarray, curve: float | dict | None
+    predicted: np.ndarray,
+    measured: np.ndarray,
+    index: np.ndarray,
+    curve: float | dict | None,
+    sources: NoiseSources = None,
 ) -> NoiseSample:
     """The values at flat ``index`` of a predicted and a measured frame (grey levels, CHW) with their signal in
-    linear light through ``curve``, its slope and the predicted frame's local detail."""
+    linear light through ``curve``, its slope and the predicted frame's local detail.
+
+    A value computed after the sensor as a weighted sum of sensor values (``sources``: a colour map that
+    mis-decodes rows) carries their noise: variance ``sum w_k^2 J_k^2 (read + shot x_k)``. The sample's slope is
+    then ``sqrt(sum w_k^2 J_k^2)`` and its signal the ``w_k^2 J_k^2``-weighted mean of the ``x_k``, which keeps the
+    read and photon terms exact (the multiplicative term is read at that mean signal)."""
     values = predicted.ravel()[index]
-    signal, slope = linearise(values, curve)
+    if sources is None:
+        signal, slope = linearise(values, curve)
+    else:
+        spread, weighted_signal = np.zeros(len(index)), np.zeros(len(index))
+        for frame, weight in sources:
+            x, j = linearise(frame.ravel()[index], curve)
+            share = np.broadcast_to(weight, predicted.shape).ravel()[index] ** 2 * j**2
+            spread += share
+            weighted_signal += share * x
+        slope = np.sqrt(spread)
+        signal = np.divide(weighted_signal, spread, out=np.zeros_like(spread), where=spread > 0)
     return NoiseSample(
         signal, slope, local_detail(predicted).ravel()[index], measured.ravel()[index] - values
     )

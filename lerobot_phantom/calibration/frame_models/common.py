@@ -29,7 +29,7 @@ from lerobot_phantom.calibration.core import (
     fit_least_squares,
     further_starts,
 )
-from lerobot_phantom.calibration.noise import NoiseSample, noise_sample, tone_curve, unclipped
+from lerobot_phantom.calibration.noise import NoiseSample, NoiseSources, noise_sample, tone_curve, unclipped
 from lerobot_phantom.calibration.structure import LAG, NeighbourPairs, ResidualSample, line_terms
 from lerobot_phantom.transforms.physics import gaussian_spread
 
@@ -214,7 +214,7 @@ class FrameProblem(Problem):
                 sample.covariates["pattern_detail"].append(pattern_detail(pair.pattern)[c, y, x])
             for direction, terms in line_terms(residual, predicted).items():
                 sample.lines[direction].append(terms)
-            noise_sample, noise_position = self.noise_terms(fit, predicted, measured, (c, y, x))
+            noise_sample, noise_position = self.noise_terms(fit, int(i), predicted, measured, (c, y, x))
             sample.noise.append(noise_sample)
             for name, values in noise_position.items():
                 sample.noise_position.setdefault(name, []).append(values)
@@ -227,21 +227,28 @@ class FrameProblem(Problem):
                 sample.neighbours[name].pairs.append((a.ravel()[pick], b.ravel()[pick]))
         return sample
 
-    @staticmethod
     def noise_terms(
+        self,
         fit: Fit,
+        index: int,
         predicted: np.ndarray,
         measured: np.ndarray,
         where: tuple[np.ndarray, np.ndarray, np.ndarray],
     ) -> tuple[NoiseSample, dict[str, np.ndarray]]:
-        """The sensor-noise terms (``noise.NoiseSample``) of the sampled values ``where`` (channel, row, column) of a
-        pair's predicted and measured frames (grey levels) that are not clipped, and their row and column (0-1)."""
+        """The sensor-noise terms (``noise.NoiseSample``) of the sampled values ``where`` (channel, row, column) of
+        pair ``index``'s predicted and measured frames (grey levels) that are not clipped, and their row and column
+        (0-1)."""
         flat = np.ravel_multi_index(where, predicted.shape)
         flat = flat[unclipped(predicted.ravel()[flat], measured.ravel()[flat])]
         _, y, x = np.unravel_index(flat, predicted.shape)
         _, height, width = predicted.shape
-        sample = noise_sample(predicted, measured, flat, tone_curve(fit))
+        sample = noise_sample(predicted, measured, flat, tone_curve(fit), self.noise_sources(fit, index))
         return sample, {"row": y / max(height - 1, 1), "column": x / max(width - 1, 1)}
+
+    def noise_sources(self, fit: Fit, index: int) -> NoiseSources:
+        """Which sensor values pair ``index``'s predicted values carry the noise of (``noise.NoiseSources``): by
+        default each its own, as wherever the attack adds or removes light before the sensor counts it."""
+        return None
 
     @property
     def n_items(self) -> int:

@@ -7,6 +7,7 @@ import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import LatentFrameProblem
+from lerobot_phantom.calibration.noise import NoiseSources
 from lerobot_phantom.transforms import physics
 
 EM_EFFECTS = (
@@ -114,6 +115,24 @@ class EMStripFrames(LatentFrameProblem):
         mask = self.mask(fit.effects, fit.params, index, placement)
         mapped = physics.em_color_map(pair.clean.unsqueeze(0), fit.params["gain"], fit.params["offset"])[0]
         return mask * mapped + (1 - mask) * pair.clean
+
+    def noise_sources(self, fit: Fit, index: int) -> NoiseSources:
+        """Interference corrupts the decoding, after the sensor: a mis-decoded row's red and blue are its sensor
+        green times the map's gain, its green the mean of its sensor red and blue, and they carry those values'
+        noise so scaled (the paper's gain 2.5: 6.25 times the variance, read at green's signal, not at the brighter
+        value shown). The clean frame the prediction maps carries its noise the same way."""
+        pair = self.pairs[index]
+        placement = self.placements(fit.effects, fit.params, [index])[index]
+        rows = self.mask(fit.effects, fit.params, index, placement)[0, :, 0].bool().numpy()
+        clean = 255.0 * pair.clean.numpy()
+        first, first_weight = clean.copy(), np.ones_like(clean)
+        second, second_weight = clean.copy(), np.zeros_like(clean)
+        first[0, rows] = first[2, rows] = clean[1, rows]
+        first[1, rows] = clean[0, rows]
+        first_weight[0, rows] = first_weight[2, rows] = fit.params["gain"]
+        first_weight[1, rows] = second_weight[1, rows] = 0.5
+        second[1, rows] = clean[2, rows]
+        return (first, first_weight), (second, second_weight)
 
     # Colour maps the alternating fit starts from: the paper's, and the one demosaicing with the colour-filter
     # phase off by one gives (green read as red and blue, their mean as green: gain 1, offset 0). The map is
