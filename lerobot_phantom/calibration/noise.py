@@ -15,6 +15,10 @@ unit of linear light), and its variance is modelled as
 - ``detail * D``: compression (JPEG) and resampling error, added in output units where the image has detail: ``D``
   is the local variance of the predicted frame (3x3), so flat regions carry none of it.
 
+A value the attack computes after the sensor from other sensor values (the EM colour strip's mis-decoded rows:
+red read from green times 2.5) carries their noise, weighted, and is read at them, not at the value it shows
+(``noise_sample``'s ``sources``, from the frame model's ``noise_sources``).
+
 Noise added after the tone curve in any other form (not a sensor's) is outside this model: under an sRGB curve a
 constant output-unit noise has nearly the shape of photon noise (``J^2 x`` is almost flat) and would be read as it.
 

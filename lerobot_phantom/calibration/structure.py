@@ -394,8 +394,9 @@ def variance_tests(
     carry eta2, so an item bootstrap without the strongest pair loses it: on camsim's strip speckle (ten master
     seeds) their low end was 0.0135-0.0376, four under the floor, the absolute form's 0.0619-0.1107; of 70 null
     cases two are above the floor with the absolute form, one with squares, all EM colour strips (the colour map
-    multiplies the noise of the rows it decodes, which a noise model of the signal alone does not place;
-    docs/bench/session73/variance_statistic*.txt). Only position is tested, since the paper's digital forms scale
+    multiplies the noise of the rows it decodes: docs/bench/session73/variance_statistic*.txt; read at the sensor
+    values the map took, ``FrameProblem.noise_sources``, one of the two stays above it, its excess not on the
+    decoded rows: docs/bench/session74.md). Only position is tested, since the paper's digital forms scale
     the attacked frame's noise with the intensity (a blend by 1 - a) and demosaicing gives green less noise than
     red and blue (eta2 up to 0.04 by intensity or channel on the independent simulator's null cases, at most 0.008
     by row or column: docs/bench/session46/variance_probe.txt, squared form). The size of a finding: a bin whose
