@@ -31,7 +31,11 @@ def summary(report_path: Path, tally: dict, side: str, case: str) -> str:
         for r in report["noise"].get("reasons", [])
     )
     counts.setdefault("named", []).append(named)
-    return f"{named:18s} {found:44s} row {lows.get('row', float('nan')):.4f} col {lows.get('col', float('nan')):.4f} {noise}"
+    share = report["noise"].get("shot_share_beside_gain", {}).get("estimate", float("nan"))
+    return (
+        f"{named:18s} {found:44s} row {lows.get('row', float('nan')):.4f} col {lows.get('col', float('nan')):.4f} "
+        f"{noise} (photon share beside the multiplicative term {share:.2f})"
+    )
 
 
 def main() -> None:
