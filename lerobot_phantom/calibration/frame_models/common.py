@@ -247,7 +247,8 @@ class FrameProblem(Problem):
 
     def noise_sources(self, fit: Fit, index: int) -> NoiseSources:
         """Which sensor values pair ``index``'s predicted values carry the noise of (``noise.NoiseSources``): by
-        default each its own, as wherever the attack adds or removes light before the sensor counts it."""
+        default each its own, as where the attack adds or removes light before the sensor counts it or moves values
+        unchanged after it (EM truncation's rows); a frame model whose values are mixed after the sensor says so."""
         return None
 
     @property
