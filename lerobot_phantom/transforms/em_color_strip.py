@@ -395,6 +395,7 @@ class EMColorStrip(CameraAttack):
         gain: float = GREEN_GAIN,
         offset: float = GREEN_OFFSET,
         max_fraction: float = 0.75,
+        demosaic_pattern: str | None = None,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
@@ -405,6 +406,14 @@ class EMColorStrip(CameraAttack):
             raise ValueError(f"unknown EM color strip model {model!r}; valid: 'paper', 'bayer_phase_flip'")
         if not (0.0 < max_fraction <= 1.0):
             raise ValueError(f"max_fraction must lie in (0, 1], got {max_fraction!r}")
+        # demosaic_pattern (a colour-filter tile, lerobot-phantom-calibrate's bayer_demosaic): mis-decoded rows are
+        # the demosaic after a lost line with the map's gain and offset, in either model, instead of the map of
+        # each pixel; the paper's bands then use ``gain`` and ``offset`` too
+        if demosaic_pattern is not None and demosaic_pattern not in physics.BAYER_PATTERNS:
+            raise ValueError(
+                f"unknown demosaic_pattern {demosaic_pattern!r}; valid: None, {', '.join(physics.BAYER_PATTERNS)}"
+            )
+        self.demosaic_pattern = demosaic_pattern
         self.model = model
         self.bayer = {"gain": float(gain), "offset": float(offset), "max_fraction": float(max_fraction)}
         if num_stripes is not None and int(num_stripes) < 1:
@@ -455,12 +464,28 @@ class EMColorStrip(CameraAttack):
             mask = physics.bayer_flip_mask(
                 height, params["start_fraction"].to(x.device) * height, device=x.device
             )
-            wrong = physics.em_color_map(x, self.bayer["gain"], self.bayer["offset"])
-            return torch.lerp(x, wrong, mask.to(x.dtype)).clamp_(0.0, 1.0)
+            return torch.lerp(x, self._mis_decoded(x), mask.to(x.dtype)).clamp_(0.0, 1.0)
+        if self.demosaic_pattern is not None:
+            weights = _row_weights(
+                x.shape[-2],
+                x.shape[0],
+                x.device,
+                params["num_stripes"],
+                params["band_fraction"],
+                params["next_num_stripes"],
+                params["mix"],
+            )
+            return torch.lerp(x, self._mis_decoded(x), weights.to(x.dtype)[:, None, :, None]).clamp_(0.0, 1.0)
         return self._apply_paper(x, params)
 
+    def _mis_decoded(self, x: torch.Tensor) -> torch.Tensor:
+        gain, offset = self.bayer["gain"], self.bayer["offset"]
+        if self.demosaic_pattern is None:
+            return physics.em_color_map(x, gain, offset)
+        return physics.em_demosaic_colour_map(x, self.demosaic_pattern, gain, offset)
+
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.model == "bayer_phase_flip":
+        if self.model == "bayer_phase_flip" or self.demosaic_pattern is not None:
             return NotImplemented
         return self._apply_paper(x, params)
 
@@ -470,6 +495,8 @@ class EMColorStrip(CameraAttack):
         )
 
     def extra_repr(self) -> str:
-        return super().extra_repr() + (
-            "" if self.num_stripes is None else f", num_stripes={self.num_stripes}"
+        return (
+            super().extra_repr()
+            + ("" if self.num_stripes is None else f", num_stripes={self.num_stripes}")
+            + ("" if self.demosaic_pattern is None else f", demosaic_pattern={self.demosaic_pattern!r}")
         )

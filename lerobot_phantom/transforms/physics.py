@@ -685,6 +685,66 @@ def em_color_map(
     return torch.cat([swapped, mixed, swapped], dim=1).clamp(0.0, 1.0)
 
 
+# colour of each site of a 2x2 colour-filter tile, row by row (0 red, 1 green, 2 blue), by its usual name
+BAYER_PATTERNS: dict[str, tuple[tuple[int, int], tuple[int, int]]] = {
+    "RGGB": ((0, 1), (1, 2)),
+    "GRBG": ((1, 0), (2, 1)),
+    "GBRG": ((1, 2), (0, 1)),
+    "BGGR": ((2, 1), (1, 0)),
+}
+# bilinear interpolation weights: red and blue sites lie on a square lattice of pitch 2, green on a quincunx
+_BILINEAR_RED_BLUE = ((1.0, 2.0, 1.0), (2.0, 4.0, 2.0), (1.0, 2.0, 1.0))
+_BILINEAR_GREEN = ((0.0, 1.0, 0.0), (1.0, 4.0, 1.0), (0.0, 1.0, 0.0))
+
+
+def demosaic_after_lost_line(x: torch.Tensor, pattern: str = "RGGB") -> torch.Tensor:
+    """The frame an ISP demosaics when the link lost the line above it: ``(B, 3, H, W)`` in, same out.
+
+    The sensor samples one colour per site (``pattern``, the colour-filter tile); a line lost on the bus moves
+    every later raw line up by one, so each site holds the sample of the site below it, which sits under another
+    filter (a red site holds a green sample, a green site between reds a blue one); the ISP, not knowing, fills in
+    each channel by bilinear interpolation of the sites it believes carry that colour. So every row's colours are
+    interpolated from the next row's samples on the wrong sites: red and blue from green, green from red and blue,
+    each mixed with the neighbours' values (edges get colour fringes a per-pixel colour map does not make). The
+    mosaic is read from the frame's own values, the ISP's output, so this is the paper's colour swap with the
+    demosaic's spatial form (GlitchHiker, Jiang et al. 2023; paper, Method). Borders are mirrored, which keeps
+    the tile's phase; the last raw line is read twice (nothing arrives after it), so the last row keeps its own
+    samples.
+    """
+    if pattern not in BAYER_PATTERNS:
+        raise ValueError(f"unknown colour-filter pattern {pattern!r}; valid: {', '.join(BAYER_PATTERNS)}")
+    _, _, height, width = x.shape
+    tile = torch.tensor(BAYER_PATTERNS[pattern], device=x.device)
+    sites = tile[torch.arange(height, device=x.device) % 2][:, torch.arange(width, device=x.device) % 2]
+    raw = x.gather(1, sites.expand(x.shape[0], 1, height, width))
+    raw = raw[:, :, torch.clamp(torch.arange(height, device=x.device) + 1, max=height - 1)]
+    masks = torch.stack([sites == c for c in range(3)]).to(x.dtype).unsqueeze(0)  # (1, 3, H, W)
+    kernels = torch.tensor(
+        (_BILINEAR_RED_BLUE, _BILINEAR_GREEN, _BILINEAR_RED_BLUE), dtype=x.dtype, device=x.device
+    ).unsqueeze(1)
+    # normalised convolution: each channel's weighted sum of the sites that carry it over the sum of their weights
+    sums = F.conv2d(F.pad(raw * masks, (1, 1, 1, 1), mode="reflect"), kernels, groups=3)
+    weights = F.conv2d(F.pad(masks, (1, 1, 1, 1), mode="reflect"), kernels, groups=3)
+    return sums / weights
+
+
+def em_demosaic_colour_map(
+    x: torch.Tensor,
+    pattern: str,
+    gain: float | torch.Tensor = 2.5,
+    offset: float | torch.Tensor = 50.0 / 255.0,
+) -> torch.Tensor:
+    """``em_color_map`` with the demosaic's spatial form: red and blue ``gain`` times the mis-phased demosaic's
+    red and blue (interpolated green samples), green its green (interpolated red and blue) minus ``offset``. On a
+    frame of one colour its red and blue are ``em_color_map``'s and its green is, averaged over each 2x2 tile: the
+    green sites keep their own red or blue sample, a zipper the per-pixel map smooths away."""
+    wrong = demosaic_after_lost_line(x, pattern)
+    gain_, offset_ = _as(gain, wrong[:, :1]), _as(offset, wrong[:, :1])
+    return torch.cat([gain_ * wrong[:, 0:1], wrong[:, 1:2] - offset_, gain_ * wrong[:, 2:3]], dim=1).clamp(
+        0.0, 1.0
+    )
+
+
 def periodic_band_mask(
     height: int, period_rows: float | torch.Tensor, phase_rows: float | torch.Tensor = 0.0, *, device=None
 ) -> torch.Tensor:

@@ -172,3 +172,18 @@ def test_calibration_to_attack_end_to_end(tmp_path):
     assert len(changed_rows) > 0 and int(changed_rows.min()) > 0
     # the flip runs to the frame's end: every row after the first changed one may differ, none before
     assert int(changed_rows.max()) >= x.shape[-2] - 8
+
+
+def test_a_calibrated_demosaic_reaches_the_paper_bands(tmp_path):
+    """``bayer_demosaic`` named on the paper's bands: calibrated.json carries the tile and the fitted colours, and
+    the attack mis-decodes its bands through the demosaic with them."""
+    from lerobot_phantom.transforms.em_color_strip import EMColorStrip
+
+    kwargs = {"gain": 1.1, "offset": 0.02, "demosaic_pattern": "GBRG"}
+    attack = make_attack(
+        "em_color_strip", intensity=0.7, calibration=str(write(tmp_path, "em_color_strip", kwargs)), seed=4
+    )
+    assert (attack.model, attack.demosaic_pattern, attack.bayer["gain"]) == ("paper", "GBRG", 1.1)
+    x = scene(2)
+    torch.testing.assert_close(attack(x), EMColorStrip(0.7, seed=4, **kwargs)(x))
+    assert not torch.allclose(attack(x), EMColorStrip(0.7, seed=4)(x))

@@ -1,7 +1,12 @@
-"""EM colour strip frame model: the colour-map fit must not stay at a start where the clamped map saturates."""
+"""EM colour strip frame model: the colour-map fit must not stay at a start where the clamped map saturates; the
+demosaic form (``bayer_demosaic``) finds the colour-filter tile of frames an independent simulator mis-decodes
+from its raw mosaic, and loses to the map where the map made the frames."""
 
 from __future__ import annotations
 
+import os
+
+import camsim as cs
 import numpy as np
 import pytest
 import torch
@@ -32,3 +37,34 @@ def test_colour_map_is_recovered_where_the_papers_map_saturates(gain, offset):
     fit = EMStripFrames(pairs, seed=0).fit(frozenset({"bayer_phase_flip"}), np.arange(len(pairs)))
     assert fit.params["gain"] == pytest.approx(gain, abs=0.02)
     assert fit.params["offset"] == pytest.approx(offset, abs=0.01)
+
+
+def lost_line_pairs(seed: int) -> list[Pair]:
+    """camsim's single lost line: its RGGB raw lines moved up by one from a random row, then its own bilinear
+    demosaic, tone curve, noise and JPEG (not the package's forms)."""
+    frames = cs.em_strip_pairs(np.random.default_rng(seed), cs.Camera(), 8, lost_lines="single")
+    as_tensor = lambda image: torch.from_numpy(image.transpose(2, 0, 1) / 255.0)  # noqa: E731
+    return [
+        Pair(f"pair_{i}", as_tensor(f.clean), as_tensor(f.attacked), None, f.intensity)
+        for i, f in enumerate(frames)
+    ]
+
+
+def test_the_demosaic_form_finds_the_simulators_tile_and_halves_the_residual_variance():
+    seed = int(os.environ["CAMSIM_SEED"])  # fresh per run (tests/conftest.py)
+    pairs = lost_line_pairs(seed)
+    problem, items = EMStripFrames(pairs, seed=0), np.arange(len(pairs))
+    colour_map = problem.fit(frozenset({"bayer_phase_flip"}), items)
+    demosaic = problem.fit(frozenset({"bayer_phase_flip", "bayer_demosaic"}), items)
+    assert demosaic.extra["pattern"] == "RGGB", f"replay with CAMSIM_SEED={seed}"
+    assert problem.transform_kwargs(demosaic)["demosaic_pattern"] == "RGGB"
+    ratio = demosaic.extra["noise_variance"] / colour_map.extra["noise_variance"]
+    assert ratio < 0.5, f"residual variance ratio {ratio:.3f}; replay with CAMSIM_SEED={seed}"
+
+
+def test_the_demosaic_form_loses_to_the_map_on_frames_the_map_made():
+    pairs = bright_flipped_pairs(1.2, 0.05)
+    problem, items = EMStripFrames(pairs, seed=0), np.arange(len(pairs))
+    colour_map = problem.fit(frozenset({"bayer_phase_flip"}), items)
+    demosaic = problem.fit(frozenset({"bayer_phase_flip", "bayer_demosaic"}), items)
+    assert demosaic.extra["noise_variance"] > 2 * colour_map.extra["noise_variance"]

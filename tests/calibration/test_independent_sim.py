@@ -230,11 +230,10 @@ CASES = [
         "em_strip_bayer_flip",
         "em_color_strip",
         "effect",
-        # the library's bayer_phase_flip is one lost line whose wrong phase runs to the frame's end; bands of
-        # flipped rows (a second lost line restoring the phase) are the paper's geometry with the demosaicing
-        # colours, which the base (band period, phase and colour map fitted) already is: em_strip_bayer_bands
+        # the library's bayer_phase_flip is one lost line whose wrong phase runs to the frame's end, and camsim
+        # demosaics the moved raw lines (bayer_demosaic; before session 75 the library had only the colour map)
         lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS, lost_lines="single"),
-        planted=frozenset({"bayer_phase_flip"}),
+        planted=frozenset({"bayer_phase_flip", "bayer_demosaic"}),
     ),
     # EM truncation
     Case(
@@ -305,8 +304,11 @@ CASES = [
     Case(
         "em_strip_bayer_bands",
         "em_color_strip",
-        "null",
+        # bands of rows demosaiced after a lost line (a second one restores the phase): the paper's geometry,
+        # the demosaic's form (a null until session 75, when the library had only the paper's colour map)
+        "effect",
         lambda rng, cam: cs.em_strip_pairs(rng, cam, N_PAIRS, lost_lines="banded"),
+        planted=frozenset({"bayer_demosaic"}),
     ),
     # an effect the library lacks for the three attacks that had none (session 46): the paper's digital forms (the
     # nulls) with a physical effect on top, so all that is left to find is the unnamed one

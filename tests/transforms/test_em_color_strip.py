@@ -256,3 +256,34 @@ def test_a_last_band_whose_period_runs_past_the_frame_is_corrupted_exactly(num_s
     out = em_color_strip(images, num_stripes)
     for i in range(2):
         torch.testing.assert_close(out[i], _reference(images[i], num_stripes), atol=0, rtol=0)
+
+
+@pytest.mark.parametrize("model", ["paper", "bayer_phase_flip"])
+def test_a_demosaic_pattern_mis_decodes_the_same_rows_through_the_demosaic_after_a_lost_line(model):
+    """The rows the model mis-decodes show ``physics.em_demosaic_colour_map`` of the frame (the calibrated
+    ``bayer_demosaic``), the other rows are untouched, per sample in a batch, for uint8 and float, picklable."""
+    from lerobot_phantom.transforms import physics
+
+    frames = torch.rand(3, 3, 24, 20, generator=torch.Generator().manual_seed(5))
+    options = {"model": model, "gain": 1.3, "offset": 0.02}
+    plain = EMColorStrip((0.1, 1.0), **options)
+    demosaicing = pickle.loads(pickle.dumps(EMColorStrip((0.1, 1.0), **options, demosaic_pattern="GRBG")))
+    params = demosaicing.sample_params(3, 24, 20, generator=torch.Generator().manual_seed(1))
+    assert len(set(params["intensity"].tolist())) == 3
+    if model == "paper":
+        keys = ("num_stripes", "band_fraction", "next_num_stripes", "mix")
+        weights = em_color_strip_module._row_weights(24, 3, frames.device, *(params[k] for k in keys))
+        rows = weights[:, None, :, None].float().expand_as(frames)
+    else:
+        rows = (plain.apply_params(frames, params) != frames).any(1, keepdim=True).expand_as(frames).float()
+    expected = torch.lerp(frames, physics.em_demosaic_colour_map(frames, "GRBG", 1.3, 0.02), rows)
+    out = demosaicing.apply_params(frames, params)
+    torch.testing.assert_close(out, expected)
+    rows_per_sample = rows[:, 0, :, 0].sum(1)
+    assert rows_per_sample.min() > 0 and rows_per_sample.max() < 24
+    if model == "bayer_phase_flip":
+        assert not torch.allclose(out, plain.apply_params(frames, params))
+    as_uint8 = demosaicing.apply_params((frames * 255).round().to(torch.uint8), params)
+    assert as_uint8.dtype == torch.uint8 and _mad(as_uint8, expected * 255) < 1.0
+    with pytest.raises(ValueError, match="valid: None, RGGB, GRBG, GBRG, BGGR"):
+        EMColorStrip(demosaic_pattern="rggb")

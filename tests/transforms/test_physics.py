@@ -229,6 +229,49 @@ def test_em_colour_map_and_masks():
     assert bands.flatten().tolist() == [1, 1, 0, 0, 1, 1, 0, 0]
 
 
+# OpenCV names a Bayer pattern by the second row's two first sites (its BG is the RGGB tile)
+OPENCV_BAYER = {
+    "RGGB": "COLOR_BayerBG2RGB",
+    "GRBG": "COLOR_BayerGB2RGB",
+    "GBRG": "COLOR_BayerGR2RGB",
+    "BGGR": "COLOR_BayerRG2RGB",
+}
+
+
+@pytest.mark.parametrize("pattern", list(physics.BAYER_PATTERNS))
+def test_demosaic_after_a_lost_line_is_opencvs_bilinear_demosaic_of_the_raw_lines_moved_up(pattern):
+    """Mosaic the frame with the tile, move the raw lines up by one, demosaic: OpenCV's bilinear demosaic of the
+    same mosaic (16-bit) agrees inside the frame's one-pixel border (OpenCV's border rule differs)."""
+    cv2 = pytest.importorskip("cv2")
+    rng = np.random.default_rng(4)
+    frame = rng.uniform(size=(3, 12, 14))
+    tile = np.array(physics.BAYER_PATTERNS[pattern])
+    sites = tile[np.arange(12)[:, None] % 2, np.arange(14)[None, :] % 2]
+    raw = np.take_along_axis(frame, sites[None], 0)[0]
+    moved_up = np.concatenate([raw[1:], raw[-1:]])
+    expected = cv2.cvtColor(np.round(moved_up * 65535).astype(np.uint16), getattr(cv2, OPENCV_BAYER[pattern]))
+    expected = expected.astype(np.float64).transpose(2, 0, 1) / 65535
+    got = physics.demosaic_after_lost_line(torch.from_numpy(frame).unsqueeze(0), pattern)[0].numpy()
+    assert np.abs(got - expected)[:, 1:-2, 1:-1].max() < 1e-4
+    # red sites now hold the green sample of the site below, which they keep
+    red_sites = sites == 0
+    assert np.allclose(got[0][:-1][red_sites[:-1]], frame[1][1:][red_sites[:-1]])
+
+
+@pytest.mark.parametrize("pattern", list(physics.BAYER_PATTERNS))
+def test_the_demosaic_colour_map_of_one_colour_is_the_papers_map_with_a_green_zipper(pattern):
+    colour = torch.tensor([0.2, 0.3, 0.5], dtype=torch.float64).reshape(1, 3, 1, 1)
+    frame = colour.expand(1, 3, 6, 8)
+    mapped = physics.em_demosaic_colour_map(frame, pattern, 2.0, 0.1)[..., :-2, :]  # above the last raw line
+    paper = physics.em_color_map(colour, 2.0, 0.1)
+    assert torch.allclose(mapped[:, [0, 2]], paper[:, [0, 2]].expand_as(mapped[:, [0, 2]]))
+    green = mapped[0, 1]
+    assert set(np.round(green.unique().numpy(), 9)) == {0.1, 0.25, 0.4}  # blue or red kept, or their mean
+    assert torch.allclose(green.reshape(2, 2, 4, 2).mean((1, 3)), paper[0, 1, 0, 0].expand(2, 4))
+    with pytest.raises(ValueError, match="valid: RGGB, GRBG, GBRG, BGGR"):
+        physics.demosaic_after_lost_line(frame, "RGBG")
+
+
 def test_a_recording_that_does_not_drift_is_the_interior_rule_and_a_whole_period_is_the_lit_rule():
     """Phase drift bridges the two frame rules: a locked phase (drift 0) sees the whole stripes the interior rule
     counts, exactly; a phase that covers the whole period (drift 1) any phase, as the lit rule does (to the

@@ -17,6 +17,13 @@ EM_EFFECTS = (
         "the colour-filter phase off by one, so the wrong colours run from that row to the frame's end instead "
         "of alternating in periodic bands",
     ),
+    Effect(
+        "bayer_demosaic",
+        "a lost line moves the later raw lines up by one, so the ISP interpolates each mis-decoded row's colours "
+        "from the next row's samples on the wrong colour sites (a bilinear demosaic of the Bayer mosaic, colour "
+        "filter tile fitted): red and blue from its neighbours' green, green alternating between red and blue "
+        "samples, with colour fringes at edges, not the paper's colour map of each pixel",
+    ),
 )
 
 
@@ -33,6 +40,31 @@ class EMStripFrames(LatentFrameProblem):
     candidates = EM_EFFECTS
     periods = tuple(np.linspace(0.04, 1.0, 49))  # band period as a share of the frame height
     latent = "band phase or flip row of each frame (when the interference hits)"
+
+    def __init__(self, pairs, seed: int) -> None:
+        super().__init__(pairs, seed)
+        self._demosaiced: dict[tuple[int, str], torch.Tensor] = {}
+
+    def demosaiced(self, index: int, pattern: str) -> torch.Tensor:
+        """Pair ``index``'s clean frame demosaiced after a lost line with colour-filter tile ``pattern`` (fixed
+        by the frame, so computed once)."""
+        key = (index, pattern)
+        if key not in self._demosaiced:
+            clean = self.pairs[index].clean.unsqueeze(0)
+            self._demosaiced[key] = physics.demosaic_after_lost_line(clean, pattern)[0]
+        return self._demosaiced[key]
+
+    def mis_decoded(
+        self, fit_effects, params, pattern: str | None, index: int, rows=slice(None)
+    ) -> torch.Tensor:
+        """The colours pair ``index``'s ``rows`` show when mis-decoded: the paper's map of each pixel, or with
+        ``bayer_demosaic`` the map's gain and offset on the demosaic after a lost line."""
+        pair = self.pairs[index]
+        if "bayer_demosaic" not in fit_effects:
+            return physics.em_color_map(pair.clean[:, rows].unsqueeze(0), params["gain"], params["offset"])[0]
+        wrong = self.demosaiced(index, pattern)[:, rows]
+        gain, offset = params["gain"], params["offset"]
+        return torch.cat([gain * wrong[0:1], wrong[1:2] - offset, gain * wrong[2:3]]).clamp(0.0, 1.0)
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         specs = [Param("gain", 2.5, 0.0, 10.0), Param("offset", 50.0 / 255.0, -1.0, 1.0, 0.1)]
@@ -61,7 +93,7 @@ class EMStripFrames(LatentFrameProblem):
         return np.concatenate([[0.0], np.cumsum(keep)]) + np.concatenate([np.cumsum(swap[::-1])[::-1], [0.0]])
 
     def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
-        keep, swap = self.row_costs(fit.params, index)
+        keep, swap = self.row_costs(fit.effects, fit.params, index, fit.extra.get("pattern"))
         if "bayer_phase_flip" in fit.effects:
             sse = self.flip_row_costs(keep, swap)
         else:
@@ -71,9 +103,9 @@ class EMStripFrames(LatentFrameProblem):
             return sse, weights
         return sse, np.full(len(sse), 1.0 / len(sse))
 
-    def row_costs(self, params, index: int) -> tuple[np.ndarray, np.ndarray]:
+    def row_costs(self, effects, params, index: int, pattern: str | None) -> tuple[np.ndarray, np.ndarray]:
         pair = self.pairs[index]
-        mapped = physics.em_color_map(pair.clean.unsqueeze(0), params["gain"], params["offset"])[0]
+        mapped = self.mis_decoded(effects, params, pattern, index)
         keep = ((pair.attacked - pair.clean) ** 2).sum(dim=(0, 2)).numpy()
         swap = ((pair.attacked - mapped) ** 2).sum(dim=(0, 2)).numpy()
         return keep, swap
@@ -90,11 +122,11 @@ class EMStripFrames(LatentFrameProblem):
         start = int(np.argmin(costs))
         return float(costs[start]), start
 
-    def placements(self, effects, params, items) -> dict[int, tuple[str, float]]:
+    def placements(self, effects, params, items, pattern: str | None = None) -> dict[int, tuple[str, float]]:
         """Per-frame placement (band phase or flip row) registered on each frame: fit frames, figures."""
         out = {}
         for i in items:
-            keep, swap = self.row_costs(params, int(i))
+            keep, swap = self.row_costs(effects, params, int(i), pattern)
             if "bayer_phase_flip" in effects:
                 out[int(i)] = ("flip", float(self.best_flip_row(keep, swap)[1]))
             else:
@@ -110,19 +142,22 @@ class EMStripFrames(LatentFrameProblem):
         return physics.periodic_band_mask(height, params["period"] * height, value)[0].double()
 
     def predict_registered(self, fit: Fit, index: int) -> torch.Tensor:
-        placement = self.placements(fit.effects, fit.params, [index])[index]
+        pattern = fit.extra.get("pattern")
+        placement = self.placements(fit.effects, fit.params, [index], pattern)[index]
         pair = self.pairs[index]
         mask = self.mask(fit.effects, fit.params, index, placement)
-        mapped = physics.em_color_map(pair.clean.unsqueeze(0), fit.params["gain"], fit.params["offset"])[0]
+        mapped = self.mis_decoded(fit.effects, fit.params, pattern, index)
         return mask * mapped + (1 - mask) * pair.clean
 
     def noise_sources(self, fit: Fit, index: int) -> NoiseSources:
         """Interference corrupts the decoding, after the sensor: a mis-decoded row's red and blue are its sensor
         green times the map's gain, its green the mean of its sensor red and blue, and they carry those values'
         noise so scaled (the paper's gain 2.5: 6.25 times the variance, read at green's signal, not at the brighter
-        value shown). The clean frame the prediction maps carries its noise the same way."""
+        value shown). The clean frame the prediction maps carries its noise the same way. With ``bayer_demosaic``
+        the same weights stand for the interpolated samples (not traced: an interpolation of two to four samples
+        carries less of their noise, and the clean frame's own demosaic already averaged it)."""
         pair = self.pairs[index]
-        placement = self.placements(fit.effects, fit.params, [index])[index]
+        placement = self.placements(fit.effects, fit.params, [index], fit.extra.get("pattern"))[index]
         rows = self.mask(fit.effects, fit.params, index, placement)[0, :, 0].bool().numpy()
         clean = 255.0 * pair.clean.numpy()
         first, first_weight = clean.copy(), np.ones_like(clean)
@@ -143,19 +178,24 @@ class EMStripFrames(LatentFrameProblem):
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         if start is not None and start.effects == effects:
-            # a refit of the same model (bootstrap draws)
-            return self._fit_from(effects, items, dict(start.params), rounds=1)
+            # a refit of the same model (bootstrap draws): the colour-filter tile too is the estimate's
+            return self._fit_from(effects, items, dict(start.params), start.extra.get("pattern"), rounds=1)
+        # the tile is a property of the sensor, one of four: each is fitted and the fit items choose
+        patterns = tuple(physics.BAYER_PATTERNS) if "bayer_demosaic" in effects else (None,)
         fits = [
-            self._fit_from(effects, items, {**colour, "period": 0.25}, rounds=3)
+            self._fit_from(effects, items, {**colour, "period": 0.25}, pattern, rounds=3)
+            for pattern in patterns
             for colour in self.COLOUR_STARTS
         ]
         return min(fits, key=lambda fit: fit.extra["noise_variance"])  # the registered SSE over ``items``
 
-    def _fit_from(self, effects: frozenset[str], items: np.ndarray, params: dict, rounds: int) -> Fit:
+    def _fit_from(
+        self, effects: frozenset[str], items: np.ndarray, params: dict, pattern: str | None, rounds: int
+    ) -> Fit:
         """Alternate ``rounds`` times: placement given the colour map, colour map given the placement."""
         for _ in range(rounds):
             if "bayer_phase_flip" not in effects:
-                row_costs = [self.row_costs(params, int(i)) for i in items]
+                row_costs = [self.row_costs(effects, params, int(i), pattern) for i in items]
 
                 def total(period, row_costs=row_costs):
                     return sum(
@@ -169,7 +209,7 @@ class EMStripFrames(LatentFrameProblem):
                     max(coarse - step, self.periods[0]), min(coarse + step, self.periods[-1]), 11
                 )
                 params["period"] = float(min(fine, key=total))
-            placement = self.placements(effects, params, items)
+            placement = self.placements(effects, params, items, pattern)
             masks = {
                 int(i): self.mask(effects, params, int(i), placement[int(i)])[0, :, 0].bool() for i in items
             }
@@ -177,13 +217,10 @@ class EMStripFrames(LatentFrameProblem):
             def residuals(p, masks=masks):
                 parts = []
                 for i in items:
-                    pair = self.pairs[int(i)]
                     rows = masks[int(i)]
                     if rows.any():
-                        mapped = physics.em_color_map(
-                            pair.clean[:, rows].unsqueeze(0), p["gain"], p["offset"]
-                        )[0]
-                        parts.append((mapped - pair.attacked[:, rows]).ravel())
+                        mapped = self.mis_decoded(effects, p, pattern, int(i), rows)
+                        parts.append((mapped - self.pairs[int(i)].attacked[:, rows]).ravel())
                 return torch.cat(parts) if parts else torch.zeros(1, dtype=torch.float64)
 
             colour = fit_least_squares(
@@ -193,12 +230,18 @@ class EMStripFrames(LatentFrameProblem):
             params.update(colour)
         if "bayer_phase_flip" in effects:
             params.pop("period", None)
-        fit = Fit(effects, params)
+        fit = Fit(effects, params, {} if pattern is None else {"pattern": pattern})
         fit.extra["noise_variance"] = self.noise_variance(fit, items)
         return fit
 
+    def derived(self, fit: Fit) -> dict:
+        return {"colour_filter_tile": fit.extra["pattern"]} if "bayer_demosaic" in fit.effects else {}
+
     def transform_kwargs(self, fit: Fit) -> dict:
-        """``EMColorStrip`` options: the Bayer-flip model with the fitted colour map (the paper's bands: none)."""
+        """``EMColorStrip`` options: the Bayer-flip model with the fitted colour map, with ``bayer_demosaic`` the
+        demosaic's tile (the paper's bands: none, or with ``bayer_demosaic`` the tile and the fitted colour map)."""
+        demosaic = {"demosaic_pattern": fit.extra["pattern"]} if "bayer_demosaic" in fit.effects else {}
+        colours = {"gain": fit.params["gain"], "offset": fit.params["offset"]}
         if "bayer_phase_flip" in fit.effects:
-            return {"model": "bayer_phase_flip", "gain": fit.params["gain"], "offset": fit.params["offset"]}
-        return {}
+            return {"model": "bayer_phase_flip", **colours, **demosaic}
+        return {**colours, **demosaic} if demosaic else {}
