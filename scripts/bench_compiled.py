@@ -169,15 +169,7 @@ def _strip(attack, params, x):
 
 
 def _stripe_rows(attack, params, x):
-    weights = ecs._row_weights(
-        x.shape[-2],
-        x.shape[0],
-        x.device,
-        params["num_stripes"],
-        params["band_fraction"],
-        params["next_num_stripes"],
-        params["mix"],
-    )
+    weights = ecs.row_weights_of(x, params)
     if not bool(((weights == 0) | (weights == 1)).all()):
         raise ValueError("the benchmark's EM color strip graph covers whole-row patterns (levels, 'random')")
     return (x, (weights > 0)[:, None, :, None])

@@ -156,6 +156,12 @@ def _row_weights(
     return weights
 
 
+def row_weights_of(x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
+    """Per-row corruption weights ``(batch, height)`` of the paper's bands for the transform's ``params`` on ``x``."""
+    keys = ("num_stripes", "band_fraction", "next_num_stripes", "mix")
+    return _row_weights(x.shape[-2], x.shape[0], x.device, *(params[k] for k in keys))
+
+
 def _runs(row_weights: list[float]) -> list[tuple[int, int]]:
     """``[start, stop)`` runs of fully corrupted rows."""
     runs, start = [], None
@@ -466,16 +472,8 @@ class EMColorStrip(CameraAttack):
             )
             return torch.lerp(x, self._mis_decoded(x), mask.to(x.dtype)).clamp_(0.0, 1.0)
         if self.demosaic_pattern is not None:
-            weights = _row_weights(
-                x.shape[-2],
-                x.shape[0],
-                x.device,
-                params["num_stripes"],
-                params["band_fraction"],
-                params["next_num_stripes"],
-                params["mix"],
-            )
-            return torch.lerp(x, self._mis_decoded(x), weights.to(x.dtype)[:, None, :, None]).clamp_(0.0, 1.0)
+            weights = row_weights_of(x, params).to(x.dtype)[:, None, :, None]
+            return torch.lerp(x, self._mis_decoded(x), weights).clamp_(0.0, 1.0)
         return self._apply_paper(x, params)
 
     def _mis_decoded(self, x: torch.Tensor) -> torch.Tensor:

@@ -271,9 +271,9 @@ def test_a_demosaic_pattern_mis_decodes_the_same_rows_through_the_demosaic_after
     params = demosaicing.sample_params(3, 24, 20, generator=torch.Generator().manual_seed(1))
     assert len(set(params["intensity"].tolist())) == 3
     if model == "paper":
-        keys = ("num_stripes", "band_fraction", "next_num_stripes", "mix")
-        weights = em_color_strip_module._row_weights(24, 3, frames.device, *(params[k] for k in keys))
-        rows = weights[:, None, :, None].float().expand_as(frames)
+        rows = (
+            em_color_strip_module.row_weights_of(frames, params)[:, None, :, None].float().expand_as(frames)
+        )
     else:
         rows = (plain.apply_params(frames, params) != frames).any(1, keepdim=True).expand_as(frames).float()
     expected = torch.lerp(frames, physics.em_demosaic_colour_map(frames, "GRBG", 1.3, 0.02), rows)
