@@ -1,5 +1,6 @@
 """Where an EM colour strip case's residual holds more or less variance than the noise model places, read on every
-unclipped value of every pair under the report's written model: measured over modelled variance on the rows the
+unclipped value of every pair under the report's written model (with ``bayer_demosaic``, since session 75, its fitted
+tile): measured over modelled variance on the rows the
 model decodes and on the rest, per channel, per eighth of the frame's height and per pair. The noise model is the
 package's (``FrameProblem.noise_terms``, ``noise.fit_variance``) at the checkout on PYTHONPATH.
 Usage: ``PYTHONPATH=. python docs/bench/session74/decoded_rows_noise.py CASE_DIR [MAX_SIDE]`` (CASE_DIR holds
@@ -23,7 +24,12 @@ def main() -> None:
     report = json.loads((case / "out/report.json").read_text())
     pairs = load_pairs(case / "pairs", max_side=int(sys.argv[2]) if len(sys.argv) > 2 else 128)
     problem = EMStripFrames(pairs, seed=0)
-    fit = Fit(frozenset(report["extended"]["effects"]), dict(report["extended"]["params"]))
+    tile = report["extended"]["derived"].get("colour_filter_tile")
+    fit = Fit(
+        frozenset(report["extended"]["effects"]),
+        dict(report["extended"]["params"]),
+        {} if tile is None else {"pattern": tile},
+    )
     samples, decoded, channel, row, pair_index = [], [], [], [], []
     for index, pair in enumerate(pairs):
         predicted, measured = 255.0 * problem.predict_pair(fit, index).numpy(), 255.0 * pair.attacked.numpy()
@@ -32,7 +38,7 @@ def main() -> None:
         # the values noise_terms keeps, in its order
         kept = np.flatnonzero(unclipped(predicted.ravel(), measured.ravel()))
         c, y, _ = np.unravel_index(kept, predicted.shape)
-        placement = problem.placements(fit.effects, fit.params, [index])[index]
+        placement = problem.placements(fit.effects, fit.params, [index], tile)[index]
         rows_decoded = problem.mask(fit.effects, fit.params, index, placement)[0, :, 0].numpy() > 0
         samples.append(sample)
         decoded.append(rows_decoded[y])
@@ -61,7 +67,7 @@ def main() -> None:
     lag1 = {name: [] for name in "RGB"}
     for index, pair in enumerate(pairs):
         residual = 255.0 * (problem.predict_pair(fit, index) - pair.attacked).numpy()
-        placement = problem.placements(fit.effects, fit.params, [index])[index]
+        placement = problem.placements(fit.effects, fit.params, [index], tile)[index]
         rows_decoded = problem.mask(fit.effects, fit.params, index, placement)[0, :, 0].numpy() > 0
         for c, name in enumerate("RGB"):
             on_rows = residual[c][rows_decoded]
