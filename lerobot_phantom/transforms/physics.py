@@ -734,15 +734,21 @@ def em_demosaic_colour_map(
     gain: float | torch.Tensor = 2.5,
     offset: float | torch.Tensor = 50.0 / 255.0,
 ) -> torch.Tensor:
-    """``em_color_map`` with the demosaic's spatial form: red and blue ``gain`` times the mis-phased demosaic's
-    red and blue (interpolated green samples), green its green (interpolated red and blue) minus ``offset``. On a
-    frame of one colour its red and blue are ``em_color_map``'s and its green is, averaged over each 2x2 tile: the
-    green sites keep their own red or blue sample, a zipper the per-pixel map smooths away."""
-    wrong = demosaic_after_lost_line(x, pattern)
-    gain_, offset_ = _as(gain, wrong[:, :1]), _as(offset, wrong[:, :1])
-    return torch.cat([gain_ * wrong[:, 0:1], wrong[:, 1:2] - offset_, gain_ * wrong[:, 2:3]], dim=1).clamp(
-        0.0, 1.0
-    )
+    """``em_color_map`` with the demosaic's spatial form: ``em_colours_of_demosaic`` of
+    ``demosaic_after_lost_line``. On a frame of one colour its red and blue are ``em_color_map``'s and its green is,
+    averaged over each 2x2 tile: the green sites keep their own red or blue sample, a zipper the per-pixel map smooths
+    away."""
+    return em_colours_of_demosaic(demosaic_after_lost_line(x, pattern), gain, offset)
+
+
+def em_colours_of_demosaic(
+    demosaiced: torch.Tensor, gain: float | torch.Tensor, offset: float | torch.Tensor
+) -> torch.Tensor:
+    """The map's ``gain`` on a demosaic-after-a-lost-line's red and blue (interpolated green samples), its
+    ``offset`` off its green (interpolated red and blue), clamped to [0, 1]."""
+    gain_, offset_ = _as(gain, demosaiced[:, :1]), _as(offset, demosaiced[:, :1])
+    red, green, blue = demosaiced[:, 0:1], demosaiced[:, 1:2], demosaiced[:, 2:3]
+    return torch.cat([gain_ * red, green - offset_, gain_ * blue], dim=1).clamp(0.0, 1.0)
 
 
 def periodic_band_mask(

@@ -54,17 +54,14 @@ class EMStripFrames(LatentFrameProblem):
             self._demosaiced[key] = physics.demosaic_after_lost_line(clean, pattern)[0]
         return self._demosaiced[key]
 
-    def mis_decoded(
-        self, fit_effects, params, pattern: str | None, index: int, rows=slice(None)
-    ) -> torch.Tensor:
+    def mis_decoded(self, effects, params, pattern: str | None, index: int, rows=slice(None)) -> torch.Tensor:
         """The colours pair ``index``'s ``rows`` show when mis-decoded: the paper's map of each pixel, or with
         ``bayer_demosaic`` the map's gain and offset on the demosaic after a lost line."""
-        pair = self.pairs[index]
-        if "bayer_demosaic" not in fit_effects:
-            return physics.em_color_map(pair.clean[:, rows].unsqueeze(0), params["gain"], params["offset"])[0]
-        wrong = self.demosaiced(index, pattern)[:, rows]
-        gain, offset = params["gain"], params["offset"]
-        return torch.cat([gain * wrong[0:1], wrong[1:2] - offset, gain * wrong[2:3]]).clamp(0.0, 1.0)
+        if "bayer_demosaic" not in effects:
+            clean = self.pairs[index].clean[:, rows].unsqueeze(0)
+            return physics.em_color_map(clean, params["gain"], params["offset"])[0]
+        demosaiced = self.demosaiced(index, pattern)[:, rows].unsqueeze(0)
+        return physics.em_colours_of_demosaic(demosaiced, params["gain"], params["offset"])[0]
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         specs = [Param("gain", 2.5, 0.0, 10.0), Param("offset", 50.0 / 255.0, -1.0, 1.0, 0.1)]
