@@ -467,20 +467,18 @@ class EMColorStrip(CameraAttack):
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         if self.model == "bayer_phase_flip":
             height = x.shape[-2]
-            mask = physics.bayer_flip_mask(
+            rows = physics.bayer_flip_mask(
                 height, params["start_fraction"].to(x.device) * height, device=x.device
             )
-            return torch.lerp(x, self._mis_decoded(x), mask.to(x.dtype)).clamp_(0.0, 1.0)
-        if self.demosaic_pattern is not None:
-            weights = row_weights_of(x, params).to(x.dtype)[:, None, :, None]
-            return torch.lerp(x, self._mis_decoded(x), weights).clamp_(0.0, 1.0)
-        return self._apply_paper(x, params)
-
-    def _mis_decoded(self, x: torch.Tensor) -> torch.Tensor:
+        elif self.demosaic_pattern is not None:
+            rows = row_weights_of(x, params)[:, None, :, None]
+        else:
+            return self._apply_paper(x, params)
         gain, offset = self.bayer["gain"], self.bayer["offset"]
         if self.demosaic_pattern is None:
-            return physics.em_color_map(x, gain, offset)
-        return physics.em_demosaic_colour_map(x, self.demosaic_pattern, gain, offset)
+            return torch.lerp(x, physics.em_color_map(x, gain, offset), rows.to(x.dtype)).clamp_(0.0, 1.0)
+        terms, weights = physics.bayer_line_terms(x, self.demosaic_pattern)
+        return physics.em_demosaic_rows(terms, weights, x, rows[:, 0, :, 0], gain, offset)
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         if self.model == "bayer_phase_flip" or self.demosaic_pattern is not None:

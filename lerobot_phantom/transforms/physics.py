@@ -697,19 +697,18 @@ _BILINEAR_RED_BLUE = ((1.0, 2.0, 1.0), (2.0, 4.0, 2.0), (1.0, 2.0, 1.0))
 _BILINEAR_GREEN = ((0.0, 1.0, 0.0), (1.0, 4.0, 1.0), (0.0, 1.0, 0.0))
 
 
-def demosaic_after_lost_line(x: torch.Tensor, pattern: str = "RGGB") -> torch.Tensor:
-    """The frame an ISP demosaics when the link lost the line above it: ``(B, 3, H, W)`` in, same out.
+def bayer_line_terms(x: torch.Tensor, pattern: str = "RGGB") -> tuple[torch.Tensor, torch.Tensor]:
+    """Each row's bilinear demosaic of ``x``'s mosaic split by the raw line it reads: ``(terms, weights)``.
 
-    The sensor samples one colour per site (``pattern``, the colour-filter tile); a line lost on the bus moves
-    every later raw line up by one, so each site holds the sample of the site below it, which sits under another
-    filter (a red site holds a green sample, a green site between reds a blue one); the ISP, not knowing, fills in
-    each channel by bilinear interpolation of the sites it believes carry that colour. So every row's colours are
-    interpolated from the next row's samples on the wrong sites: red and blue from green, green from red and blue,
-    each mixed with the neighbours' values (edges get colour fringes a per-pixel colour map does not make). The
-    mosaic is read from the frame's own values, the ISP's output, so this is the paper's colour swap with the
-    demosaic's spatial form (GlitchHiker, Jiang et al. 2023; paper, Method). Borders are mirrored, which keeps
-    the tile's phase; the last raw line is read twice (nothing arrives after it), so the last row keeps its own
-    samples.
+    The sensor samples one colour per site (``pattern``, the colour-filter tile); a line lost on the bus moves every
+    later raw line up by one, so each site holds the sample of the site below it, which sits under another filter
+    (a red site holds a green sample, a green site between reds a blue one); the ISP, not knowing, fills in each
+    channel by bilinear interpolation of the sites it believes carry that colour (normalised convolution, borders
+    mirrored, which keeps the tile's phase). The interpolation is linear in the raw lines, so a row's demosaic is
+    the sum of three terms, from the line above, its own and the line below, each either as sampled or moved up by
+    one: ``terms[moved, offset]`` ``(2, 3, B, 3, H, W)``, divided by ``weights`` ``(1, 3, H, W)`` (the sum of the
+    interpolation weights). The mosaic is read from the frame's own values, the ISP's output (GlitchHiker, Jiang et
+    al. 2023; paper, Method). The last raw line is read twice when moved (nothing arrives after it).
     """
     if pattern not in BAYER_PATTERNS:
         raise ValueError(f"unknown colour-filter pattern {pattern!r}; valid: {', '.join(BAYER_PATTERNS)}")
@@ -717,15 +716,69 @@ def demosaic_after_lost_line(x: torch.Tensor, pattern: str = "RGGB") -> torch.Te
     tile = torch.tensor(BAYER_PATTERNS[pattern], device=x.device)
     sites = tile[torch.arange(height, device=x.device) % 2][:, torch.arange(width, device=x.device) % 2]
     raw = x.gather(1, sites.expand(x.shape[0], 1, height, width))
-    raw = raw[:, :, torch.clamp(torch.arange(height, device=x.device) + 1, max=height - 1)]
+    moved_up = raw[:, :, torch.clamp(torch.arange(height, device=x.device) + 1, max=height - 1)]
     masks = torch.stack([sites == c for c in range(3)]).to(x.dtype).unsqueeze(0)  # (1, 3, H, W)
     kernels = torch.tensor(
         (_BILINEAR_RED_BLUE, _BILINEAR_GREEN, _BILINEAR_RED_BLUE), dtype=x.dtype, device=x.device
     ).unsqueeze(1)
-    # normalised convolution: each channel's weighted sum of the sites that carry it over the sum of their weights
-    sums = F.conv2d(F.pad(raw * masks, (1, 1, 1, 1), mode="reflect"), kernels, groups=3)
+    # one kernel per line offset: row k of the 3x3 kernel alone
+    by_offset = [
+        kernels * (torch.arange(3, device=x.device) == k).to(x.dtype).reshape(1, 1, 3, 1) for k in range(3)
+    ]
+    terms = torch.stack(
+        [
+            torch.stack(
+                [F.conv2d(F.pad(lines * masks, (1, 1, 1, 1), mode="reflect"), k, groups=3) for k in by_offset]
+            )
+            for lines in (raw, moved_up)
+        ]
+    )
     weights = F.conv2d(F.pad(masks, (1, 1, 1, 1), mode="reflect"), kernels, groups=3)
-    return sums / weights
+    return terms, weights
+
+
+def demosaic_of_moved_lines(terms: torch.Tensor, weights: torch.Tensor, moved: torch.Tensor) -> torch.Tensor:
+    """The demosaic (``bayer_line_terms``) when each row's raw line is moved up by the share ``moved`` ``(B, H)``
+    (1: the line below it arrived in its place; between 0 and 1, a blend of the two frames); the mirrored border
+    line above the first row and below the last is row 1's and row H-2's."""
+    height = terms.shape[-2]
+    padded = F.pad(moved.to(terms.dtype).unsqueeze(1), (1, 1), mode="reflect")[:, 0]
+    total = torch.zeros_like(terms[0, 0])
+    for offset in range(3):
+        share = padded[:, offset : offset + height].reshape(-1, 1, height, 1)
+        total = total + torch.lerp(terms[0, offset], terms[1, offset], share)
+    return total / weights
+
+
+def demosaic_after_lost_line(x: torch.Tensor, pattern: str = "RGGB") -> torch.Tensor:
+    """The frame an ISP demosaics when the link lost the line above it (every raw line moved up by one): each row's
+    colours interpolated from the next row's samples on the wrong sites, red and blue from green, green from red
+    and blue, mixed with the neighbours' (``bayer_line_terms``)."""
+    terms, weights = bayer_line_terms(x, pattern)
+    return demosaic_of_moved_lines(
+        terms, weights, torch.ones(x.shape[0], x.shape[-2], dtype=x.dtype, device=x.device)
+    )
+
+
+def em_demosaic_rows(
+    terms: torch.Tensor,
+    weights: torch.Tensor,
+    x: torch.Tensor,
+    moved: torch.Tensor,
+    gain: float | torch.Tensor,
+    offset: float | torch.Tensor,
+) -> torch.Tensor:
+    """The frame ``x`` (with ``bayer_line_terms`` ``terms``, ``weights``) after lost lines moved the raw lines of
+    the rows ``moved`` ``(B, H)``: those rows show ``em_colours_of_demosaic`` of the demosaic of the moved lines;
+    the others keep their colours, plus what their interpolation now reads from a moved neighbouring line (the row
+    on each side of a band's edge)."""
+    moved = moved.to(x.dtype)
+    after = demosaic_of_moved_lines(terms, weights, moved)
+    before = demosaic_of_moved_lines(terms, weights, torch.zeros_like(moved))
+    mis_decoded = em_colours_of_demosaic(after, gain, offset)
+    return torch.lerp(x + after - before, mis_decoded, moved.reshape(*moved.shape[:1], 1, -1, 1)).clamp(
+        0.0, 1.0
+    )
 
 
 def em_demosaic_colour_map(

@@ -260,8 +260,8 @@ def test_a_last_band_whose_period_runs_past_the_frame_is_corrupted_exactly(num_s
 
 @pytest.mark.parametrize("model", ["paper", "bayer_phase_flip"])
 def test_a_demosaic_pattern_mis_decodes_the_same_rows_through_the_demosaic_after_a_lost_line(model):
-    """The rows the model mis-decodes show ``physics.em_demosaic_colour_map`` of the frame (the calibrated
-    ``bayer_demosaic``), the other rows are untouched, per sample in a batch, for uint8 and float, picklable."""
+    """The rows the model mis-decodes are the ones ``physics.em_demosaic_rows`` moves (the calibrated
+    ``bayer_demosaic``), per sample in a batch, for uint8 and float, picklable."""
     from lerobot_phantom.transforms import physics
 
     frames = torch.rand(3, 3, 24, 20, generator=torch.Generator().manual_seed(5))
@@ -276,7 +276,8 @@ def test_a_demosaic_pattern_mis_decodes_the_same_rows_through_the_demosaic_after
         )
     else:
         rows = (plain.apply_params(frames, params) != frames).any(1, keepdim=True).expand_as(frames).float()
-    expected = torch.lerp(frames, physics.em_demosaic_colour_map(frames, "GRBG", 1.3, 0.02), rows)
+    terms, weights = physics.bayer_line_terms(frames, "GRBG")
+    expected = physics.em_demosaic_rows(terms, weights, frames, rows[:, 0, :, 0], 1.3, 0.02)
     out = demosaicing.apply_params(frames, params)
     torch.testing.assert_close(out, expected)
     rows_per_sample = rows[:, 0, :, 0].sum(1)

@@ -272,6 +272,39 @@ def test_the_demosaic_colour_map_of_one_colour_is_the_papers_map_with_a_green_zi
         physics.demosaic_after_lost_line(frame, "RGBG")
 
 
+@pytest.mark.parametrize("pattern", ["RGGB", "GBRG"])
+def test_lost_lines_in_bands_demosaic_the_moved_mosaic_rows_beside_the_bands_included(pattern):
+    """Rows whose raw line moved up show the map's colours on OpenCV's demosaic of the mosaic with those lines
+    moved; the other rows keep their colours plus that demosaic's change, which reaches the row on each side of a
+    band (inside the one-pixel border)."""
+    cv2 = pytest.importorskip("cv2")
+    rng = np.random.default_rng(6)
+    frame = rng.uniform(size=(3, 16, 14))
+    moved = np.zeros(16, bool)
+    moved[4:8] = moved[11:13] = True
+    tile = np.array(physics.BAYER_PATTERNS[pattern])
+    sites = tile[np.arange(16)[:, None] % 2, np.arange(14)[None, :] % 2]
+    raw = np.take_along_axis(frame, sites[None], 0)[0]
+    raw_moved = np.where(moved[:, None], np.concatenate([raw[1:], raw[-1:]]), raw)
+
+    def opencv(mosaic):
+        rgb = cv2.cvtColor(np.round(mosaic * 65535).astype(np.uint16), getattr(cv2, OPENCV_BAYER[pattern]))
+        return torch.from_numpy(rgb.astype(np.float64).transpose(2, 0, 1) / 65535).unsqueeze(0)
+
+    after, before = opencv(raw_moved), opencv(raw)
+    x = torch.from_numpy(frame).unsqueeze(0)
+    expected = torch.where(
+        torch.from_numpy(moved).reshape(1, 1, 16, 1),
+        physics.em_colours_of_demosaic(after, 1.2, 0.03),
+        (x + after - before).clamp(0, 1),
+    )
+    terms, weights = physics.bayer_line_terms(x, pattern)
+    got = physics.em_demosaic_rows(terms, weights, x, torch.from_numpy(moved)[None], 1.2, 0.03)
+    assert (got - expected).abs()[..., 1:-2, 1:-1].max() < 1e-4
+    beside = [3, 8, 10, 13]  # rows next to a band, not in it
+    assert (got - x)[0, :, beside, 1:-1].abs().amax(dim=(0, 2)).min() > 1e-3
+
+
 def test_a_recording_that_does_not_drift_is_the_interior_rule_and_a_whole_period_is_the_lit_rule():
     """Phase drift bridges the two frame rules: a locked phase (drift 0) sees the whole stripes the interior rule
     counts, exactly; a phase that covers the whole period (drift 1) any phase, as the lit rule does (to the

@@ -43,25 +43,27 @@ class EMStripFrames(LatentFrameProblem):
 
     def __init__(self, pairs, seed: int) -> None:
         super().__init__(pairs, seed)
-        self._demosaiced: dict[tuple[int, str], torch.Tensor] = {}
+        self._line_terms: dict[tuple[int, str], tuple[torch.Tensor, torch.Tensor]] = {}
 
-    def demosaiced(self, index: int, pattern: str) -> torch.Tensor:
-        """Pair ``index``'s clean frame demosaiced after a lost line with colour-filter tile ``pattern`` (fixed
-        by the frame, so computed once)."""
+    def line_terms(self, index: int, pattern: str) -> tuple[torch.Tensor, torch.Tensor]:
+        """``physics.bayer_line_terms`` of pair ``index``'s clean frame with tile ``pattern`` (fixed by the frame,
+        so computed once)."""
         key = (index, pattern)
-        if key not in self._demosaiced:
-            clean = self.pairs[index].clean.unsqueeze(0)
-            self._demosaiced[key] = physics.demosaic_after_lost_line(clean, pattern)[0]
-        return self._demosaiced[key]
+        if key not in self._line_terms:
+            self._line_terms[key] = physics.bayer_line_terms(self.pairs[index].clean.unsqueeze(0), pattern)
+        return self._line_terms[key]
 
     def mis_decoded(self, effects, params, pattern: str | None, index: int, rows=slice(None)) -> torch.Tensor:
-        """The colours pair ``index``'s ``rows`` show when mis-decoded: the paper's map of each pixel, or with
-        ``bayer_demosaic`` the map's gain and offset on the demosaic after a lost line."""
+        """The colours pair ``index``'s ``rows`` show when every row is mis-decoded: the paper's map of each pixel,
+        or with ``bayer_demosaic`` the map's gain and offset on the demosaic after a lost line."""
         if "bayer_demosaic" not in effects:
             clean = self.pairs[index].clean[:, rows].unsqueeze(0)
             return physics.em_color_map(clean, params["gain"], params["offset"])[0]
-        demosaiced = self.demosaiced(index, pattern)[:, rows].unsqueeze(0)
-        return physics.em_colours_of_demosaic(demosaiced, params["gain"], params["offset"])[0]
+        terms, weights = self.line_terms(index, pattern)
+        moved = physics.demosaic_of_moved_lines(
+            terms, weights, torch.ones(1, terms.shape[-2], dtype=terms.dtype)
+        )
+        return physics.em_colours_of_demosaic(moved[:, :, rows], params["gain"], params["offset"])[0]
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         specs = [Param("gain", 2.5, 0.0, 10.0), Param("offset", 50.0 / 255.0, -1.0, 1.0, 0.1)]
@@ -70,11 +72,23 @@ class EMStripFrames(LatentFrameProblem):
         return specs
 
     @staticmethod
-    def band_phase_costs(keep, swap, period_rows: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def placement_sse(costs, masks: np.ndarray) -> np.ndarray:
+        """SSE of each placement (``masks`` ``(K, H)``, the rows it mis-decodes) from ``row_costs``: a row's own
+        cost, or with ``bayer_demosaic`` the cost of its neighbourhood (the line above, its own, the line below
+        moved or not; mirrored at the frame's border, as the demosaic is)."""
+        if isinstance(costs, tuple):
+            keep, swap = costs
+            return np.where(masks, swap[None, :], keep[None, :]).sum(1)
+        moved = np.pad(masks, ((0, 0), (1, 1)), mode="reflect").astype(np.int64)
+        neighbourhood = 4 * moved[:, :-2] + 2 * moved[:, 1:-1] + moved[:, 2:]
+        return costs[neighbourhood, np.arange(masks.shape[1])[None, :]].sum(1)
+
+    @classmethod
+    def band_phase_costs(cls, costs, period_rows: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(phases, SSE for each, prior weight of each): one phase inside every interval of phases over which
         the band mask stays the same (its edges cross a row at ``r mod P`` and ``(r - P/2) mod P``), weighted
         by the interval's share of the period - every distinct band placement, exactly, under a uniform phase."""
-        rows = np.arange(len(keep))
+        rows = np.arange(costs[0].shape[-1])
         edges = np.unique(
             np.concatenate([rows % period_rows, (rows - 0.5 * period_rows) % period_rows, [0.0]])
         )
@@ -82,53 +96,74 @@ class EMStripFrames(LatentFrameProblem):
         phases = 0.5 * (bounds[:-1] + bounds[1:])
         weights = np.diff(bounds) / period_rows
         masks = np.remainder(rows[None, :] - phases[:, None], period_rows) < 0.5 * period_rows
-        return phases, np.where(masks, swap[None, :], keep[None, :]).sum(1), weights
+        return phases, cls.placement_sse(costs, masks), weights
 
-    @staticmethod
-    def flip_row_costs(keep, swap) -> np.ndarray:
+    @classmethod
+    def flip_row_costs(cls, costs) -> np.ndarray:
         """SSE when rows from ``start`` on are flipped, for every start 0..h."""
-        return np.concatenate([[0.0], np.cumsum(keep)]) + np.concatenate([np.cumsum(swap[::-1])[::-1], [0.0]])
+        if isinstance(costs, tuple):
+            keep, swap = costs
+            return np.concatenate([[0.0], np.cumsum(keep)]) + np.concatenate(
+                [np.cumsum(swap[::-1])[::-1], [0.0]]
+            )
+        height = costs.shape[1]
+        return cls.placement_sse(costs, np.arange(height)[None, :] >= np.arange(height + 1)[:, None])
 
     def latent_candidates(self, fit: Fit, index: int) -> tuple[np.ndarray, np.ndarray]:
-        keep, swap = self.row_costs(fit.effects, fit.params, index, fit.extra.get("pattern"))
+        costs = self.row_costs(fit.effects, fit.params, index, fit.extra.get("pattern"))
         if "bayer_phase_flip" in fit.effects:
-            sse = self.flip_row_costs(keep, swap)
+            sse = self.flip_row_costs(costs)
         else:
-            _, sse, weights = self.band_phase_costs(
-                keep, swap, fit.params["period"] * self.pairs[index].height
-            )
+            _, sse, weights = self.band_phase_costs(costs, fit.params["period"] * self.pairs[index].height)
             return sse, weights
         return sse, np.full(len(sse), 1.0 / len(sse))
 
-    def row_costs(self, effects, params, index: int, pattern: str | None) -> tuple[np.ndarray, np.ndarray]:
+    def row_costs(self, effects, params, index: int, pattern: str | None):
+        """Each row's SSE: under the colour map ``(keep, swap)``, the row as it is or mapped; with
+        ``bayer_demosaic`` an ``(8, H)`` array, one per neighbourhood ``4 above + 2 own + below`` (1: that raw
+        line moved up), since a row's interpolation reads the lines beside it: a mis-decoded row shows the map's
+        colours on the demosaic of its neighbourhood, a row left as it is keeps its colours plus what a moved
+        neighbouring line adds."""
         pair = self.pairs[index]
-        mapped = self.mis_decoded(effects, params, pattern, index)
         keep = ((pair.attacked - pair.clean) ** 2).sum(dim=(0, 2)).numpy()
-        swap = ((pair.attacked - mapped) ** 2).sum(dim=(0, 2)).numpy()
-        return keep, swap
+        if "bayer_demosaic" not in effects:
+            swap = ((pair.attacked - self.mis_decoded(effects, params, pattern, index)) ** 2).sum(dim=(0, 2))
+            return keep, swap.numpy()
+        terms, weights = self.line_terms(index, pattern)
+        before = (terms[0, 0] + terms[0, 1] + terms[0, 2]) / weights
+        costs = []
+        for neighbourhood in range(8):
+            above, own, below = (neighbourhood >> 2) & 1, (neighbourhood >> 1) & 1, neighbourhood & 1
+            after = (terms[above, 0] + terms[own, 1] + terms[below, 2]) / weights
+            if own:
+                shown = physics.em_colours_of_demosaic(after, params["gain"], params["offset"])[0]
+            else:
+                shown = pair.clean + (after - before)[0]
+            costs.append(((pair.attacked - shown) ** 2).sum(dim=(0, 2)).numpy())
+        return np.stack(costs)
 
     @classmethod
-    def best_band_phase(cls, keep, swap, period_rows: float) -> tuple[float, float]:
-        phases, costs, _ = cls.band_phase_costs(keep, swap, period_rows)
-        k = int(np.argmin(costs))
-        return float(costs[k]), float(phases[k])
+    def best_band_phase(cls, costs, period_rows: float) -> tuple[float, float]:
+        phases, sse, _ = cls.band_phase_costs(costs, period_rows)
+        k = int(np.argmin(sse))
+        return float(sse[k]), float(phases[k])
 
     @classmethod
-    def best_flip_row(cls, keep, swap) -> tuple[float, int]:
-        costs = cls.flip_row_costs(keep, swap)
-        start = int(np.argmin(costs))
-        return float(costs[start]), start
+    def best_flip_row(cls, costs) -> tuple[float, int]:
+        sse = cls.flip_row_costs(costs)
+        start = int(np.argmin(sse))
+        return float(sse[start]), start
 
     def placements(self, effects, params, items, pattern: str | None = None) -> dict[int, tuple[str, float]]:
         """Per-frame placement (band phase or flip row) registered on each frame: fit frames, figures."""
         out = {}
         for i in items:
-            keep, swap = self.row_costs(effects, params, int(i), pattern)
+            costs = self.row_costs(effects, params, int(i), pattern)
             if "bayer_phase_flip" in effects:
-                out[int(i)] = ("flip", float(self.best_flip_row(keep, swap)[1]))
+                out[int(i)] = ("flip", float(self.best_flip_row(costs)[1]))
             else:
                 period = params["period"] * self.pairs[int(i)].height
-                out[int(i)] = ("bands", self.best_band_phase(keep, swap, period)[1])
+                out[int(i)] = ("bands", self.best_band_phase(costs, period)[1])
         return out
 
     def mask(self, effects, params, index: int, placement) -> torch.Tensor:
@@ -143,6 +178,11 @@ class EMStripFrames(LatentFrameProblem):
         placement = self.placements(fit.effects, fit.params, [index], pattern)[index]
         pair = self.pairs[index]
         mask = self.mask(fit.effects, fit.params, index, placement)
+        if "bayer_demosaic" in fit.effects:
+            terms, weights = self.line_terms(index, pattern)
+            moved = mask[:, :, 0]
+            gain, offset = fit.params["gain"], fit.params["offset"]
+            return physics.em_demosaic_rows(terms, weights, pair.clean.unsqueeze(0), moved, gain, offset)[0]
         mapped = self.mis_decoded(fit.effects, fit.params, pattern, index)
         return mask * mapped + (1 - mask) * pair.clean
 
@@ -196,8 +236,8 @@ class EMStripFrames(LatentFrameProblem):
 
                 def total(period, row_costs=row_costs):
                     return sum(
-                        self.best_band_phase(keep, swap, period * self.pairs[int(i)].height)[0]
-                        for i, (keep, swap) in zip(items, row_costs, strict=True)
+                        self.best_band_phase(costs, period * self.pairs[int(i)].height)[0]
+                        for i, costs in zip(items, row_costs, strict=True)
                     )
 
                 coarse = min(self.periods, key=total)
@@ -210,14 +250,26 @@ class EMStripFrames(LatentFrameProblem):
             masks = {
                 int(i): self.mask(effects, params, int(i), placement[int(i)])[0, :, 0].bool() for i in items
             }
+            # with the demosaic, the mis-decoded rows' interpolation given the placement (the colours are fitted on it)
+            moved_lines = {
+                i: physics.demosaic_of_moved_lines(*self.line_terms(i, pattern), rows[None].double())[
+                    :, :, rows
+                ]
+                for i, rows in masks.items()
+                if "bayer_demosaic" in effects and rows.any()
+            }
 
-            def residuals(p, masks=masks):
+            def residuals(p, masks=masks, moved_lines=moved_lines):
                 parts = []
                 for i in items:
                     rows = masks[int(i)]
-                    if rows.any():
-                        mapped = self.mis_decoded(effects, p, pattern, int(i), rows)
-                        parts.append((mapped - self.pairs[int(i)].attacked[:, rows]).ravel())
+                    if not rows.any():
+                        continue
+                    if "bayer_demosaic" in effects:
+                        shown = physics.em_colours_of_demosaic(moved_lines[int(i)], p["gain"], p["offset"])[0]
+                    else:
+                        shown = self.mis_decoded(effects, p, pattern, int(i), rows)
+                    parts.append((shown - self.pairs[int(i)].attacked[:, rows]).ravel())
                 return torch.cat(parts) if parts else torch.zeros(1, dtype=torch.float64)
 
             colour = fit_least_squares(
