@@ -750,16 +750,6 @@ def demosaic_of_moved_lines(terms: torch.Tensor, weights: torch.Tensor, moved: t
     return total / weights
 
 
-def demosaic_after_lost_line(x: torch.Tensor, pattern: str = "RGGB") -> torch.Tensor:
-    """The frame an ISP demosaics when the link lost the line above it (every raw line moved up by one): each row's
-    colours interpolated from the next row's samples on the wrong sites, red and blue from green, green from red
-    and blue, mixed with the neighbours' (``bayer_line_terms``)."""
-    terms, weights = bayer_line_terms(x, pattern)
-    return demosaic_of_moved_lines(
-        terms, weights, torch.ones(x.shape[0], x.shape[-2], dtype=x.dtype, device=x.device)
-    )
-
-
 def em_demosaic_rows(
     terms: torch.Tensor,
     weights: torch.Tensor,
@@ -781,24 +771,14 @@ def em_demosaic_rows(
     )
 
 
-def em_demosaic_colour_map(
-    x: torch.Tensor,
-    pattern: str,
-    gain: float | torch.Tensor = 2.5,
-    offset: float | torch.Tensor = 50.0 / 255.0,
-) -> torch.Tensor:
-    """``em_color_map`` with the demosaic's spatial form: ``em_colours_of_demosaic`` of
-    ``demosaic_after_lost_line``. On a frame of one colour its red and blue are ``em_color_map``'s and its green is,
-    averaged over each 2x2 tile: the green sites keep their own red or blue sample, a zipper the per-pixel map smooths
-    away."""
-    return em_colours_of_demosaic(demosaic_after_lost_line(x, pattern), gain, offset)
-
-
 def em_colours_of_demosaic(
     demosaiced: torch.Tensor, gain: float | torch.Tensor, offset: float | torch.Tensor
 ) -> torch.Tensor:
-    """The map's ``gain`` on a demosaic-after-a-lost-line's red and blue (interpolated green samples), its
-    ``offset`` off its green (interpolated red and blue), clamped to [0, 1]."""
+    """``em_color_map`` with the demosaic's spatial form: the map's ``gain`` on the red and blue of a demosaic after
+    lost lines (``demosaic_of_moved_lines``: interpolated green samples), its ``offset`` off its green (interpolated
+    red and blue), clamped to [0, 1]. On a frame of one colour its red and blue are ``em_color_map``'s and its green
+    is, averaged over each 2x2 tile: the green sites keep their own red or blue sample, a zipper the per-pixel map
+    smooths away."""
     gain_, offset_ = _as(gain, demosaiced[:, :1]), _as(offset, demosaiced[:, :1])
     red, green, blue = demosaiced[:, 0:1], demosaiced[:, 1:2], demosaiced[:, 2:3]
     return torch.cat([gain_ * red, green - offset_, gain_ * blue], dim=1).clamp(0.0, 1.0)

@@ -238,6 +238,12 @@ OPENCV_BAYER = {
 }
 
 
+def all_lines_moved(frame: torch.Tensor, pattern: str) -> torch.Tensor:
+    """The demosaic when a line above the frame was lost: every raw line moved up by one."""
+    terms, weights = physics.bayer_line_terms(frame, pattern)
+    return physics.demosaic_of_moved_lines(terms, weights, torch.ones(frame.shape[0], frame.shape[-2]))
+
+
 @pytest.mark.parametrize("pattern", list(physics.BAYER_PATTERNS))
 def test_demosaic_after_a_lost_line_is_opencvs_bilinear_demosaic_of_the_raw_lines_moved_up(pattern):
     """Mosaic the frame with the tile, move the raw lines up by one, demosaic: OpenCV's bilinear demosaic of the
@@ -251,7 +257,7 @@ def test_demosaic_after_a_lost_line_is_opencvs_bilinear_demosaic_of_the_raw_line
     moved_up = np.concatenate([raw[1:], raw[-1:]])
     expected = cv2.cvtColor(np.round(moved_up * 65535).astype(np.uint16), getattr(cv2, OPENCV_BAYER[pattern]))
     expected = expected.astype(np.float64).transpose(2, 0, 1) / 65535
-    got = physics.demosaic_after_lost_line(torch.from_numpy(frame).unsqueeze(0), pattern)[0].numpy()
+    got = all_lines_moved(torch.from_numpy(frame).unsqueeze(0), pattern)[0].numpy()
     assert np.abs(got - expected)[:, 1:-2, 1:-1].max() < 1e-4
     # red sites now hold the green sample of the site below, which they keep
     red_sites = sites == 0
@@ -262,14 +268,16 @@ def test_demosaic_after_a_lost_line_is_opencvs_bilinear_demosaic_of_the_raw_line
 def test_the_demosaic_colour_map_of_one_colour_is_the_papers_map_with_a_green_zipper(pattern):
     colour = torch.tensor([0.2, 0.3, 0.5], dtype=torch.float64).reshape(1, 3, 1, 1)
     frame = colour.expand(1, 3, 6, 8)
-    mapped = physics.em_demosaic_colour_map(frame, pattern, 2.0, 0.1)[..., :-2, :]  # above the last raw line
+    mapped = physics.em_colours_of_demosaic(all_lines_moved(frame, pattern), 2.0, 0.1)[
+        ..., :-2, :
+    ]  # above the last raw line
     paper = physics.em_color_map(colour, 2.0, 0.1)
     assert torch.allclose(mapped[:, [0, 2]], paper[:, [0, 2]].expand_as(mapped[:, [0, 2]]))
     green = mapped[0, 1]
     assert set(np.round(green.unique().numpy(), 9)) == {0.1, 0.25, 0.4}  # blue or red kept, or their mean
     assert torch.allclose(green.reshape(2, 2, 4, 2).mean((1, 3)), paper[0, 1, 0, 0].expand(2, 4))
     with pytest.raises(ValueError, match="valid: RGGB, GRBG, GBRG, BGGR"):
-        physics.demosaic_after_lost_line(frame, "RGBG")
+        physics.bayer_line_terms(frame, "RGBG")
 
 
 @pytest.mark.parametrize("pattern", ["RGGB", "GBRG"])

@@ -64,9 +64,7 @@ def decoded_rows_rmse(case: Path) -> dict[str, float]:
             squared / sum(3 * int(r.sum()) * pair.width for pair, r in zip(pairs, rows, strict=True))
         ) ** 0.5
 
-    figures = {
-        "map": rmse([problem.mis_decoded(fit.effects, fit.params, None, i) for i in range(len(pairs))])
-    }
+    figures = {"map": rmse([problem.colour_mapped(fit.params, i) for i in range(len(pairs))])}
     for linear in (False, True):
         for tile in physics.BAYER_PATTERNS:
             demosaiced = [opencv_demosaic_after_lost_line(pair.clean, tile, linear) for pair in pairs]

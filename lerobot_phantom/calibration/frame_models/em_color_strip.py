@@ -53,17 +53,10 @@ class EMStripFrames(LatentFrameProblem):
             self._line_terms[key] = physics.bayer_line_terms(self.pairs[index].clean.unsqueeze(0), pattern)
         return self._line_terms[key]
 
-    def mis_decoded(self, effects, params, pattern: str | None, index: int, rows=slice(None)) -> torch.Tensor:
-        """The colours pair ``index``'s ``rows`` show when every row is mis-decoded: the paper's map of each pixel,
-        or with ``bayer_demosaic`` the map's gain and offset on the demosaic after a lost line."""
-        if "bayer_demosaic" not in effects:
-            clean = self.pairs[index].clean[:, rows].unsqueeze(0)
-            return physics.em_color_map(clean, params["gain"], params["offset"])[0]
-        terms, weights = self.line_terms(index, pattern)
-        moved = physics.demosaic_of_moved_lines(
-            terms, weights, torch.ones(1, terms.shape[-2], dtype=terms.dtype)
-        )
-        return physics.em_colours_of_demosaic(moved[:, :, rows], params["gain"], params["offset"])[0]
+    def colour_mapped(self, params, index: int, rows=slice(None)) -> torch.Tensor:
+        """Pair ``index``'s ``rows`` through the paper's colour map of each pixel (with the fitted gain, offset)."""
+        clean = self.pairs[index].clean[:, rows].unsqueeze(0)
+        return physics.em_color_map(clean, params["gain"], params["offset"])[0]
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         specs = [Param("gain", 2.5, 0.0, 10.0), Param("offset", 50.0 / 255.0, -1.0, 1.0, 0.1)]
@@ -127,7 +120,7 @@ class EMStripFrames(LatentFrameProblem):
         pair = self.pairs[index]
         keep = ((pair.attacked - pair.clean) ** 2).sum(dim=(0, 2)).numpy()
         if "bayer_demosaic" not in effects:
-            swap = ((pair.attacked - self.mis_decoded(effects, params, pattern, index)) ** 2).sum(dim=(0, 2))
+            swap = ((pair.attacked - self.colour_mapped(params, index)) ** 2).sum(dim=(0, 2))
             return keep, swap.numpy()
         terms, weights = self.line_terms(index, pattern)
         before = (terms[0, 0] + terms[0, 1] + terms[0, 2]) / weights
@@ -183,7 +176,7 @@ class EMStripFrames(LatentFrameProblem):
             moved = mask[:, :, 0]
             gain, offset = fit.params["gain"], fit.params["offset"]
             return physics.em_demosaic_rows(terms, weights, pair.clean.unsqueeze(0), moved, gain, offset)[0]
-        mapped = self.mis_decoded(fit.effects, fit.params, pattern, index)
+        mapped = self.colour_mapped(fit.params, index)
         return mask * mapped + (1 - mask) * pair.clean
 
     def noise_sources(self, fit: Fit, index: int) -> NoiseSources:
@@ -268,7 +261,7 @@ class EMStripFrames(LatentFrameProblem):
                     if "bayer_demosaic" in effects:
                         shown = physics.em_colours_of_demosaic(moved_lines[int(i)], p["gain"], p["offset"])[0]
                     else:
-                        shown = self.mis_decoded(effects, p, pattern, int(i), rows)
+                        shown = self.colour_mapped(p, int(i), rows)
                     parts.append((shown - self.pairs[int(i)].attacked[:, rows]).ravel())
                 return torch.cat(parts) if parts else torch.zeros(1, dtype=torch.float64)
 
