@@ -71,3 +71,23 @@ def test_the_demosaic_form_loses_to_the_map_on_frames_the_map_made():
     colour_map = problem.fit(frozenset({"bayer_phase_flip"}), items)
     demosaic = problem.fit(frozenset({"bayer_phase_flip", "bayer_demosaic"}), items)
     assert demosaic.extra["noise_variance"] > 2 * colour_map.extra["noise_variance"]
+
+
+@pytest.mark.parametrize(
+    "lost_lines, effects",
+    [
+        ("single", frozenset({"bayer_phase_flip", "bayer_demosaic"})),
+        ("banded", frozenset({"bayer_demosaic"})),
+    ],
+)
+def test_the_placement_search_scores_each_frame_as_the_prediction_it_registers(lost_lines, effects):
+    """The search's per-row costs (eight neighbourhoods per row) add up to the squared error of the frame
+    ``predict_registered`` builds with ``physics.em_demosaic_rows``, band edges and the rows beside them included."""
+    pairs = lost_line_pairs(3, lost_lines)
+    problem = EMStripFrames(pairs, seed=0)
+    fit = problem.fit(effects, np.arange(len(pairs)))
+    for index, pair in enumerate(pairs):
+        predicted = problem.predict_registered(fit, index)
+        assert problem.registered_sse(fit, index) == pytest.approx(
+            float(((predicted - pair.attacked) ** 2).sum())
+        )
