@@ -71,6 +71,10 @@ class CalibrateConfig:
     # Stripe tables: which frames the table's means averaged: all, lit (frames with a lit row), interior (frames
     # whose first and last rows are dark), or auto (the rule that fits the fit split best, reported).
     stripe_frames: str = "auto"
+    # Light projection: what the recorded projected image is, emitted (the frame the projector was sent) or captured
+    # (the projection as this camera captured it, e.g. on a board in the dark). Required for frame pairs unless
+    # pairs.csv has a pattern_record column; colour-triple tables are emitted (SLAP's format).
+    pattern_record: str | None = None
     # Frame pairs: frames are resized so their longer side is at most this many pixels.
     max_side: int = 256
     # Laser captures: captures are resized so their longer side is at most this many pixels.
@@ -111,15 +115,20 @@ def build_problem(cfg: CalibrateConfig) -> Problem:
             f"--measured {path} is {kind.replace('_', ' ')}, which calibrates {', '.join(SUPPORTED[kind])}, "
             f"not {cfg.attack!r}"
         )
+    if cfg.pattern_record is not None and cfg.attack != "light_projection":
+        raise ValueError(
+            f"--pattern-record describes light projection's patterns; drop it for --attack {cfg.attack}"
+        )
     if kind == "stripe_table":
         return StripeProblem(
             path, image_height=cfg.image_height, exposure_unit_s=cfg.exposure_unit_s, frames=cfg.stripe_frames
         )
     if kind == "colour_triples":
-        return TripleProblem(path)
+        return TripleProblem(path, pattern_record=cfg.pattern_record)
     if kind == "laser_captures":
         return MultiCapture(path, max_side=cfg.capture_max_side, seed=cfg.seed)
-    return FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed)
+    options = {"pattern_record": cfg.pattern_record} if cfg.attack == "light_projection" else {}
+    return FRAME_PROBLEMS[cfg.attack](load_pairs(path, max_side=cfg.max_side), cfg.seed, **options)
 
 
 def calibrate(cfg: CalibrateConfig) -> dict:

@@ -236,6 +236,10 @@ class Problem:
     def n_items(self) -> int:
         raise NotImplementedError
 
+    def recording_facts(self) -> dict[str, str]:
+        """Facts of the recording the models depend on, each with where it was read (the report's input)."""
+        return {}
+
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         """Least-squares fit of the model with ``effects`` on ``items``; ``start``: a nested model's fit."""
         raise NotImplementedError

@@ -112,12 +112,39 @@ SPREAD_HIGH_REF_PX = 8.0
 
 CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
 
+# What a recorded projected image is, a fact of the recording that no fit can be left to guess: the frame the
+# projector was sent ("emitted": a display's transfer, its EOTF, turns it into light, whatever the camera's tone curve)
+# or the projector's light captured by this camera, e.g. on a white board in the dark ("captured": the camera's own
+# tone curve decodes it, as it decodes the scene). On a filmic camera (camsim) decoding an emitted frame through the
+# camera's curve put a pattern level of one half at 0.04 of white instead of 0.22, and the fit paid for it with a
+# hard-clip knee and a reflectance floor at its bound (docs/bench/session76.md)
+PATTERN_RECORD_COLUMN = "pattern_record"
+PATTERN_RECORDS = {
+    "emitted": "the frame the projector was sent: its light is projected ** projector_gamma, the projector's "
+    "display transfer, fitted with every model in which projected light adds",
+    "captured": "the projector's light as this camera captured it (a board in the dark): decoded through the "
+    "camera's tone curve, like the scene",
+}
 
-def projection_specs(effects: frozenset[str]) -> list[Param]:
+
+def check_pattern_record(record: str | None, where: str) -> str:
+    if record not in PATTERN_RECORDS:
+        raise ValueError(
+            f"{where}: pattern record {record!r}; valid: "
+            + "; ".join(f"{k!r} ({v})" for k, v in PATTERN_RECORDS.items())
+        )
+    return record
+
+
+def projection_specs(effects: frozenset[str], pattern_record: str) -> list[Param]:
     specs: list[Param] = []
     additive = "additive_light" in effects
     if not additive:
         specs.append(Param("opacity", 0.3, 0.0, 1.0, scale=0.3))
+    elif pattern_record == "emitted":
+        # displays' transfers lie near 2.2 (sRGB, BT.1886's 2.4, projectors' bright modes lower): the range only
+        # keeps a fit away from a flat or a step response
+        specs.append(Param("projector_gamma", 2.2, 0.5, 5.0, scale=1.0))
     if "channel_crosstalk" in effects:
         # a primary's own gain is >= 0 and unbounded in physics (projector power over ambient light): the range
         # only has to be wide enough never to decide a fit; leaks between channels may be negative (colour matrix)
@@ -170,6 +197,14 @@ def tone_curve(effects, params: dict):
     return (lambda v: v), (lambda v: v)
 
 
+def projected_decode(effects, params: dict):
+    """Projected colour -> linear light: the projector's display transfer where the model has one (an emitted
+    pattern, ``PATTERN_RECORDS``), else the camera's own tone curve."""
+    if "projector_gamma" in params:
+        return lambda v: v.clamp(min=0) ** params["projector_gamma"]
+    return tone_curve(effects, params)[0]
+
+
 def projection_predict(
     surface: torch.Tensor,
     projected: torch.Tensor,
@@ -186,7 +221,7 @@ def projection_predict(
     surface colour decoded under this model's tone curve."""
     decode, encode = tone_curve(effects, params)
     surface_lin = decode(surface) if surface_light is None else surface_light
-    light = decode(projected) if projected_light is None else projected_light
+    light = projected_decode(effects, params)(projected) if projected_light is None else projected_light
     if "channel_crosstalk" in effects:
         matrix = torch.stack(
             [torch.as_tensor(params[n], dtype=surface.dtype) for n in CROSSTALK_NAMES]
@@ -246,6 +281,8 @@ def projection_kwargs(fit: Fit) -> dict:
         kwargs["gamma"] = equivalent_power_gamma(p, p.get("gamma"))
     if "channel_crosstalk" in effects:  # builds on additive light: the matrix carries the light's scale
         kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
+    if "projector_gamma" in p:
+        kwargs["projector_gamma"] = p["projector_gamma"]
     if "clipping" in effects:
         kwargs["white"] = p["white"]
     if "light_spread" in effects:
@@ -284,9 +321,18 @@ class ProjectionTerms:
     attack = "light_projection"
     extended_model = "additive projector light"
     candidates = EFFECTS
+    # PATTERN_RECORDS' key and where it was read, set by the problem from its data
+    pattern_record: str
+    pattern_record_source: str
+
+    def recording_facts(self) -> dict[str, str]:
+        return {
+            "pattern_record": f"{self.pattern_record}: {PATTERN_RECORDS[self.pattern_record]}",
+            "pattern_record_source": self.pattern_record_source,
+        }
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
-        return projection_specs(effects)
+        return projection_specs(effects, self.pattern_record)
 
     def null_values(self, effect: str) -> dict[str, float]:
         return projection_nulls(effect)
@@ -306,7 +352,15 @@ class TripleProblem(ProjectionTerms, Problem):
     base_model = "alpha blend of surface and projected colour (the paper's light projection)"
     item_name = "table rows"
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, pattern_record: str | None = None) -> None:
+        if pattern_record is None:
+            self.pattern_record = "emitted"
+            self.pattern_record_source = (
+                "the table's format: SLAP's addition_r,g,b is the colour the projector emitted"
+            )
+        else:
+            self.pattern_record = check_pattern_record(pattern_record, "--pattern-record")
+            self.pattern_record_source = "--pattern-record"
         table = pd.read_csv(path)
         missing = [c for c in TRIPLE_COLUMNS if c not in table.columns]
         if missing:
@@ -334,7 +388,7 @@ class TripleProblem(ProjectionTerms, Problem):
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         target = self.captured[torch.as_tensor(items)]
         params = fit_least_squares(
-            projection_specs(effects),
+            projection_specs(effects, self.pattern_record),
             lambda p: (self.predict(effects, p, items) - target).ravel(),
             warm=projection_warm(start, effects),
             starts=further_starts(start, effects),

@@ -114,7 +114,11 @@ def build_report(
     ]
     report = {
         "attack": problem.attack,
-        "input": {"path": str(input_path), "kind": problem.input_kind},
+        "input": {
+            "path": str(input_path),
+            "kind": problem.input_kind,
+            "recording": problem.recording_facts(),
+        },
         "units": problem.units,
         "n_fit": len(fit_items),
         "n_heldout": len(heldout_items),

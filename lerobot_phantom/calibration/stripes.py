@@ -383,6 +383,9 @@ class StripeProblem(Problem):
     def n_items(self) -> int:
         return len(self.rows)
 
+    def recording_facts(self) -> dict[str, str]:
+        return {"image_height": str(self.image_height), **{f"{k}_source": v for k, v in self.sources.items()}}
+
     # -- model ---------------------------------------------------------------------------------------------
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
         height = self.image_height

@@ -167,6 +167,7 @@ class LightProjection(CameraAttack):
         crosstalk: Sequence[Sequence[float]] | None = None,
         white: float = 1.0,
         gamma: float | None = 1.0,
+        projector_gamma: float | None = None,
         spread: float = 0.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
@@ -174,14 +175,20 @@ class LightProjection(CameraAttack):
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "light projection transparency", upper=1.0)
         # model="additive"/"blend" (lerobot-phantom-calibrate): projector light at strength x intensity through
-        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve, spread over ``spread`` pixels
-        # at the 256-pixel reference, scaled by max(H, W) / 256)
+        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve, the projector's own display
+        # transfer, spread over ``spread`` pixels at the 256-pixel reference, scaled by max(H, W) / 256)
         if model not in ("paper", "additive", "blend"):
             raise ValueError(f"unknown light projection model {model!r}; valid: 'paper', 'additive', 'blend'")
         if spread < 0.0 or (spread > 0.0 and model == "paper"):
             raise ValueError(
                 f"spread={spread!r}: the projected light's spread is >= 0 reference pixels and only spreads light "
                 "in the physical models (model='additive' or 'blend'); the paper's watermark has sharp edges"
+            )
+        if projector_gamma is not None and (projector_gamma <= 0.0 or model == "paper"):
+            raise ValueError(
+                f"projector_gamma={projector_gamma!r}: the projector's display exponent is > 0 and only turns the "
+                "pattern into light in the physical models (model='additive' or 'blend'); None decodes the "
+                "pattern with the camera's gamma"
             )
         matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float32)
         if matrix is not None and matrix.shape != (3, 3):
@@ -194,6 +201,7 @@ class LightProjection(CameraAttack):
             "crosstalk": matrix,
             "white": float(white),
             "gamma": None if gamma is None else float(gamma),
+            "projector_gamma": None if projector_gamma is None else float(projector_gamma),
             "spread": float(spread),
         }
         if size is None or size == "native":
@@ -285,6 +293,7 @@ class LightProjection(CameraAttack):
                 crosstalk=p["crosstalk"],
                 white=p["white"],
                 gamma=p["gamma"],
+                projector_gamma=p["projector_gamma"],
                 spread_px=p["spread"] * max(height, width) / REFERENCE_SIZE,
                 blend=self.model == "blend",
             )

@@ -199,6 +199,7 @@ def project_light(
     crosstalk: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
     gamma: float | torch.Tensor | None = 1.0,
+    projector_gamma: float | torch.Tensor | None = None,
     spread_px: float | torch.Tensor = 0.0,
     blend: bool = False,
 ) -> torch.Tensor:
@@ -210,10 +211,12 @@ def project_light(
     ``spread_px`` pixels (``gaussian_spread``: a projector out of focus on the surface, the lens's point spread),
     scaled by ``strength`` and, with ``albedo``, by the surface's reflectance estimated from its colour
     (``scene + reflectance_floor``). The sum clips at ``white`` and is re-encoded; ``gamma`` as in ``decode``
-    (1 = compose the encoded values).
+    (1 = compose the encoded values). ``projector_gamma``: the pattern is the frame the projector is sent, turned
+    into light by the projector's display transfer ``pattern ** projector_gamma``; None: the pattern is decoded
+    like the scene, a capture of the projected light through this camera.
     """
     scene = decode(x, gamma)
-    light = decode(pattern, gamma)
+    light = decode(pattern, gamma if projector_gamma is None else projector_gamma)
     if isinstance(spread_px, torch.Tensor) or spread_px > 0.0:
         light = gaussian_spread(light, spread_px)
     if crosstalk is not None:

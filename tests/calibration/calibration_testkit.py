@@ -215,6 +215,8 @@ def render_light_projection(folder: Path, effects: set[str], seed: int, n_pairs:
                 "attacked": f"attacked_{i}.png",
                 "pattern": f"pattern_{i}.png",
                 "intensity": round(s, 4),
+                # the projected light is the pattern's own values, as the scene's light is the clean frame's
+                "pattern_record": "captured",
             }
         )
     write_table(folder, rows)

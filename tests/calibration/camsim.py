@@ -495,7 +495,12 @@ def light_projection_pairs(
             irradiance = refl * light + returned * intensity * power * projector
             attacked, _ = capture(irradiance, cam, rng, exposure=exposure)
             attacked_u8 = encode(attacked, cam)
-        pairs.append(FramePair(encode(clean, cam), attacked_u8, float(intensity), pattern_u8))
+        record = "emitted" if pattern_record == "emitted" else "captured"
+        pairs.append(
+            FramePair(
+                encode(clean, cam), attacked_u8, float(intensity), pattern_u8, {"pattern_record": record}
+            )
+        )
     return pairs
 
 
@@ -791,13 +796,15 @@ def ultrasound_blur_pairs(
 
 
 def write_pairs(folder, pairs: list[FramePair]) -> None:
-    """The calibration CLI's frame-pair input: PNGs and pairs.csv (clean, attacked[, pattern], intensity)."""
+    """The calibration CLI's frame-pair input: PNGs and pairs.csv (clean, attacked[, pattern], intensity and the
+    pairs' settings, e.g. pattern_record)."""
     from pathlib import Path
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     with_pattern = pairs[0].pattern is not None
-    header = ["clean", "attacked"] + (["pattern"] if with_pattern else []) + ["intensity"]
+    settings = list(pairs[0].settings)
+    header = ["clean", "attacked"] + (["pattern"] if with_pattern else []) + ["intensity", *settings]
     lines = [",".join(header)]
     for i, pair in enumerate(pairs):
         names = [f"clean_{i:03d}.png", f"attacked_{i:03d}.png"]
@@ -806,7 +813,7 @@ def write_pairs(folder, pairs: list[FramePair]) -> None:
         if with_pattern:
             names.append(f"pattern_{i:03d}.png")
             Image.fromarray(pair.pattern).save(folder / names[2])
-        lines.append(",".join([*names, f"{pair.intensity:.6f}"]))
+        lines.append(",".join([*names, f"{pair.intensity:.6f}", *(str(pair.settings[k]) for k in settings)]))
     (folder / "pairs.csv").write_text("\n".join(lines) + "\n")
 
 

@@ -24,7 +24,7 @@ from lerobot_phantom.transforms.light_projection import LightProjection
 def test_light_spread_is_named_and_measured_only_when_the_light_spreads(spread_px):
     # scipy's Gaussian blur of the sharp frame the projector was sent (calibration_testkit), not the package's
     pairs = projection_pairs_with_spread_light(spread_px, seed=3)
-    problem = ProjectionFrames(pairs, seed=3)
+    problem = ProjectionFrames(pairs, seed=3, pattern_record="captured")
     _, chain, selection, _ = select_and_identify(
         problem, np.arange(len(pairs)), seed=3, margin=0.05, folds=3, draws=60
     )
@@ -54,7 +54,10 @@ def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
     effects = frozenset(
         {"additive_light", "channel_crosstalk", "tone_shoulder", "sensor_gamma", "light_spread"}
     )
-    kept, fresh = ProjectionFrames(pairs, seed=5), ProjectionFrames(pairs, seed=5)
+    kept, fresh = (
+        ProjectionFrames(pairs, seed=5, pattern_record="captured"),
+        ProjectionFrames(pairs, seed=5, pattern_record="captured"),
+    )
     # the features of all pairs stacked, as a fit stacks them
     per_pair = [kept.features(i, kept.samples[i]) for i in range(len(pairs))]
     feats = {k: torch.cat([f[k] for f in per_pair]) for k in per_pair[0]}
@@ -74,7 +77,7 @@ def test_a_jacobian_taken_by_torch_passes_the_kept_light_by():
     the derivative in a tone parameter and in the spread matches a central difference."""
     pairs = projection_pairs_with_spread_light(1.0, seed=5)
     effects = frozenset({"additive_light", "sensor_gamma", "light_spread"})
-    problem = ProjectionFrames(pairs, seed=5)
+    problem = ProjectionFrames(pairs, seed=5, pattern_record="captured")
     feats = problem.features(0, problem.samples[0])
     names = ("gamma", "spread_ref_px")
     point = {spec.name: spec.init for spec in problem.param_specs(effects)}

@@ -442,7 +442,9 @@ def test_light_projection_selects_the_tone_form_the_frames_were_made_with(
 ):
     """Light projection offers both tone forms, never together: on frames made under a filmic-like shoulder the
     shoulder is selected (with the reflectance term it carries), on power-law frames the power law is."""
-    problem = ProjectionFrames(projection_pairs(frozenset(tone), tone_params, seed=7), seed=0)
+    problem = ProjectionFrames(
+        projection_pairs(frozenset(tone), tone_params, seed=7), seed=0, pattern_record="captured"
+    )
     assert exclusive(problem.candidates, {"tone_shoulder", "sensor_gamma"})
     chosen, steps = forward_select(problem, np.arange(6), seed=0, margin=0.05)
     assert named in chosen and not_named not in chosen, [(s.effects, s.tried, s.set_aside) for s in steps]

@@ -381,7 +381,9 @@ def test_a_few_held_out_items_outside_the_fit_errors_are_reported_by_name(seed):
 
 @pytest.mark.parametrize("spread_px", [0.0, 1.0, 2.0])
 def test_light_spread_across_the_pattern_edges_is_reported_as_dependence_on_pattern_detail(spread_px):
-    problem = ProjectionFrames(projection_pairs_with_spread_light(spread_px), seed=0)
+    problem = ProjectionFrames(
+        projection_pairs_with_spread_light(spread_px), seed=0, pattern_record="captured"
+    )
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     detail = next(t for t in result["tests"] if t["variable"] == "pattern_detail")
@@ -402,7 +404,7 @@ def structure_with_band_of_rows(band: Callable[[int, np.random.Generator], np.nd
         extra = np.zeros(pair.attacked.shape)
         extra[:, 10:20] = band(index, rng)
         pair.attacked = (pair.attacked + torch.from_numpy(extra)).clamp(0, 1)
-    problem = ProjectionFrames(pairs, seed=0)
+    problem = ProjectionFrames(pairs, seed=0, pattern_record="captured")
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     return residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
 
@@ -457,7 +459,7 @@ def test_frames_clipped_everywhere_leave_no_variance_to_test():
     pairs = projection_pairs_with_spread_light(0.0)
     for pair in pairs:
         pair.attacked = torch.ones_like(pair.attacked)
-    problem = ProjectionFrames(pairs, seed=0)
+    problem = ProjectionFrames(pairs, seed=0, pattern_record="captured")
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     assert not any(t["variable"].startswith("variance_by_") for t in result["tests"])
@@ -473,7 +475,7 @@ def test_rows_arriving_displaced_are_reported_with_their_displacement(slip_px):
         attacked = pair.attacked.numpy().copy()
         attacked[:, 8:32] = ndimage.shift(attacked[:, 8:32], (0, 0, -slip_px), order=3, mode="nearest")
         pair.attacked = torch.from_numpy(attacked)
-    problem = ProjectionFrames(pairs, seed=0)
+    problem = ProjectionFrames(pairs, seed=0, pattern_record="captured")
     fit = Fit(frozenset({"additive_light"}), {"strength": 0.4})
     result = residual_structure(problem, fit, np.arange(6), base_mse=1.0, rng=np.random.default_rng(0))
     tests = {t["variable"]: t for t in result["tests"]}

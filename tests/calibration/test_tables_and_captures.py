@@ -19,7 +19,6 @@ from lerobot_phantom.calibration.projection import (
     TRIPLE_COLUMNS,
     TripleProblem,
     nearest_surface_colour,
-    projection_specs,
 )
 from lerobot_phantom.transforms.calibrated import calibrated_kwargs
 
@@ -280,7 +279,8 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
 def test_both_trust_region_steps_and_both_jacobians_reach_the_same_triple_fit(tmp_path):
     """Colour-triple fits take exact trust-region steps and finite-difference Jacobians for speed
     (docs/bench/solver_choice.md, jacobian_choice.py), not for another answer: on a table with cross-talk under a
-    power-law tone curve (11 parameters), lsmr's steps and forward-mode Jacobians reach the same fit."""
+    power-law tone curve (12 parameters with the projector's gamma), lsmr's steps and forward-mode Jacobians reach
+    the same fit."""
     rng = np.random.default_rng(11)
     surface = rng.uniform(0.05, 0.9, (400, 3))
     projected = rng.choice([0.0, 127 / 255, 254 / 255], (400, 3))
@@ -296,14 +296,15 @@ def test_both_trust_region_steps_and_both_jacobians_reach_the_same_triple_fit(tm
         return (problem.predict(effects, params, items) - target).ravel()
 
     fits = {
-        solver: fit_least_squares(projection_specs(effects), residuals, tr_solver=solver)
+        solver: fit_least_squares(problem.param_specs(effects), residuals, tr_solver=solver)
         for solver in ("lsmr", "exact")
     }
-    assert len(fits["exact"]) == 11
+    assert len(fits["exact"]) == 12
     assert fits["exact"]["gamma"] == pytest.approx(2.2, abs=0.1)
+    assert fits["exact"]["projector_gamma"] == pytest.approx(2.2, abs=0.1)
     assert fits["exact"] == pytest.approx(fits["lsmr"], abs=2e-3)
     # the Jacobian by finite differences (the default, for speed: docs/bench/jacobian_choice.py) or by forward mode
-    forward = fit_least_squares(projection_specs(effects), residuals, tr_solver="exact", jacobian="forward")
+    forward = fit_least_squares(problem.param_specs(effects), residuals, tr_solver="exact", jacobian="forward")
     assert forward == pytest.approx(fits["exact"], abs=1e-4)
     with pytest.raises(ValueError, match="2-point, forward"):
-        fit_least_squares(projection_specs(effects), residuals, jacobian="3-point")
+        fit_least_squares(problem.param_specs(effects), residuals, jacobian="3-point")

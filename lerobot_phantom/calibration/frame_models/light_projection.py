@@ -19,8 +19,11 @@ from lerobot_phantom.calibration.frame_models.common import (
 )
 from lerobot_phantom.calibration.projection import (
     FRAME_EFFECTS,
+    PATTERN_RECORD_COLUMN,
     SPREAD_HIGH_REF_PX,
     ProjectionTerms,
+    check_pattern_record,
+    projected_decode,
     projection_predict,
     projection_warm,
     tone_curve,
@@ -28,8 +31,9 @@ from lerobot_phantom.calibration.projection import (
 from lerobot_phantom.calibration.tone import TONE_PARAMS
 from lerobot_phantom.transforms.physics import gaussian_spread
 
-# the parameters spreading the projected light depends on (decoding it depends on TONE_PARAMS)
-SPREAD_PARAMS = (*TONE_PARAMS, "spread_ref_px")
+# the parameters the projected light's decoding depends on, and its spreading
+PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma")
+SPREAD_PARAMS = (*PROJECTED_PARAMS, "spread_ref_px")
 # how much farther from 1 the whole frame's gamma may lie than the mean of the gammas fitted on the pixels nearest the
 # frame's centre and on the rest, each half with its own light: a tone curve acts on every pixel alike, so its gamma
 # is the same in both halves and whole (camsim's planted power-law curves: 0.95-1.11 times), while a projector's
@@ -52,11 +56,32 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
     # pinned, + shoulder + reflectance 3.01, cross-validated)
     joint_effects = 3
 
-    def __init__(self, pairs: list[Pair], seed: int) -> None:
+    def __init__(self, pairs: list[Pair], seed: int, pattern_record: str | None = None) -> None:
+        """``pattern_record``: what the pairs' patterns are (``PATTERN_RECORDS``); None reads it from the pairs'
+        ``pattern_record`` column, one value for all."""
         if any(p.pattern is None for p in pairs):
             raise ValueError(
                 "light_projection frame pairs need a 'pattern' column: the image the attacker projected"
             )
+        recorded = {p.settings.get(PATTERN_RECORD_COLUMN) for p in pairs}
+        if pattern_record is None:
+            if len(recorded) != 1 or None in recorded:
+                raise ValueError(
+                    f"light_projection frame pairs must say what their patterns are: a {PATTERN_RECORD_COLUMN} "
+                    f"column in pairs.csv with one value for all pairs (found {sorted(map(str, recorded))}) or "
+                    "--pattern-record; valid: emitted (the frame the projector was sent) or captured (the "
+                    "projection as this camera captured it, e.g. on a board in the dark)"
+                )
+            (pattern_record,) = recorded
+            self.pattern_record_source = f"pairs.csv column {PATTERN_RECORD_COLUMN}"
+        elif recorded - {None, pattern_record}:
+            raise ValueError(
+                f"--pattern-record {pattern_record} contradicts the pairs' {PATTERN_RECORD_COLUMN} column "
+                f"({sorted(map(str, recorded - {None}))}); drop the flag"
+            )
+        else:
+            self.pattern_record_source = "--pattern-record"
+        self.pattern_record = check_pattern_record(pattern_record, self.pattern_record_source)
         super().__init__(pairs, seed)
         # one kernel for every value a fit tries: as wide as the widest spread at the smallest working scale
         self.spread_radius = max(math.ceil(3.0 * SPREAD_HIGH_REF_PX / p.to_reference) for p in pairs)
@@ -87,7 +112,7 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
 
     def spread_light(self, effects, params, feats) -> torch.Tensor:
         """Each row's projected light in linear light, spread over its neighbours (``light_spread``)."""
-        decode, _ = tone_curve(effects, params)
+        decode = projected_decode(effects, params)
         pairs = feats["pair"].tolist()
         rows = torch.split(feats["pixel"], feats["pixel_count"].tolist())
         light = [None] * len(pairs)
@@ -108,7 +133,7 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         projected = (
             partial(self.spread_light, effects, params, feats)
             if spread
-            else partial(decode, feats["projected"])
+            else partial(projected_decode(effects, params), feats["projected"])
         )
         return projection_predict(
             feats["surface"],
@@ -120,7 +145,7 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
                 "surface", feats, effects, params, TONE_PARAMS, partial(decode, feats["surface"])
             ),
             projected_light=self.memoised_light(
-                "projected", feats, effects, params, SPREAD_PARAMS if spread else TONE_PARAMS, projected
+                "projected", feats, effects, params, SPREAD_PARAMS if spread else PROJECTED_PARAMS, projected
             ),
         )
 
