@@ -11,6 +11,8 @@ Inputs (recognised from the path and the table columns):
   laser captures without scene (image file or folder of images)         -> laser_blinding
   frame pairs (folder with pairs.csv: clean,attacked[,pattern][,intensity],...) -> laser_blinding,
       light_projection, ultrasound_blur, em_color_strip, em_truncation, laser_color_strip
+Light projection's frame pairs say what their pattern is: a pattern_record column (emitted: the frame the projector
+was sent; captured: the projection as the camera captured it) or --pattern-record.
 """
 
 from __future__ import annotations

@@ -2,7 +2,8 @@
 
 report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percentile bootstrap over items):
 
-- ``attack``, ``input`` {path, kind}, ``units``, ``n_fit``, ``n_heldout``, ``split`` {seed, items};
+- ``attack``, ``input`` {path, kind, recording: the facts of the recording the models depend on, each with where
+  it was read}, ``units``, ``n_fit``, ``n_heldout``, ``split`` {seed, items};
 - ``heldout_scoring`` {definition, latent}: how held-out items are scored; ``latent`` names the per-frame
   quantity nobody can know in advance (None for inputs without one);
 - ``base`` / ``extended``: {model, params, param_intervals, heldout_rmse (predictive), heldout_rmse_interval,
@@ -396,7 +397,8 @@ def _problem_lines(report: dict) -> list[str]:
             " effect is its validation ratio over the fit items."
             if report["n_heldout"] < MIN_TESTED_ITEMS
             else ""
-        ),
+        )
+        + "".join(f" {k.replace('_', ' ')}: {v}." for k, v in report["input"]["recording"].items()),
         "",
         "## What the simulation gets wrong",
         "",

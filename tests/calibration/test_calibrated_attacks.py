@@ -34,6 +34,7 @@ CALIBRATED = {
         "reflectance_floor": 0.2,
         "crosstalk": [[0.8, 0.1, 0.0], [0.1, 0.7, 0.1], [0.0, 0.2, 0.9]],
         "gamma": 1.0,
+        "projector_gamma": 2.2,
     },
     "laser_color_strip": {
         "model": "rolling_shutter",
@@ -113,6 +114,7 @@ def test_a_calibration_set_calibrates_its_attacks_and_leaves_the_others_paper(tm
     assert list(attacks) == list(CAMERA_ATTACKS)
     assert attacks["laser_blinding"].model == "physical"
     assert attacks["light_projection"].model == "additive"
+    assert attacks["light_projection"].physical["projector_gamma"] == 2.2
     x = scene()
     for name in ("em_truncation", "ultrasound_blur", "laser_color_strip"):
         paper = make_attack(name, intensity=1.0)

@@ -304,7 +304,9 @@ def test_both_trust_region_steps_and_both_jacobians_reach_the_same_triple_fit(tm
     assert fits["exact"]["projector_gamma"] == pytest.approx(2.2, abs=0.1)
     assert fits["exact"] == pytest.approx(fits["lsmr"], abs=2e-3)
     # the Jacobian by finite differences (the default, for speed: docs/bench/jacobian_choice.py) or by forward mode
-    forward = fit_least_squares(problem.param_specs(effects), residuals, tr_solver="exact", jacobian="forward")
+    forward = fit_least_squares(
+        problem.param_specs(effects), residuals, tr_solver="exact", jacobian="forward"
+    )
     assert forward == pytest.approx(fits["exact"], abs=1e-4)
     with pytest.raises(ValueError, match="2-point, forward"):
         fit_least_squares(problem.param_specs(effects), residuals, jacobian="3-point")

@@ -215,3 +215,35 @@ def test_uint8_kernel_is_the_float_composite_rounded(position):
     out = attack.apply_params(images, params)
     reference = attack.apply_params(images.float() / 255, params)
     assert torch.equal(out, torch.round(reference * 255).to(torch.uint8))
+
+
+def test_the_projectors_gamma_turns_the_pattern_into_light_apart_from_the_cameras_curve():
+    """An attacker's pattern is a frame sent to a projector: its light is pattern ** projector_gamma (the display's
+    transfer) while the scene is decoded and re-encoded by the camera's sRGB curve; numpy's reference, not the
+    package's decode."""
+    image = torch.full((1, 3, 96, 96), 0.3)
+    options = {"model": "additive", "pattern": "disk", "size": 0.5, "strength": 0.4, "gamma": None}
+    emitted = LightProjection("strong", **options, projector_gamma=2.4)(image)
+    captured = LightProjection("strong", **options)(image)
+    watermark = LightProjection("strong", **options).watermark(96, 96)
+    top, left = (96 - watermark.shape[-2]) // 2, (96 - watermark.shape[-1]) // 2
+    rgb, alpha = watermark[:3].double().numpy(), watermark[3:].double().numpy()
+    pattern = np.zeros((3, 96, 96))
+    pattern[:, top : top + rgb.shape[1], left : left + rgb.shape[2]] = rgb * alpha
+
+    def srgb_decode(v):
+        return np.where(v <= 0.04045, v / 12.92, ((v + 0.055) / 1.055) ** 2.4)
+
+    def srgb_encode(v):
+        return np.where(v <= 0.0031308, 12.92 * v, 1.055 * np.clip(v, 1e-12, None) ** (1 / 2.4) - 0.055)
+
+    strength = 0.4 * 1.0  # the strong level is intensity 1
+    total = np.clip(srgb_decode(0.3) + strength * pattern**2.4, 0.0, 1.0)
+    expected = srgb_encode(total)
+    assert np.allclose(emitted[0].double().numpy(), expected, atol=2e-5)
+    # decoded by the camera's curve instead, a half-bright pattern pixel is another light
+    assert float((emitted - captured).abs().max()) > 0.01
+    with pytest.raises(ValueError, match="'additive' or 'blend'"):
+        LightProjection(projector_gamma=2.2)
+    with pytest.raises(ValueError, match="> 0"):
+        LightProjection(model="additive", projector_gamma=0.0)
