@@ -4,6 +4,10 @@ Base (the paper): the captured colour is an alpha blend of the surface and the p
 projector's light *adds* to the ambient light, in proportion to what the surface reflects, seen through the
 camera's colour filters (cross-talk between primaries), and the sensor saturates.
 
+What a recorded projected colour is comes from the data (``PATTERN_RECORDS``): the frame the projector was sent,
+whose light is the projector's own display transfer (``projector_gamma``, fitted with every model in which light
+adds), or the projection as the camera captured it, decoded through the camera's tone curve like the scene.
+
 Every model's output is clipped to the file's range (no camera writes more than its white); ``clipping`` is a
 sensor that saturates *below* the file's maximum (a white level < 1, e.g. video range or white-balance gains
 applied after the raw clip), so saturation exactly at the file's maximum is part of every model and is never

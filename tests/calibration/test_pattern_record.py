@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
+from lerobot_phantom.calibration.example import write_example
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 
@@ -83,3 +84,18 @@ def test_the_pattern_record_flag_belongs_to_light_projection(tmp_path):
         build_problem(
             CalibrateConfig(attack="laser_color_strip", measured=str(table), pattern_record="emitted")
         )
+
+
+def test_a_colour_triple_table_is_emitted_by_its_format_unless_told(tmp_path):
+    # SLAP's addition_r,g,b is the colour the projector emitted; --pattern-record captured says otherwise
+    path = write_example(tmp_path, rows=60)
+    additive = frozenset({"additive_light"})
+    emitted = build_problem(CalibrateConfig(attack="light_projection", measured=str(path)))
+    assert "projector_gamma" in {p.name for p in emitted.param_specs(additive)}
+    assert emitted.recording_facts()["pattern_record_source"].startswith("the table's format")
+    captured = build_problem(
+        CalibrateConfig(attack="light_projection", measured=str(path), pattern_record="captured")
+    )
+    assert "projector_gamma" not in {p.name for p in captured.param_specs(additive)}
+    with pytest.raises(ValueError, match="valid: 'emitted'"):
+        build_problem(CalibrateConfig(attack="light_projection", measured=str(path), pattern_record="sent"))

@@ -85,6 +85,9 @@ def test_slap_triples(tmp_path, name):
     assert report["extended"]["heldout_rmse"] <= PROJECTION_LIMIT
     assert report["gain"]["rmse_ratio_interval"]["low"] > 1.0
     assert_named_causes_are_identified(report)
+    # SLAP's addition_r,g,b is the colour the projector emitted: its light is the projector's transfer of it
+    assert report["input"]["recording"]["pattern_record"].startswith("emitted")
+    assert "projector_gamma" in report["extended"]["params"]
 
 
 @pytest.mark.slow
