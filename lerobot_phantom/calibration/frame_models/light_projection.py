@@ -82,12 +82,6 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         else:
             self.pattern_record_source = "--pattern-record"
         self.pattern_record = check_pattern_record(pattern_record, self.pattern_record_source)
-        if self.pattern_record == "emitted":
-            # a board capture holds the camera's response to the projector's primaries; an emitted frame leaves the
-            # cross-talk to be found, a fourth term that pays only beside the other three (camsim's filmic cross-talk
-            # draw 725596845: light, cross-talk and shoulder pinned at a hard knee without the reflectance, all four
-            # named only when scored together; docs/bench/session76.md)
-            self.joint_effects = 4
         super().__init__(pairs, seed)
         # one kernel for every value a fit tries: as wide as the widest spread at the smallest working scale
         self.spread_radius = max(math.ceil(3.0 * SPREAD_HIGH_REF_PX / p.to_reference) for p in pairs)
