@@ -33,7 +33,10 @@ def main() -> None:
                 for k in ("projector_gamma", "reflectance_floor", "shoulder", "shoulder_exponent")
                 if k in fit.params
             )
-            print(f"{record}, {'+'.join(FORM + extra)}: RMSE {np.sqrt(sse / n):.3f} grey levels; {shown}", flush=True)
+            print(
+                f"{record}, {'+'.join(FORM + extra)}: RMSE {np.sqrt(sse / n):.3f} grey levels; {shown}",
+                flush=True,
+            )
 
 
 if __name__ == "__main__":
