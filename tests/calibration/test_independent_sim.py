@@ -586,7 +586,7 @@ def test_a_filmic_cross_talk_draw_names_the_reflectance_it_plants(root):
     """projection_crosstalk on a filmic camera (case seed 279192423, master seed 3044965331 of session 75's matrix,
     where it named light, cross-talk, clipping, spread and a power law; sessions 18-75 missed the reflectance on most
     filmic cameras drawn). The pattern is the frame camsim's projector was sent, whose light is frame ** 2.2: decoded
-    through the camera's filmic curve, a half level became a twentieth of that light, and the fit ran the shoulder's
+    through the camera's filmic curve, a half level became a sixth of that light, and the fit ran the shoulder's
     knee to a hard clip and dropped the reflectance. Decoded by the fitted projector gamma (the pairs record their
     pattern as emitted), the written model holds every planted term, the projector gamma near camsim's and the floor
     near full modulation (docs/bench/session76.md)."""
