@@ -56,6 +56,10 @@ def test_colour_triples_find_additive_light(tmp_path):
     assert report["extended"]["heldout_rmse"] < 3.0
     assert report["gain"]["rmse_ratio"] >= 1.5
     assert_evidence_quotes_the_compared_steps(report)
+    # what the projected colour is comes from SLAP's format, and both reports say so
+    assert report["input"]["recording"]["pattern_record"].startswith("emitted")
+    assert "projector_gamma" in report["extended"]["params"]
+    assert "pattern record: emitted" in (tmp_path / "out" / "report.md").read_text()
 
 
 def one_material_table(path, ripple: float):
@@ -270,6 +274,12 @@ def test_cli_main_accepts_dashed_options(tmp_path, capsys):
     assert calibrated_kwargs("laser_color_strip", tmp_path / "out")["frame_rows"] == 600
     assert report["base"]["param_intervals"]["band_rows"]["draws"] == 10
     assert report["extended"]["derived"]["frames_averaged"] == "all"
+    # the table's geometry and units came from the flags, and both reports say where
+    recording = report["input"]["recording"]
+    assert recording["image_height"] == "600"
+    assert recording["image_height_source"] == "--image-height"
+    assert recording["exposure_source"] == "--exposure-unit-s"
+    assert "image height source: --image-height." in (tmp_path / "out" / "report.md").read_text()
     # stripe tables are compared row by row (StripeProblem.selection_score), and the report says so
     assert report["selection"]["score"] == "mean per-item error"
     assert "by 2-fold cross-validated" in report["selection"]["criterion"]
