@@ -433,6 +433,11 @@ class Step:
     # per scored group (by its label in ``tried``): its per-item terms, like ``item_errors``; what a simpler form
     # that lost this step to a richer one is judged by if the richer one is not identified (identify.py)
     tried_item_errors: dict[str, np.ndarray] = field(default_factory=dict)
+    # the last step of a pass, per selected effect that no other selected effect builds on: the score and per-item
+    # terms of the selected model without it, on the same folds (:func:`forward_select`); what it still brings once
+    # every later step is in (identify.py, rule 2)
+    without: dict[str, float] = field(default_factory=dict)
+    without_item_errors: dict[str, np.ndarray] = field(default_factory=dict)
 
 
 def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
@@ -454,6 +459,11 @@ def dependants(problem: Problem, effects: frozenset[str], effect: str) -> frozen
         frontier = {e for e in effects if requires.get(e, set()) & frontier} - found
         found |= frontier
     return frozenset(found)
+
+
+def leaves(problem: Problem, effects: frozenset[str]) -> list[str]:
+    """The effects in ``effects`` that no other one in it builds on, by name."""
+    return sorted(e for e in effects if not dependants(problem, effects, e))
 
 
 def own_params(problem: Problem, effects: frozenset[str], effect: str) -> list[Param]:
@@ -603,7 +613,11 @@ def forward_select(
 
     Before that comparison, a scored group is set aside (``Step.set_aside``, with the reason) when a member's own
     parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
-    of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`)."""
+    of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`).
+
+    A step never revisits an earlier one, so an effect taken as the best of its step can stand in for one that
+    only a later step could take: on the same folds, the selected model is scored without each effect no other
+    selected effect builds on (``Step.without`` of the last step), for identification's rule 2."""
     splits = selection_folds(fit_items, folds, seed, max_train_items)
 
     def aligned(per_item: dict[int, float]) -> np.ndarray:
@@ -612,6 +626,7 @@ def forward_select(
     chosen: frozenset[str] = frozenset()
     current, parents, per_item = cross_validated(problem, chosen, splits, None)
     steps = [Step([], current, {}, aligned(per_item))]
+    fold_fits = [parents]  # per step
     while True:
         scored, labels = scored_groups(problem, chosen, withdrawn, splits, parents)
         if not scored:
@@ -635,6 +650,7 @@ def forward_select(
                         paired=True,
                     )
                 )
+                fold_fits.append(scored[prefix][1])
             taken = joint
         else:
             best_single, tied = lowest_scoring(problem, {g: v for g, v in eligible.items() if len(g) == 1})
@@ -645,6 +661,20 @@ def forward_select(
         chosen = chosen | taken
         current, parents, per_item = scored[taken]
         steps.append(Step(sorted(chosen), current, {}, aligned(per_item)))
+        fold_fits.append(parents)
+    for effect in leaves(problem, chosen):
+        rest = chosen - {effect}
+        # warm start: the fold fits of the largest step nested in the model without it, as identification's refits
+        nested = max(
+            (k for k, s in enumerate(steps) if set(s.effects) <= rest), key=lambda k: len(steps[k].effects)
+        )
+        if set(steps[nested].effects) == rest:
+            score, terms = steps[nested].validation_error, steps[nested].item_errors
+        else:
+            score, _, without = cross_validated(problem, rest, splits, fold_fits[nested])
+            terms = aligned(without)
+        steps[-1].without[effect] = score
+        steps[-1].without_item_errors[effect] = terms
     return chosen, steps
 
 

@@ -14,7 +14,13 @@ The rule (:func:`identify`): an extension is a named cause only if
    is compared with them: the model without it cannot have them either, so its gain is what it brings together
    with those of its dependants that pass 2-5 on their own (an effect of no use alone is still not named unless
    what it makes possible is); the effects of a group selection took in one step are judged together, so each
-   member is compared with what any member of the group hosts;
+   member is compared with what any member of the group hosts. And where no other selected effect builds on it,
+   it is not shown redundant once every later step is in: the interval of the error ratio of the selected model
+   without it to the selected model, on the same folds (``core.forward_select``'s ``Step.without``), does not lie
+   wholly under 1 + half the selection margin (:class:`Redundancy`). A step never revisits an earlier one, so an effect
+   taken as its step's best can stand in for a form a later step brings (camsim's filmic light projection took a
+   sub-white clip while the shoulder's knee ran to its bound, then the shoulder, light spread and reflectance,
+   beside which the clip gained nothing: docs/bench/session77.md);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
    range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare
    whose inner scale lies far inside the clipped core is a pure power law where the frames show it;
@@ -41,7 +47,9 @@ judged in its place (:func:`simpler_form_result`): rule 2 on its own scores, rul
 
 Selection is greedy, so an extension that fails the rule has still shaped every step after the one that took it.
 One that fails on its own evidence (not only because an effect it builds on, or was refitted without, failed) is
-withdrawn, and selection and identification run again without it until a pass withdraws nothing
+withdrawn, and selection and identification run again without it until a pass withdraws nothing; effects that
+fail only rule 2's test of the selected model without them are withdrawn one at a time, the one whose removal
+costs least first (backward elimination: without it, the others may pay again)
 (:func:`select_and_identify`; ``selection.withdrawn`` in report.json). Every pass is
 :func:`core.select_forms`: where it took the simpler of two forms of one term, it runs again without that form
 (``selection.form_passes``).
@@ -230,6 +238,7 @@ def identify(
     nulls: Mapping[str, float],
     limits: Mapping[str, Mapping[str, str]] | None = None,
     joint_null: Interval | None = None,
+    redundancy: Redundancy | None = None,
 ) -> Identification:
     """Apply the module's rule to one extension.
 
@@ -239,7 +248,8 @@ def identify(
     of the inner cross-validated error ratio without / with the extension (None if it was never scored);
     ``limits``: parameter -> {bound side: what the model is there}, for bounds that are the form's physical limit
     (``core.physical_limits``: ``Param.low_limit``/``high_limit``); ``joint_null``: the interval of the
-    extension's distance from its null when its nulls all sit at bounds (:func:`joint_null_interval`)."""
+    extension's distance from its null when its nulls all sit at bounds (:func:`joint_null_interval`);
+    ``redundancy``: the selected model scored without each effect no other builds on (None: not scored)."""
     limits = limits or {}
     reasons = []
     if not selected:
@@ -252,9 +262,44 @@ def identify(
             f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
             "does not exclude 1 (no gain)"
         )
+    if redundancy is not None and redundancy.shown(effect):
+        reasons.append(redundancy.reason(effect))
     parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits, joint_null)
     reasons += parameter_reasons
     return Identification(effect, not reasons, tuple(reasons), tuple(notes))
+
+
+@dataclass(frozen=True)
+class Redundancy:
+    """Rule 2's test of what an effect still brings once every other selected effect is in: per effect no other
+    selected effect builds on, the paired bootstrap interval of the inner cross-validated error ratio of the selected
+    model without it to the selected model (the last step's ``Step.without``). An effect is shown redundant when the
+    whole interval lies under ``1 + margin / 2``: the data then show that it brings less than half the gain
+    selection asks of a step, not merely that its gain is uncertain (a reflectance term carried by a few pairs
+    gains 7% with an interval reaching under 1; camsim master seed 1396225205). Removal asks for less than entry, as
+    stepwise selection's removal threshold sits beside its entry threshold, so that a step and its undoing cannot
+    alternate: at the whole margin a planted reflectance that gained 1.1% (0.98-1.04) was withdrawn after the clip
+    beside it, and the repeat without both ran the shoulder's knee to its bound and named a power law
+    (master seed 913236811; the clips this test withdraws gain -0.1% to 0.2%, interval ends under 0.5%:
+    docs/bench/session77.md)."""
+
+    ratios: Mapping[str, Interval]
+    margin: float
+
+    def shown(self, effect: str) -> bool:
+        return effect in self.ratios and self.ratios[effect].high < self.bound
+
+    @property
+    def bound(self) -> float:
+        return 1.0 + self.margin / 2
+
+    def reason(self, effect: str) -> str:
+        ratio = self.ratios[effect]
+        return (
+            f"the selected model without it scores an inner cross-validated error ratio of {ratio.estimate:.4f} "
+            f"({100 * ratio.level:.0f}% interval {ratio.low:.4f}-{ratio.high:.4f}) to the selected model, under "
+            f"{self.bound:g} (half the selection margin): the effects selected after it hold what it brought"
+        )
 
 
 def excludes_null(interval: Interval, null: float, low: float, high: float) -> bool:
@@ -446,7 +491,8 @@ class Selection:
     fit: Fit  # the model with the identified effects only, fitted on the fit items
     intervals: dict[str, Interval]  # its parameters' intervals
     # selected effects that failed the rule on their own evidence, not only because an effect they build on or
-    # were refitted without failed (select_and_identify withdraws them)
+    # were refitted without failed (select_and_identify withdraws them); of those that fail only the test of the
+    # selected model without them (rule 2), the one whose removal costs least, and only when no other fails
     rejected: list[str] = field(default_factory=list)
     # the selection passes repeated without a simpler form of a term (core.select_forms), set by select_and_identify
     form_passes: list[FormPass] = field(default_factory=list)
@@ -462,17 +508,34 @@ def identify_selection(
     *,
     draws: int,
     rng: np.random.Generator,
+    redundancy: Redundancy | None = None,
 ) -> Selection:
-    """Judge every extension forward selection kept by the module's rule; refit without those that fail."""
+    """Judge every extension forward selection kept by the module's rule; refit without those that fail.
+    ``redundancy``: :func:`redundancy` of the steps (None: rule 2's test of the selected model without each effect is
+    not made)."""
     selected_fit = chain[-1]
     samples = parameter_draws(problem, selected_fit, fit_items, draws=draws, rng=rng)
     intervals = draw_intervals(selected_fit, samples)
     entries = selection_entries(steps)
     own = own_evidence_results(
-        problem, steps, entries, selected_fit, intervals, fit_items, samples=samples, rng=rng
+        problem,
+        steps,
+        entries,
+        selected_fit,
+        intervals,
+        fit_items,
+        samples=samples,
+        rng=rng,
+        redundancy=redundancy,
     )
     # taken before the passes below add collateral reasons (an effect it builds on, or a refit without one, failed)
-    rejected = sorted(effect for effect, result in own.items() if not result["identified"])
+    rejected = sorted(
+        effect for effect, result in own.items() if not result["identified"] and not result["redundant"]
+    )
+    redundant = [effect for effect, result in own.items() if result["redundant"]]
+    if redundant and not rejected:
+        # one at a time, as backward elimination: without the one the others hold best, the rest may gain again
+        rejected = [min(redundant, key=lambda e: own[e]["ratio_without"]["estimate"])]
     results, identified = requirement_results(problem, entries, own)
     for effect, before, after in entries:
         if not own[effect]["identified"]:
@@ -508,6 +571,17 @@ def selection_entries(steps: list[Step]) -> list[tuple[str, int, int]]:
     return entries
 
 
+def redundancy(problem: Problem, steps: list[Step], *, margin: float, rng: np.random.Generator) -> Redundancy:
+    """The :class:`Redundancy` test of the effects the selection's last step scored the selected model without
+    (``Step.without``), at the selection's ``margin``."""
+    last = steps[-1]
+    ratios = {
+        effect: error_ratio(terms, last.item_errors, rng=rng, score=problem.selection_score)
+        for effect, terms in sorted(last.without_item_errors.items())
+    }
+    return Redundancy(ratios, margin)
+
+
 def own_evidence_results(
     problem: Problem,
     steps: list[Step],
@@ -518,8 +592,10 @@ def own_evidence_results(
     *,
     samples: Sequence[Mapping[str, float]],
     rng: np.random.Generator,
+    redundancy: Redundancy | None,
 ) -> dict[str, dict]:
-    """Each selected effect's result by the rule on its own evidence: its validation ratio and its own parameters
+    """Each selected effect's result by the rule on its own evidence: its validation ratio, the ratio of the
+    selected model without it (``redundancy``; ``redundant`` when that alone fails) and its own parameters
     in the selected model (``samples``: the bootstrap refits ``intervals`` come from). Leaves first: an effect that
     hosts others (the form their parameters live in) is judged with those of them that pass on their own, because
     the model without it cannot have them either; so is every other member of a group taken with it in one step."""
@@ -560,8 +636,15 @@ def own_evidence_results(
             nulls=nulls,
             limits=physical_limits(specs),
             joint_null=joint_null,
+            redundancy=redundancy,
         )
         result = outcome.as_dict()
+        without = None if redundancy is None else redundancy.ratios.get(effect)
+        result["redundant"] = (
+            redundancy is not None
+            and redundancy.shown(effect)
+            and outcome.reasons == (redundancy.reason(effect),)
+        )
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
         # whole frame); each failed check is a reason
         checks = getattr(problem, "identification_checks", None)
@@ -574,6 +657,7 @@ def own_evidence_results(
             # the selection steps the ratio compares (an interacting pair: from the step before the pair)
             compared_steps=[before, after],
             judged_with=sorted(hosted),
+            ratio_without=None if without is None else without.as_dict(),
             params=params,
             intervals={p.name: intervals[p.name].as_dict() for p in specs},
             nulls=nulls,
@@ -756,7 +840,9 @@ def select_and_identify(
     draws: int,
 ) -> tuple[list[Step], list[Fit], Selection, list[Withdrawal]]:
     """Forward selection and identification, repeated without the effects identification rejects on their own
-    evidence (the module docstring says why) until a pass rejects none: (steps, chain, selection) of the last pass
+    evidence (the module docstring says why) until a pass rejects none (where all a pass rejects fail only the
+    test of the selected model without them, the one whose removal costs least, as backward elimination, since
+    without it the others may pay again): (steps, chain, selection) of the last pass
     and what was withdrawn (each withdrawal holds its pass's steps). Each pass sees the fit items only and has the
     same seeds, so a pass that withdraws nothing is the single pass of before. Measured case: camsim's blinding
     auto-exposure (master seed 3986568970), where a power law at its bound 4 beat the meter with linear light by
@@ -774,7 +860,14 @@ def select_and_identify(
         )
         chain = fit_chain(problem, steps, fit_items)
         selection = identify_selection(
-            problem, steps, chain, fit_items, draws=draws, rng=np.random.default_rng([seed, 1])
+            problem,
+            steps,
+            chain,
+            fit_items,
+            draws=draws,
+            rng=np.random.default_rng([seed, 1]),
+            # a stream of their own: the intervals of before are drawn as they were
+            redundancy=redundancy(problem, steps, margin=margin, rng=np.random.default_rng([seed, 6])),
         )
         selection.form_passes = form_passes
         selection.unoffered = unoffered

@@ -24,7 +24,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
-  includes), params, intervals, nulls} (rule: ``calibration/identify.py``); a cause implied by an identified
+  includes), ratio_without (interval of the selected model without it to the selected model, where no other
+  selected effect builds on it; else null), redundant (that is all it fails), params, intervals, nulls} (rule: ``calibration/identify.py``); a cause implied by an identified
   effect's form (``Effect.implies``) has ``implied_by`` and its statistic as ``params`` (identify.implied_results);
   the simpler form of a term judged in place of a richer one that is not identified has ``in_place_of`` and
   ``scored`` {group, validation_error} (identify.simpler_form_result);
@@ -193,6 +194,12 @@ def finding(problem: Problem, result: dict, steps: list[Step], base: Fit, extend
         + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
         f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
     )
+    without = result.get("ratio_without")
+    if without:
+        evidence += (
+            f"; beside the other selected effects, the model without it: ratio {without['estimate']:.3f} "
+            f"({without['low']:.3f}-{without['high']:.3f})"
+        )
     if result["intervals"]:
         evidence += "; " + ", ".join(
             f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
@@ -237,11 +244,14 @@ def selection_section(
         )
         + "); then each kept "
         "extension must pass the identification rule "
-        "(calibration/identify.py): cross-validated error ratio interval above 1, no own parameter at a "
-        "bound, an interval excluding its null value; a richer form that fails gives way to the simpler form "
+        "(calibration/identify.py): cross-validated error ratio interval above 1, and, where no other kept "
+        "extension builds on it, that of the selected model without it to the selected model not wholly under "
+        f"{1 + margin / 2:g} (half the gain a step must bring); no own parameter at a bound, an interval excluding "
+        "its null value; a richer form that fails gives way to the simpler form "
         "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
         "when the interval of its statistic excludes the null value; an extension a pass selected and "
-        "identification rejected on its own evidence is withdrawn and selection repeated without it; a pass "
+        "identification rejected on its own evidence is withdrawn and selection repeated without it (where the "
+        "selected model without it is all that fails, only the one of them whose removal costs least); a pass "
         "that took the simpler of two forms of one term is repeated without that form, and the repeat is taken "
         f"when it holds a richer form and its last score is >= {100 * margin:.0f}% under the pass's"
     )

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 import torch
 
+from lerobot_phantom.calibration import core
 from lerobot_phantom.calibration.core import (
     TIE_SHARE,
     Effect,
@@ -39,6 +40,7 @@ from lerobot_phantom.calibration.identify import (
     own_params,
     parameter_checks,
     percentile_interval,
+    redundancy,
     refit_reasons,
     resample,
     resummed_totals,
@@ -981,3 +983,170 @@ def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
     assert any("sits at its high bound 10" in r for r in reasons["parent"]), reasons
     assert reasons["child"] and all(r.startswith("builds on parent") for r in reasons["child"]), reasons
     assert selection.rejected == ["parent"]
+
+
+class ClipBeforeShoulder(Problem):
+    """camsim's filmic light projection in miniature (master seed 690823847, docs/bench/session77.md): alone, the
+    shoulder's knee runs to its bound (set aside), so the first step takes a clip; with the clip in, the shoulder
+    takes the next step and light spread the one after, and beside both of them the clip brings nothing (the
+    model without it scores what the model with it does). Light spread alone also earns a step, so a pass without
+    the clip has a path to the shoulder. Errors are fixed per model and the same on every item."""
+
+    candidates = (
+        Effect("clip", "the sensor saturates below the file's white"),
+        Effect("shoulder", "the tone curve rolls off towards white"),
+        Effect("spread", "the projected light spreads over neighbouring pixels"),
+    )
+    joint_effects = 1
+    errors: typing.ClassVar[dict[str, float]] = {
+        "": 10.0,
+        "clip": 9.0,
+        "shoulder": 8.0,
+        "spread": 9.4,
+        "clip+shoulder": 7.0,
+        "clip+spread": 8.9,
+        "shoulder+spread": 6.0,
+        "clip+shoulder+spread": 6.0,
+    }
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def param_specs(self, effects):
+        specs = {
+            "clip": Param("white", 0.95, 0.2, 1.0),
+            "shoulder": Param("knee", 1.0, 0.25, 4.0),
+            "spread": Param("sigma", 2.0, 0.0, 8.0),
+        }
+        return [specs[e] for e in sorted(effects)]
+
+    def null_values(self, effect):
+        return {"clip": {"white": 1.0}, "spread": {"sigma": 0.0}}.get(effect, {})
+
+    def fit(self, effects, items, start=None) -> Fit:
+        knee = 4.0 if not effects & {"clip", "spread"} else 1.0
+        values = {"white": 0.7, "knee": knee, "sigma": 2.0}
+        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
+
+
+def test_an_effect_the_later_steps_make_redundant_is_withdrawn(tmp_path):
+    problem = ClipBeforeShoulder()
+    steps, chain, selection, withdrawn = select_and_identify(
+        problem, np.arange(20), seed=0, margin=0.05, folds=4, draws=20
+    )
+    # pass 1 took the clip (the shoulder set aside alone), then the shoulder, then spread; the clip's own step
+    # gained 10%, but the model without it scores the model's 6.0
+    assert [(w.effect, w.selection_pass) for w in withdrawn] == [("clip", 1)]
+    first = withdrawn[0].pass_steps
+    assert [s.effects for s in first] == [[], ["clip"], ["clip", "shoulder"], ["clip", "shoulder", "spread"]]
+    assert first[-1].without == pytest.approx({"clip": 6.0, "shoulder": 8.9, "spread": 7.0})
+    assert (
+        len(withdrawn[0].reasons) == 1
+        and "under 1.025 (half the selection margin)" in withdrawn[0].reasons[0]
+    )
+    # pass 2, without the clip, takes spread, then the shoulder beside it; both still pay beside the other
+    assert [s.effects for s in steps] == [[], ["spread"], ["shoulder", "spread"]]
+    assert steps[-1].without == pytest.approx({"shoulder": 9.4, "spread": 8.0})
+    assert selection.identified == ["shoulder", "spread"] and chain[-1].effects == {"shoulder", "spread"}
+    ratios = {r["effect"]: r["ratio_without"]["estimate"] for r in selection.results}
+    assert ratios == pytest.approx({"shoulder": 9.4 / 6.0, "spread": 8.0 / 6.0})
+    report = report_on_twenty_items(problem, selection, steps, withdrawn)
+    assert (
+        "that of the selected model without it to the selected model not wholly under 1.025"
+        in report["selection"]["criterion"]
+    )
+    evidence = {f["effect"]: f["evidence"] for f in report["findings"]}
+    assert (
+        "beside the other selected effects, the model without it: ratio 1.567 (1.567-1.567)"
+        in evidence["shoulder"]
+    )
+    write_markdown(report, [], tmp_path / "report.md")
+    assert (
+        "withdrawn after pass 1: `clip`, not identified (the selected model without it"
+        in (tmp_path / "report.md").read_text()
+    )
+
+
+def test_of_effects_shown_redundant_the_cheapest_to_remove_is_withdrawn_alone_and_an_uncertain_gain_is_kept():
+    """Effects the selected model does about as well without: a and b by a ratio of 1.0 and 0.99 on every item
+    (shown under half the margin, 1.025); e by 3% on every item (under the margin a step must bring, but not under
+    half of it); d by 4% on average but unevenly over the items, its interval reaching from under 1 to past 1.025
+    (not shown redundant, though its gain is uncertain). Removing one of a and b can give the other its gain back,
+    so only the one whose removal costs least is withdrawn in a pass (backward elimination)."""
+    steps = [Step([], 10.0, {}, np.full(20, 100.0))]
+    for k in range(5):
+        steps.append(Step(sorted("abcde"[: k + 1]), 9.0 - k * 0.6, {}, np.full(20, (9.0 - k * 0.6) ** 2)))
+    final = steps[-1].validation_error
+    # two of 20 items carry d's gain, two others fit better without it
+    uneven = final**2 * np.select([np.arange(20) % 10 == 0, np.arange(20) % 10 == 5], [2.0, 0.8], 1.0)
+    steps[-1].without_item_errors = {
+        "a": np.full(20, final**2),
+        "b": np.full(20, (0.99 * final) ** 2),
+        "c": np.full(20, (1.3 * final) ** 2),
+        "d": uneven,
+        "e": np.full(20, (1.03 * final) ** 2),
+    }
+
+    class FiveEffects(Problem):
+        candidates = tuple(Effect(name, "one of five") for name in "abcde")
+
+        def param_specs(self, effects):
+            return []
+
+        def fit(self, effects, items, start=None) -> Fit:
+            return Fit(effects, {})
+
+    problem = FiveEffects()
+    items = np.arange(20)
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    test = redundancy(problem, steps, margin=0.05, rng=np.random.default_rng(0))
+    ratios = test.ratios
+    assert {e: i.estimate for e, i in ratios.items()} == pytest.approx(
+        {"a": 1.0, "b": 0.99, "c": 1.3, "d": np.sqrt(uneven.mean()) / final, "e": 1.03}
+    )
+    assert ratios["d"].low < 1.0 and ratios["d"].high > 1.025
+    assert [e for e in "abcde" if test.shown(e)] == ["a", "b"]
+    selection = identify_selection(
+        problem, steps, chain, items, draws=20, rng=np.random.default_rng(1), redundancy=test
+    )
+    results = {r["effect"]: r for r in selection.results}
+    assert [e for e, r in results.items() if r["redundant"]] == ["a", "b"]
+    assert [e for e, r in results.items() if r["identified"]] == ["c", "d", "e"]
+    assert selection.rejected == ["b"]
+    # without the test, the same steps name all five
+    plain = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    assert plain.identified == ["a", "b", "c", "d", "e"]
+
+
+def test_a_host_is_not_scored_without_and_a_model_a_step_holds_is_not_refitted():
+    """forward_select scores the selected model without each effect no other builds on; where that model is a
+    step of the pass, its scores are the step's."""
+
+    class CountingParentAndChild(ParentAndChild):
+        def __init__(self) -> None:
+            self.fitted: list[frozenset[str]] = []
+
+        @property
+        def n_items(self) -> int:
+            return 20
+
+        def fit(self, effects, items, start=None) -> Fit:
+            self.fitted.append(frozenset(effects))
+            values = {"rate": 3.0, "threshold": 0.5}  # off their bounds: neither is set aside
+            return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+
+        def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+            error = {0: 10.0, 1: 8.0, 2: 6.0}[len(fit.effects)]
+            return error**2 * len(items), len(items)
+
+    problem = CountingParentAndChild()
+    chosen, steps = core.forward_select(problem, np.arange(20), seed=0, margin=0.05)
+    assert chosen == {"parent", "child"} and [s.effects for s in steps][-1] == ["child", "parent"]
+    assert steps[-1].without == {"child": 8.0}
+    np.testing.assert_array_equal(steps[-1].without_item_errors["child"], steps[-2].item_errors)
+    # every model fitted in the folds was one selection scored: the parent alone was not fitted again
+    assert problem.fitted.count(frozenset({"parent"})) == 4
