@@ -821,10 +821,24 @@ def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identifi
     )
 
 
-class GreedyPowerLaw(Problem):
+class FixedErrorsOnTwentyItems(Problem):
+    """A problem whose error is fixed per model (``errors``, by the effects' names joined with "+") and the same on
+    each of its 20 items."""
+
+    errors: typing.ClassVar[dict[str, float]] = {}
+
+    @property
+    def n_items(self) -> int:
+        return 20
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
+
+
+class GreedyPowerLaw(FixedErrorsOnTwentyItems):
     """camsim's blinding auto-exposure case in miniature (master seed 3986568970): a power law alone edges out the
     meter with linear light by 0.6%, and on all items its exponent runs to its bound; the meter and light are
-    what made the frames. Errors are fixed per model and the same on every item."""
+    what made the frames."""
 
     candidates = (
         Effect("light", "light adds in linear irradiance"),
@@ -842,19 +856,12 @@ class GreedyPowerLaw(Problem):
         "light+meter+power": 14.1,
     }
 
-    @property
-    def n_items(self) -> int:
-        return 20
-
     def param_specs(self, effects):
         return [Param("gamma", 2.2, 0.3, 4.0)] if "power" in effects else []
 
     def fit(self, effects, items, start=None) -> Fit:
         # the exponent reaches its bound only with every item (the written fit and its bootstrap draws)
         return Fit(effects, {"gamma": 4.0 if len(items) == 20 else 3.5} if "power" in effects else {})
-
-    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
-        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
 
 
 def test_an_effect_identification_rejects_is_withdrawn_and_selection_repeated(tmp_path):
@@ -985,12 +992,12 @@ def test_an_effect_that_fails_only_because_its_host_failed_is_not_withdrawn():
     assert selection.rejected == ["parent"]
 
 
-class ClipBeforeShoulder(Problem):
+class ClipBeforeShoulder(FixedErrorsOnTwentyItems):
     """camsim's filmic light projection in miniature (master seed 690823847, docs/bench/session77.md): alone, the
     shoulder's knee runs to its bound (set aside), so the first step takes a clip; with the clip in, the shoulder
     takes the next step and light spread the one after, and beside both of them the clip brings nothing (the
     model without it scores what the model with it does). Light spread alone also earns a step, so a pass without
-    the clip has a path to the shoulder. Errors are fixed per model and the same on every item."""
+    the clip has a path to the shoulder."""
 
     candidates = (
         Effect("clip", "the sensor saturates below the file's white"),
@@ -1009,10 +1016,6 @@ class ClipBeforeShoulder(Problem):
         "clip+shoulder+spread": 6.0,
     }
 
-    @property
-    def n_items(self) -> int:
-        return 20
-
     def param_specs(self, effects):
         specs = {
             "clip": Param("white", 0.95, 0.2, 1.0),
@@ -1028,9 +1031,6 @@ class ClipBeforeShoulder(Problem):
         knee = 4.0 if not effects & {"clip", "spread"} else 1.0
         values = {"white": 0.7, "knee": knee, "sigma": 2.0}
         return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
-
-    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
-        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
 
 
 def test_an_effect_the_later_steps_make_redundant_is_withdrawn(tmp_path):

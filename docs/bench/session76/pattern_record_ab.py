@@ -20,14 +20,19 @@ def report(out: Path, master: int, case: str) -> dict:
     return json.loads((out / f"bt_{master}" / "camsim0" / case / "out" / "report.json").read_text())
 
 
-def main() -> None:
-    case, before, after = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    seeds = sorted(
+def seeds_both_hold(case: str, before: Path, after: Path) -> list[int]:
+    """The master seeds whose report of ``case`` both outputs hold."""
+    return sorted(
         int(p.name.removeprefix("bt_"))
         for p in after.glob("bt_*")
         if (p / "camsim0" / case / "out" / "report.json").is_file()
         and (before / p.name / "camsim0" / case / "out" / "report.json").is_file()
     )
+
+
+def main() -> None:
+    case, before, after = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
+    seeds = seeds_both_hold(case, before, after)
     passed = {"before": 0, "after": 0}
     for master, sim, _case, _seed, _rng, camera in case_draws(case, seeds):
         line = [f"{master} {case} ({camera.tone})"]

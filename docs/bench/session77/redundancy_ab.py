@@ -8,29 +8,21 @@ Usage: ``PYTHONPATH=. python docs/bench/session77/redundancy_ab.py CASE BEFORE_O
 
 from __future__ import annotations
 
-import json
 import re
 import sys
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "session76"))
 from camsim_case_cameras import case_draws
+from pattern_record_ab import report, seeds_both_hold
 
 SHOWN = re.compile(r"error ratio of ([\d.]+) \(90% interval ([\d.]+)-([\d.]+)\).*hold what it brought")
 
 
-def report(out: Path, master: int, case: str) -> dict:
-    return json.loads((out / f"bt_{master}" / "camsim0" / case / "out" / "report.json").read_text())
-
-
 def main() -> None:
     case, before, after = sys.argv[1], Path(sys.argv[2]), Path(sys.argv[3])
-    seeds = sorted(
-        int(p.name.removeprefix("bt_"))
-        for p in after.glob("bt_*")
-        if (p / "camsim0" / case / "out" / "report.json").is_file()
-        and (before / p.name / "camsim0" / case / "out" / "report.json").is_file()
-    )
+    seeds = seeds_both_hold(case, before, after)
     passed, unplanted = {"before": 0, "after": 0}, {"before": 0, "after": 0}
     for master, sim, _case, _seed, _rng, camera in case_draws(case, seeds):
         spec = sim.CASE_BY_NAME[case]
