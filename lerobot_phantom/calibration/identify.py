@@ -17,10 +17,10 @@ The rule (:func:`identify`): an extension is a named cause only if
    member is compared with what any member of the group hosts. And where no other selected effect builds on it,
    it is not shown redundant once every later step is in: the interval of the error ratio of the selected model
    without it to the selected model, on the same folds (``core.forward_select``'s ``Step.without``), does not lie
-   wholly under 1 + half the selection margin (:class:`Redundancy`). A step never revisits an earlier one, so an effect
-   taken as its step's best can stand in for a form a later step brings (camsim's filmic light projection took a
-   sub-white clip while the shoulder's knee ran to its bound, then the shoulder, light spread and reflectance,
-   beside which the clip gained nothing: docs/bench/session77.md);
+   wholly under 1 + half the selection margin (:class:`Redundancy`). A step never revisits an earlier one, so an
+   effect taken as its step's best can stand in for a form a later step brings (camsim's filmic light projection
+   took a sub-white clip while the shoulder's knee ran to its bound, then the shoulder, light spread and
+   reflectance, beside which the clip gained nothing: docs/bench/session77.md);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
    range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare
    whose inner scale lies far inside the clipped core is a pure power law where the frames show it;
@@ -280,7 +280,7 @@ class Redundancy:
     stepwise selection's removal threshold sits beside its entry threshold, so that a step and its undoing cannot
     alternate: at the whole margin a planted reflectance that gained 1.1% (0.98-1.04) was withdrawn after the clip
     beside it, and the repeat without both ran the shoulder's knee to its bound and named a power law
-    (master seed 913236811; the clips this test withdraws gain -0.1% to 0.2%, interval ends under 0.5%:
+    (master seed 913236811; the clips this test withdraws gain -0.9% to +0.3%, interval ends under 0.7%:
     docs/bench/session77.md)."""
 
     ratios: Mapping[str, Interval]
