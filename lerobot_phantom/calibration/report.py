@@ -27,8 +27,9 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   includes), ratio_without (interval of the selected model without it to the selected model, where no other
   selected effect builds on it; else null), redundant (that is all it fails), params, intervals, nulls} (rule:
   ``calibration/identify.py``); a cause implied by an identified effect's form (``Effect.implies``) has
-  ``implied_by`` and its statistic as ``params`` (identify.implied_results); the simpler form of a term judged in place of a richer one that is not identified has ``in_place_of`` and
-  ``scored`` {group, validation_error} (identify.simpler_form_result);
+  ``implied_by`` and its statistic as ``params`` (identify.implied_results); the simpler form of a term judged in
+  place of a richer one that is not identified has ``in_place_of`` and ``scored`` {group, validation_error}
+  (identify.simpler_form_result);
 - ``findings``: identified effects only {effect, cause, evidence} (+ ``shot_noise`` when kept, see noise.py);
 - ``unexplained_structure`` {structure_remains, summary, rule, tested_on, tests [{variable, statistic, value,
   interval, significant, where, ...}; frame pairs' ``variance_by_row`` / ``variance_by_column``: the variance beyond
