@@ -11,8 +11,8 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   identified ones only: what calibrated.json carries) and ``derived``;
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
-- ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score),
-  rejected, not_offered {effect: reason}: candidates the fit items show no sign of, never tried
+- ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score;
+  the last step's without: the score without each effect no other builds on), rejected, not_offered {effect: reason}: candidates the fit items show no sign of, never tried
   (``Problem.unoffered``), set_aside_ahead [{group, validation_error, kept_validation_error, reason}]: groups the
   last step set aside though they scored the margin under the selected model (:func:`set_aside_ahead`), withdrawn
   [{effect, pass, reasons}]: effects an earlier pass selected and identification
@@ -313,6 +313,8 @@ def step_entry(step: Step) -> dict:
         "tried": step.tried,
         "set_aside": step.set_aside,
         "tied": step.tied,
+        # the last step's: the selected model's score without each effect no other builds on (identify.Redundancy)
+        "without": step.without,
     }
 
 

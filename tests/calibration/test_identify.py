@@ -1059,6 +1059,8 @@ def test_an_effect_the_later_steps_make_redundant_is_withdrawn(tmp_path):
         "that of the selected model without it to the selected model not wholly under 1.025"
         in report["selection"]["criterion"]
     )
+    assert report["selection"]["steps"][-1]["without"] == pytest.approx({"shoulder": 9.4, "spread": 8.0})
+    assert report["selection"]["earlier_passes"][0]["steps"][-1]["without"]["clip"] == pytest.approx(6.0)
     evidence = {f["effect"]: f["evidence"] for f in report["findings"]}
     assert (
         "beside the other selected effects, the model without it: ratio 1.567 (1.567-1.567)"
