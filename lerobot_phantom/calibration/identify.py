@@ -216,6 +216,9 @@ class Identification:
     identified: bool
     reasons: tuple[str, ...]
     notes: tuple[str, ...] = ()  # parameters at their physical limit (rule 3): said, but not a reason
+    # rule 2's test of the selected model without it is its only reason (select_and_identify withdraws such
+    # effects one at a time)
+    redundant: bool = False
 
     def as_dict(self) -> dict:
         return {
@@ -262,11 +265,14 @@ def identify(
             f"({100 * validation_ratio.level:.0f}% interval {validation_ratio.low:.3f}-{validation_ratio.high:.3f}) "
             "does not exclude 1 (no gain)"
         )
-    if redundancy is not None and redundancy.shown(effect):
+    shown_redundant = redundancy is not None and redundancy.shown(effect)
+    if shown_redundant:
         reasons.append(redundancy.reason(effect))
     parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits, joint_null)
     reasons += parameter_reasons
-    return Identification(effect, not reasons, tuple(reasons), tuple(notes))
+    return Identification(
+        effect, not reasons, tuple(reasons), tuple(notes), redundant=shown_redundant and len(reasons) == 1
+    )
 
 
 @dataclass(frozen=True)
@@ -640,11 +646,7 @@ def own_evidence_results(
         )
         result = outcome.as_dict()
         without = None if redundancy is None else redundancy.ratios.get(effect)
-        result["redundant"] = (
-            redundancy is not None
-            and redundancy.shown(effect)
-            and outcome.reasons == (redundancy.reason(effect),)
-        )
+        result["redundant"] = outcome.redundant
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
         # whole frame); each failed check is a reason
         checks = getattr(problem, "identification_checks", None)

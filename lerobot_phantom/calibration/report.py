@@ -11,16 +11,16 @@ report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percenti
   identified ones only: what calibrated.json carries) and ``derived``;
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
-- ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score;
-  the last step's without: the score without each effect no other builds on), rejected, not_offered {effect: reason}: candidates the fit items show no sign of, never tried
-  (``Problem.unoffered``), set_aside_ahead [{group, validation_error, kept_validation_error, reason}]: groups the
-  last step set aside though they scored the margin under the selected model (:func:`set_aside_ahead`), withdrawn
-  [{effect, pass, reasons}]: effects an earlier pass selected and identification
-  rejected on their own evidence, left out of the passes after it (identify.select_and_identify); ``selected`` and
-  ``steps`` are the last pass's, earlier_passes [{pass, selected, withdrawn, steps}] those of each pass that withdrew one,
-  form_passes [{without, selected, validation_error, first_selected, first_validation_error, taken, other_steps}]
-  the last pass repeated without a simpler form of a term it took (core.select_forms; ``other_steps``: the steps
-  of the pass not written)};
+- ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score; the
+  last step's without: the score without each effect no other builds on), rejected, not_offered {effect: reason}:
+  candidates the fit items show no sign of, never tried (``Problem.unoffered``), set_aside_ahead [{group,
+  validation_error, kept_validation_error, reason}]: groups the last step set aside though they scored the margin
+  under the selected model (:func:`set_aside_ahead`), withdrawn [{effect, pass, reasons}]: effects an earlier pass
+  selected and identification rejected on their own evidence, left out of the passes after it
+  (identify.select_and_identify); ``selected`` and ``steps`` are the last pass's, earlier_passes [{pass, selected,
+  withdrawn, steps}] those of each pass that withdrew one, form_passes [{without, selected, validation_error,
+  first_selected, first_validation_error, taken, other_steps}] the last pass repeated without a simpler form of a term
+  it took (core.select_forms; ``other_steps``: the steps of the pass not written)};
 - ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio

@@ -28,6 +28,7 @@ from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
 from lerobot_phantom.calibration.identify import (
     RESUMMED_DRAWS,
     Interval,
+    Redundancy,
     at_bound,
     bootstrap,
     dependants,
@@ -194,6 +195,19 @@ def test_each_condition_alone_makes_it_not_identified(override, reason):
     assert not result.identified
     assert result.as_dict()["status"] == "not identified"
     assert any(reason in r for r in result.reasons), result.reasons
+
+
+def test_an_effect_is_redundant_only_when_the_model_without_it_is_all_it_fails():
+    """Rule 2's test of the selected model without it: shown (interval under 1 + margin / 2) alone makes it
+    redundant, which select_and_identify withdraws one at a time; with another failure it is rejected outright."""
+    redundancy = Redundancy({"halo_power_law": Interval(1.002, 0.995, 1.01)}, margin=0.05)
+    alone = identified(redundancy=redundancy)
+    assert not alone.identified and alone.redundant
+    assert alone.reasons == (redundancy.reason("halo_power_law"),)
+    with_bound = identified(redundancy=redundancy, params={"halo_amplitude": 0.5, "halo_exponent": 8.0})
+    assert not with_bound.identified and not with_bound.redundant
+    uncertain = Redundancy({"halo_power_law": Interval(1.01, 0.995, 1.03)}, margin=0.05)
+    assert identified(redundancy=uncertain).identified and not identified(redundancy=uncertain).redundant
 
 
 def test_a_parameter_at_its_declared_physical_limit_is_a_note_not_a_reason():
