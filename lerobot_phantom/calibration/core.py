@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
@@ -553,22 +553,42 @@ def groups_set_aside(
     scored: dict[frozenset[str], tuple[float, list[Fit], dict[int, float]]],
     labels: dict[frozenset[str], str],
     margin: float,
-) -> dict[frozenset[str], str]:
+) -> tuple[dict[frozenset[str], str], dict[frozenset[str], frozenset[str]]]:
     """The scored groups a selection step may not take, with the reason: a member pinned at a bound in most fold
     fits (:func:`pinned_members`), or the richer of two forms of one term not ``margin`` under the same group with
-    the simpler form (:func:`richer_alternatives`)."""
+    the simpler form (:func:`richer_alternatives`); and of the latter, each one's group with the simpler form."""
     set_aside: dict[frozenset[str], str] = {}
     for group, (_, fits, _) in scored.items():
         pinned = pinned_members(problem, chosen | group, group, fits)
         if pinned:
             set_aside[group] = "; ".join(f"{e}: {why}" for e, why in sorted(pinned.items()))
     unpinned = {g: v for g, v in scored.items() if g not in set_aside}
+    outscored: dict[frozenset[str], frozenset[str]] = {}
     for group, simpler in richer_alternatives(problem, chosen, unpinned):
         if unpinned[group][0] > (1.0 - margin) * unpinned[simpler][0]:
             set_aside[group] = (
                 f"not {100 * margin:.0f}% under {labels[simpler]}, the same model with the simpler form"
             )
-    return set_aside
+            outscored[group] = simpler
+    return set_aside, outscored
+
+
+def stand_ins(
+    outscored: dict[frozenset[str], frozenset[str]], scored: Mapping[frozenset[str], object]
+) -> dict[frozenset[str], set[frozenset[str]]]:
+    """Per group with the simpler of two forms of one term whose group with the richer form a step set aside for not
+    beating it by the margin (``outscored``: richer group -> simpler group): the scored groups inside that richer group
+    which hold the richer form. On the step's own scores the richer form does not pay beside the group's other
+    members, so where it scores well without them it stands in for them, and the group is not measured against it
+    (:func:`group_needs`). camsim's clipped sRGB cameras (master seeds 2735721871 and 752112996,
+    docs/bench/session78.md): with the clip in, a shoulder was not 5% under the gamma curve, yet alone it scored
+    0.8-4.1% above the clip with the gamma and, as the best smaller group, kept that pair from the step; the shoulder
+    took it, and the clip either joined it (the pair the step had set aside was written) or was missed."""
+    found: dict[frozenset[str], set[frozenset[str]]] = {}
+    for richer_group, simpler_group in outscored.items():
+        richer = richer_group - simpler_group
+        found.setdefault(simpler_group, set()).update(g for g in scored if richer <= g < richer_group)
+    return found
 
 
 def cross_validated(
@@ -613,7 +633,9 @@ def forward_select(
 
     Before that comparison, a scored group is set aside (``Step.set_aside``, with the reason) when a member's own
     parameter sits at a bound in most fold fits (:func:`pinned_members`), or when it holds the richer of two forms
-    of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`).
+    of one term and does not beat the same group with the simpler form by the margin (:func:`richer_alternatives`);
+    the group with the simpler form is then not measured against the richer form's smaller groups, which stand in
+    for its other members (:func:`stand_ins`).
 
     A step never revisits an earlier one, so an effect taken as the best of its step can stand in for one that
     only a later step could take: on the same folds, the selected model is scored without each effect no other
@@ -633,10 +655,10 @@ def forward_select(
             break
         steps[-1].tried = {labels[g]: v[0] for g, v in scored.items()}
         steps[-1].tried_item_errors = {labels[g]: aligned(v[2]) for g, v in scored.items()}
-        set_aside = groups_set_aside(problem, chosen, scored, labels, margin)
+        set_aside, outscored = groups_set_aside(problem, chosen, scored, labels, margin)
         steps[-1].set_aside = {labels[g]: why for g, why in set_aside.items()}
         eligible = {g: v[0] for g, v in scored.items() if g not in set_aside}
-        joint, tied = joint_group_taken(problem, eligible, current, margin)
+        joint, tied = joint_group_taken(problem, eligible, current, margin, stand_ins(outscored, scored))
         if joint is not None:
             steps[-1].tied = [labels[g] for g in tied]
             # its prefixes may have been set aside alone: they are steps inside it all the same
@@ -786,18 +808,23 @@ def scored_groups(
 
 
 def joint_group_taken(
-    problem: Problem, eligible: dict[frozenset[str], float], current: float, margin: float
+    problem: Problem,
+    eligible: dict[frozenset[str], float],
+    current: float,
+    margin: float,
+    not_compared: dict[frozenset[str], set[frozenset[str]]] | None = None,
 ) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
     """The group of two or more new effects a step takes, or None, and the groups its score tied with
     (:func:`lowest_scoring`): of the groups under what they need, the one with the lowest score. A group needs
-    ``margin`` under the best smaller eligible group and, over the ``current`` score, the margin once per member
-    that stands on its own (one that builds on another member only carries it).
+    ``margin`` under the best smaller eligible group but those ``not_compared`` with it (:func:`stand_ins`) and,
+    over the ``current`` score, the margin once per member that stands on its own (one that builds on another member
+    only carries it).
 
     Lowest score, not furthest under its need: a pair far under its need can be the first step of a worse model
     (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
     larger group under its need has already beaten every smaller one by the margin."""
-    needed = group_needs(requirements(problem), eligible, current, margin)
+    needed = group_needs(requirements(problem), eligible, current, margin, not_compared or {})
     return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]})
 
 
@@ -825,7 +852,11 @@ def lowest_scoring(
 
 
 def group_needs(
-    requires: dict[str, set[str]], eligible: dict[frozenset[str], float], current: float, margin: float
+    requires: dict[str, set[str]],
+    eligible: dict[frozenset[str], float],
+    current: float,
+    margin: float,
+    not_compared: dict[frozenset[str], set[frozenset[str]]],
 ) -> dict[frozenset[str], float]:
     """The score each eligible group of two or more new effects must reach to earn a step
     (:func:`joint_group_taken`)."""
@@ -833,7 +864,10 @@ def group_needs(
     for group in eligible:
         if len(group) < 2:
             continue
-        smaller = min((v for g, v in eligible.items() if len(g) < len(group)), default=math.inf)
+        skipped = not_compared.get(group, set())
+        smaller = min(
+            (v for g, v in eligible.items() if len(g) < len(group) and g not in skipped), default=math.inf
+        )
         standing = max(1, sum(1 for e in group if not requires[e] & group))
         needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
     return needed
