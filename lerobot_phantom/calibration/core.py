@@ -581,9 +581,9 @@ def stand_ins(
     which hold the richer form. On the step's own scores the richer form does not pay beside the group's other
     members, so where it scores well without them it stands in for them, and the group is not measured against it
     (:func:`group_needs`). camsim's clipped sRGB cameras (master seeds 2735721871 and 752112996,
-    docs/bench/session78.md): with the clip in, a shoulder was not 5% under the gamma curve, yet alone it scored
-    0.8-4.1% above the clip with the gamma and, as the best smaller group, kept that pair from the step; the shoulder
-    took it, and the clip either joined it (the pair the step had set aside was written) or was missed."""
+    docs/bench/session78.md): with the clip in, a shoulder was not 5% under the gamma curve, yet alone, 0.9-4.3%
+    over the clip with the gamma, it was the best smaller group and kept that pair from the step; the shoulder took
+    it, and the clip either joined it (the pair the step had set aside was written) or was missed."""
     found: dict[frozenset[str], set[frozenset[str]]] = {}
     for richer_group, simpler_group in outscored.items():
         richer = richer_group - simpler_group
