@@ -274,7 +274,23 @@ def test_the_richer_of_two_forms_must_beat_the_simpler_by_the_margin(shoulder_er
         assert steps[0].set_aside == {}
 
 
-class LightToneAndReflectance(FixedErrors):
+class ToneFormErrors(FixedErrors):
+    """Fixed errors per model, named by the effects joined with "+" (``errors``), with ToneForms' parameters: the
+    shoulder has two to the power law's one, the richer form of the tone term."""
+
+    errors: typing.ClassVar[dict[str, float]] = {}
+
+    def error(self, effects: frozenset[str]) -> float:
+        return self.errors["+".join(sorted(effects))]
+
+    def param_specs(self, effects):
+        return ToneForms({}).param_specs(effects)
+
+    def fit(self, effects, items, start=None) -> Fit:
+        return ToneForms({}).fit(effects, items)
+
+
+class LightToneAndReflectance(ToneFormErrors):
     """camsim's projection_additive on a filmic camera (master seed 3311676683, step 0's validation RMSE): light
     adds (``light``), under a power-law or a shouldered tone curve, and a reflectance term (``reflect``) that only
     pays with the shoulder. light + power is far under its need; light + shoulder + reflect is 19% below it."""
@@ -298,16 +314,6 @@ class LightToneAndReflectance(FixedErrors):
         "light+power+reflect": 2.52,
         "light+reflect+shoulder": 2.07,
     }
-
-    def error(self, effects: frozenset[str]) -> float:
-        return self.errors["+".join(sorted(effects))]
-
-    def param_specs(self, effects):
-        # the shoulder has two parameters to the power law's one: the richer form of the tone term
-        return ToneForms({}).param_specs(effects)
-
-    def fit(self, effects, items, start=None) -> Fit:
-        return ToneForms({}).fit(effects, items)
 
 
 def test_of_the_groups_that_earn_their_step_the_lowest_scoring_is_taken():
@@ -502,7 +508,7 @@ def test_groups_the_fit_items_do_not_tell_apart_are_taken_by_the_stated_preferen
         assert not any(s.tied for s in steps)
 
 
-class ClipOrShoulder(FixedErrors):
+class ClipOrShoulder(ToneFormErrors):
     """camsim's light projection of a clipped sRGB camera, the validation RMSE of the step after light, spread and
     reflectance (master seeds 2735721871 and 752112996, docs/bench/session78.md): with the clip in, the shoulder is
     not 5% under the power law, yet alone it stands in for the clip on the power law."""
@@ -515,16 +521,6 @@ class ClipOrShoulder(FixedErrors):
 
     def __init__(self, errors: dict[str, float]) -> None:
         self.errors = errors
-
-    def error(self, effects: frozenset[str]) -> float:
-        return self.errors["+".join(sorted(effects))]
-
-    def param_specs(self, effects):
-        # the shoulder has two parameters to the power law's one: the richer form of the tone term
-        return ToneForms({}).param_specs(effects)
-
-    def fit(self, effects, items, start=None) -> Fit:
-        return ToneForms({}).fit(effects, items)
 
 
 @pytest.mark.parametrize(
