@@ -812,7 +812,7 @@ def joint_group_taken(
     eligible: dict[frozenset[str], float],
     current: float,
     margin: float,
-    not_compared: dict[frozenset[str], set[frozenset[str]]] | None = None,
+    not_compared: dict[frozenset[str], set[frozenset[str]]],
 ) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
     """The group of two or more new effects a step takes, or None, and the groups its score tied with
     (:func:`lowest_scoring`): of the groups under what they need, the one with the lowest score. A group needs
@@ -824,7 +824,7 @@ def joint_group_taken(
     (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
     larger group under its need has already beaten every smaller one by the margin."""
-    needed = group_needs(requirements(problem), eligible, current, margin, not_compared or {})
+    needed = group_needs(requirements(problem), eligible, current, margin, not_compared)
     return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]})
 
 
