@@ -1,7 +1,8 @@
 """camsim ``blinding_halo``: the laser capture's dark-room light (noise-free, linear, at the capture's exposure) by
 distance from the spot, less its median over the capture's farthest tenth (what the package subtracts as the dark
 level), times a given gain (the fits' in ``addback_survey.txt``): the light a uniform dark level leaves in the
-capture's beam, as the frames see it (full wells per unit intensity). Draws exactly as ``test_independent_sim``.
+capture's beam, as the frames see it (full wells per unit intensity); and the planted glare's exponent. Draws
+exactly as ``test_independent_sim``.
 
 Usage: ``PYTHONPATH=. python docs/bench/session79/halo/dark_room_gradient.py SEED:LOG10_GAIN...``"""
 
@@ -22,12 +23,12 @@ EDGES = (0, 32, 64, 96, 128, 160, 192, 256)  # reference pixels (the frame's lon
 
 
 def recorded_render(case, rng, camera) -> dict:
-    """Render the case, keeping the spot's centre, the dark room's ambient field and the capture's exposure."""
+    """Render the case, keeping the spot's centre and glare, the dark room's ambient field and the capture's exposure."""
     seen: dict = {}
     spot, ambient, capture = camsim.laser_spot, camsim.ambient_light, camsim.capture
 
     def recording_spot(cam, centre, colour, **options):
-        seen["centre"] = centre
+        seen["centre"], seen["glare"] = centre, options["halo"]
         return spot(cam, centre, colour, **options)
 
     def recording_ambient(rng, height, width):
@@ -68,7 +69,11 @@ def main() -> None:
                 for lo, hi in itertools.pairwise(EDGES)
                 if ((radius >= lo) & (radius < hi)).any()
             ]
-            print(f"{master} (tone {cam.tone}, log10 gain {log10_gain}): " + ", ".join(left))
+            exponent = seen["glare"][2]
+            print(
+                f"{master} (tone {cam.tone}, planted glare exponent {exponent:.2f}, log10 gain {log10_gain}): "
+                + ", ".join(left)
+            )
 
 
 if __name__ == "__main__":
