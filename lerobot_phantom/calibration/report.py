@@ -235,9 +235,8 @@ def selection_section(
         f"interacting extensions taken in one step: by >= {100 * margin:.0f}% per extension in it that does not "
         f"build on another of them, and by >= {100 * margin:.0f}% under the best smaller group; a group is set "
         "aside when a member's own parameter sits at a bound of its range in most folds, and the richer of two "
-        f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one, a group with the "
-        "simpler form that outscored it then not being measured against the richer form without the group's "
-        "other members; among groups whose "
+        f"forms of one term is taken only by >= {100 * margin:.0f}% under the simpler one (where it is not, the "
+        "group with the simpler form is not measured against the richer form's smaller groups); among groups whose "
         f"scores agree within a share of {TIE_SHARE:g}, which the fit items do not tell apart, "
         + (
             f"the one holding the earliest of {', '.join(problem.tie_preference)} ({problem.tie_preference_reason}), "

@@ -526,7 +526,7 @@ class ClipOrShoulder(ToneFormErrors):
 @pytest.mark.parametrize(
     ("errors", "expected"),
     [
-        # 2735721871: at main the shoulder took the step, the clip the next: the pair the step set aside was written
+        # 2735721871: before the rule (f2df887) the shoulder took the step, the clip the next (the set-aside pair)
         (
             {
                 "": 7.385,
@@ -538,7 +538,7 @@ class ClipOrShoulder(ToneFormErrors):
             },
             {"clip", "power"},
         ),
-        # 752112996: at main the shoulder took the step and the clip, 3% under it, did not follow
+        # 752112996: before the rule the shoulder took the step and the clip, 3% under it, did not follow
         (
             {
                 "": 7.207,
