@@ -12,7 +12,8 @@ Inputs (recognised from the path and the table columns):
   frame pairs (folder with pairs.csv: clean,attacked[,pattern][,intensity],...) -> laser_blinding,
       light_projection, ultrasound_blur, em_color_strip, em_truncation, laser_color_strip
 Light projection's frame pairs say what their pattern is: a pattern_record column (emitted: the frame the projector
-was sent; captured: the projection as the camera captured it) or --pattern-record.
+was sent; captured: the projection as the camera captured it) or --pattern-record. Laser blinding's pairs may add a
+pattern_dark column: the laser capture repeated with the laser off (a dark frame), read for the dark room's shape.
 """
 
 from __future__ import annotations

@@ -94,6 +94,7 @@ class FramePair:
     intensity: float
     pattern: np.ndarray | None = None
     settings: dict = field(default_factory=dict)
+    pattern_dark: np.ndarray | None = None  # the pattern's capture with the source off
 
 
 # ---------------------------------------------------------------- scene, optics, sensor, ISP
@@ -356,6 +357,7 @@ def laser_blinding_pairs(
     halo: bool = False,
     digital_alpha: float | None = None,
     speckle_looks: int | None = None,
+    dark_frame: bool = False,
 ) -> list[FramePair]:
     """Laser blinding frame pairs and the laser pattern recorded without a scene.
 
@@ -374,7 +376,9 @@ def laser_blinding_pairs(
     ``digital_alpha``: the paper's blend (1 - a) clean + a pattern with a = digital_alpha * intensity, in 8-bit
     output space (the null case). ``speckle_looks`` (with ``digital_alpha``): the blended laser light carries a fresh
     speckle pattern per frame (``speckle``, grains of 1-2 px), which the recorded pattern does not hold: an effect
-    the library has no name for."""
+    the library has no name for. ``dark_frame``: the pattern's capture is repeated with the laser off (the same dark
+    room and exposure, fresh noise), as beam profilers record one, from a stream of its own so that every other
+    draw is the one without it."""
     colour = LASER_COLOURS[rng.choice(list(LASER_COLOURS))]
     # drawn only with speckle, so every other case keeps its draws
     grain_px = rng.uniform(1.0, 2.0) if speckle_looks else None
@@ -395,7 +399,7 @@ def laser_blinding_pairs(
     pairs = []
     dark = 0.01 * ambient_light(rng, cam.height, cam.width)
     session = Session(cam)
-    pattern_u8 = None
+    pattern_u8 = dark_u8 = None
     for intensity in intensities(rng, n_pairs):
         refl, light = scene(rng, cam)
         clean, exposure = session.clean(refl * light, rng)
@@ -404,6 +408,9 @@ def laser_blinding_pairs(
             pattern_exposure = session.first_exposure
             at_core = float(optics(spot, cam).max()) * pattern_exposure
             reference = peak_power if core_fill is None else core_fill / at_core
+            if dark_frame:
+                dark_rng = np.random.default_rng(rng.bit_generator.state["state"]["state"])
+                dark_u8 = encode(capture(dark, cam, dark_rng, exposure=pattern_exposure)[0], cam)
             pattern, _ = capture(dark + reference * spot, cam, rng, exposure=pattern_exposure)
             pattern_u8 = encode(pattern, cam)
         if digital_alpha is not None:
@@ -419,7 +426,9 @@ def laser_blinding_pairs(
             irradiance = refl * light + intensity * peak_power * spot
             attacked, _ = capture(irradiance, cam, rng, exposure=None if cam.auto_exposure else exposure)
             attacked_u8 = encode(attacked, cam)
-        pairs.append(FramePair(encode(clean, cam), attacked_u8, float(intensity), pattern_u8))
+        pairs.append(
+            FramePair(encode(clean, cam), attacked_u8, float(intensity), pattern_u8, pattern_dark=dark_u8)
+        )
     return pairs
 
 
@@ -796,15 +805,21 @@ def ultrasound_blur_pairs(
 
 
 def write_pairs(folder, pairs: list[FramePair]) -> None:
-    """The calibration CLI's frame-pair input: PNGs and pairs.csv (clean, attacked[, pattern], intensity and the
-    pairs' settings, e.g. pattern_record)."""
+    """The calibration CLI's frame-pair input: PNGs and pairs.csv (clean, attacked[, pattern[, pattern_dark]],
+    intensity and the pairs' settings, e.g. pattern_record)."""
     from pathlib import Path
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
     with_pattern = pairs[0].pattern is not None
+    with_dark = pairs[0].pattern_dark is not None
     settings = list(pairs[0].settings)
-    header = ["clean", "attacked"] + (["pattern"] if with_pattern else []) + ["intensity", *settings]
+    header = (
+        ["clean", "attacked"]
+        + (["pattern"] if with_pattern else [])
+        + (["pattern_dark"] if with_dark else [])
+        + ["intensity", *settings]
+    )
     lines = [",".join(header)]
     for i, pair in enumerate(pairs):
         names = [f"clean_{i:03d}.png", f"attacked_{i:03d}.png"]
@@ -813,6 +828,9 @@ def write_pairs(folder, pairs: list[FramePair]) -> None:
         if with_pattern:
             names.append(f"pattern_{i:03d}.png")
             Image.fromarray(pair.pattern).save(folder / names[2])
+        if with_dark:
+            names.append(f"pattern_dark_{i:03d}.png")
+            Image.fromarray(pair.pattern_dark).save(folder / names[-1])
         lines.append(",".join([*names, f"{pair.intensity:.6f}", *(str(pair.settings[k]) for k in settings)]))
     (folder / "pairs.csv").write_text("\n".join(lines) + "\n")
 

@@ -117,13 +117,17 @@ def capture_glare(radius):
     return 0.003 * ((1.0 + radius / inner) / (1.0 + 20.0 / inner)) ** -2.0
 
 
-def glare_capture(gain: float) -> tuple[BlindingFrames, torch.Tensor, torch.Tensor]:
+def glare_capture(
+    gain: float, room_slope: float = 0.0, dark_frame: bool = False
+) -> tuple[BlindingFrames, torch.Tensor, torch.Tensor]:
     """A blinding frame model of one pair whose laser capture holds a beam *and* its glare, and the laser light
     (linear, laser channel) the blinded frame really receives, ``gain`` times the capture's beam and glare.
 
     The capture (sRGB, without noise or 8-bit steps, which the gain would multiply into the comparison) is exposed
     for the beam's profile: at the frames' power, the glare it holds below its noise floor (the 8-bit step the
-    reading assumes) lights the frame, and the glare in its farthest pixels lifts its dark level."""
+    reading assumes) lights the frame, and the glare in its farthest pixels lifts its dark level. The dark room's
+    light changes by ``room_slope`` of its level across the frame's width; ``dark_frame``: the pair holds the
+    capture with the laser off."""
     height, width = 48, 64
     ys, xs = torch.meshgrid(
         torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
@@ -132,11 +136,31 @@ def glare_capture(gain: float) -> tuple[BlindingFrames, torch.Tensor, torch.Tens
     beam = 0.7 * torch.exp(-(radius**2) / (2 * 3.0**2)) + 0.1 * torch.exp(-(radius**2) / (2 * 8.0**2))
     glare = capture_glare(radius)
     colour = torch.tensor([1.0, 0.08, 0.03], dtype=torch.float64).reshape(3, 1, 1)
-    dark = 0.006
-    pattern = physics.linear_to_srgb((beam + glare) * colour + dark)
+    room = 0.006 * (1.0 + room_slope * (xs / (width - 1) - 0.5)).expand(3, -1, -1)
+    pattern = physics.linear_to_srgb((beam + glare) * colour + room)
     black = torch.zeros((3, height, width), dtype=torch.float64)
-    frames = BlindingFrames([Pair("glare", black, black, pattern, 1.0)], seed=0)
-    return frames, gain * (beam + glare), radius
+    pair = Pair("glare", black, black, pattern, 1.0)
+    if dark_frame:
+        pair.pattern_dark = physics.linear_to_srgb(room)
+    return BlindingFrames([pair], seed=0), gain * (beam + glare), radius
+
+
+def glare_light_error(frames: BlindingFrames, truth: torch.Tensor, radius: torch.Tensor, gain: float):
+    """Relative error of the model's laser light (true gain and glare) against ``truth`` where the frame is not
+    saturated (a full well or less) and the laser's light shows (a grey level or more)."""
+    params = {
+        "log10_gain": math.log10(gain),
+        "core_sigma_ref_px": 20.0,
+        # the frames' glare: gain x the capture's, at the reference distance (16 capture pixels)
+        "halo_level": gain * float(capture_glare(torch.tensor(GLARE_REFERENCE_PX / 4.0))),
+        "halo_exponent": 2.0,
+    }
+    effects = frozenset({"linear_light_saturation", "halo_power_law"})
+    decode, _ = frames.tone_curve(effects, params)
+    light = frames.compose(effects, params, frames.features(0, None), decode)[:, 0].reshape(radius.shape)
+    visible = (truth < 1.0) & (truth > 0.02)
+    assert int(visible.sum()) > 1000
+    return (light - truth)[visible].abs() / truth[visible]
 
 
 def test_the_halo_adds_the_glare_the_capture_lost_not_the_glare_it_holds():
@@ -148,25 +172,54 @@ def test_the_halo_adds_the_glare_the_capture_lost_not_the_glare_it_holds():
     gain = 100.0
     frames, truth, radius = glare_capture(gain)
     assert frames.pairs[0].to_reference == 4.0
-    # the frames' glare: gain x the capture's, at the reference distance (16 capture pixels)
-    params = {
-        "log10_gain": math.log10(gain),
-        "core_sigma_ref_px": 20.0,
-        "halo_level": gain * float(capture_glare(torch.tensor(GLARE_REFERENCE_PX / 4.0))),
-        "halo_exponent": 2.0,
-    }
-    effects = frozenset({"linear_light_saturation", "halo_power_law"})
-    f = frames.features(0, None)
-    decode, _ = frames.tone_curve(effects, params)
-    light = frames.compose(effects, params, f, decode)[:, 0].reshape(radius.shape)
-    # where the frame is not saturated (a full well or less) and the laser's light shows (a grey level or more)
-    visible = (truth < 1.0) & (truth > 0.02)
-    assert int(visible.sum()) > 1000
-    error = (light - truth)[visible].abs() / truth[visible]
+    error = glare_light_error(frames, truth, radius, gain)
     # 1.7% on average and 8.2% at most; the glare added everywhere (until session 24): 8.4% and 24%; added to the
     # beam's continued edge below the capture's floor instead of the larger of the two: 3.9% and 20%
     assert float(error.mean()) < 0.04
     assert float(error.max()) < 0.15
+
+
+def test_a_dark_frame_reads_a_dark_room_whose_light_varies():
+    """A dark room 15% brighter on one side than its mean, 15% darker on the other: read as one level, the capture's
+    light over it is laser light on one side and a deficit on the other, both scaled by the gain into the frames
+    (camsim's glare case, docs/bench/session79.md). The capture repeated with the laser off gives the room's shape,
+    and the model's light is then the light the frame receives as with a uniform room."""
+    gain = 100.0
+    one_level = glare_light_error(*glare_capture(gain, room_slope=0.3), gain)
+    frames, truth, radius = glare_capture(gain, room_slope=0.3, dark_frame=True)
+    from_frame = glare_light_error(frames, truth, radius, gain)
+    assert "dark frame" in frames.recording_facts()["capture_dark_level"]
+    # one level: 10.0% on average and 48% at most; with the dark frame 1.7% and 8.2%, as with a uniform room (read
+    # as one level: the same). The room's shape put on the capture's own median: 3.7% and 9.9%
+    assert float(one_level.mean()) > 0.06
+    assert float(one_level.max()) > 0.3
+    assert float(from_frame.mean()) < 0.04
+    assert float(from_frame.max()) < 0.15
+
+
+def test_pairs_with_a_dark_frame_load_it_and_other_attacks_refuse_it(tmp_path):
+    from PIL import Image
+
+    from lerobot_phantom.calibration.frame_models.common import load_pairs
+    from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
+
+    grey = np.full((12, 16, 3), 90, dtype=np.uint8)
+    for name in ("clean", "attacked", "pattern", "dark"):
+        Image.fromarray(grey + (name == "dark")).save(tmp_path / f"{name}.png")
+    rows = "clean.png,attacked.png,pattern.png,dark.png,0.5\n" * 2
+    (tmp_path / "pairs.csv").write_text("clean,attacked,pattern,pattern_dark,intensity\n" + rows)
+    pairs = load_pairs(tmp_path, max_side=256)
+    assert all(p.pattern_dark is not None and p.settings == {} for p in pairs)
+    assert float(pairs[0].pattern_dark[0, 0, 0]) == pytest.approx(91 / 255)
+    with pytest.raises(
+        ValueError, match=r"ultrasound_blur's frame model reads no pattern_dark.*laser_blinding"
+    ):
+        BlurFrames(pairs, seed=0)
+    (tmp_path / "pairs.csv").write_text(
+        "clean,attacked,pattern_dark\n" + "clean.png,attacked.png,dark.png\n" * 2
+    )
+    with pytest.raises(ValueError, match=r"pattern_dark dark\.png .* the pair has no pattern"):
+        load_pairs(tmp_path, max_side=256)
 
 
 @pytest.mark.parametrize(

@@ -122,6 +122,22 @@ def test_blinding_speckle_leaves_a_saturated_pattern_saturated_and_draws_nothing
         assert np.std(blend_miss(pair, 0.6, lit)) > 1.5 * noise
 
 
+def test_a_dark_frame_is_the_laser_capture_without_the_laser_and_changes_no_other_draw():
+    cam = cs.Camera(jpeg_quality=97)
+    plain = cs.laser_blinding_pairs(np.random.default_rng(5), cam, 3, halo=True)
+    dark = cs.laser_blinding_pairs(np.random.default_rng(5), cam, 3, halo=True, dark_frame=True)
+    for a, b in zip(plain, dark, strict=True):
+        assert a.pattern_dark is None
+        assert all(np.array_equal(getattr(a, k), getattr(b, k)) for k in ("clean", "attacked", "pattern"))
+    frame, pattern = dark[0].pattern_dark.astype(float), dark[0].pattern.astype(float)
+    spot = np.unravel_index(np.argmax(pattern.sum(2)), pattern.shape[:2])
+    # the laser's spot is in the capture and not in the dark frame; far from it, the two read the same room
+    assert pattern[spot].max() > 150 and frame[spot].max() < 40
+    corner = (slice(0, 6), slice(0, 6))
+    assert abs(np.median(frame[corner]) - np.median(pattern[corner])) < 6
+    assert all(np.array_equal(p.pattern_dark, dark[0].pattern_dark) for p in dark)
+
+
 def test_pixel_slip_moves_only_the_corrupted_rows_left():
     cam = cs.Camera(jpeg_quality=97)
     plain = cs.em_strip_pairs(np.random.default_rng(2), cam, 2, paper_map=True)

@@ -1,9 +1,10 @@
 """Frame pairs -> any camera attack: the shared part (loading ``pairs.csv``, per-pair scoring, residuals).
 
-A folder holds ``pairs.csv`` (clean, attacked[, pattern][, intensity], ...). Items are whole image pairs (held-out
-pairs are never seen while fitting). Frames are resized so that their longer side is at most ``max_side`` pixels
-(area averaging); pixel-sized parameters are reported on the package's 256-pixel reference scale. Each attack's
-frame model lives in its own module of this package.
+A folder holds ``pairs.csv`` (clean, attacked[, pattern[, pattern_dark]][, intensity], ...): ``pattern_dark`` is
+the pattern's capture repeated with the source off (a dark frame), for the models that read one. Items are whole
+image pairs (held-out pairs are never seen while fitting). Frames are resized so that their longer side is at most
+``max_side`` pixels (area averaging); pixel-sized parameters are reported on the package's 256-pixel reference
+scale. Each attack's frame model lives in its own module of this package.
 """
 
 from __future__ import annotations
@@ -108,6 +109,7 @@ class Pair:
     intensity: float
     settings: dict = field(default_factory=dict)
     original_size: tuple[int, int] = (0, 0)  # (W, H) before resizing
+    pattern_dark: torch.Tensor | None = None  # the pattern's capture with the source off
 
     @property
     def height(self) -> int:
@@ -123,17 +125,29 @@ class Pair:
         return REFERENCE_SIZE / max(self.height, self.width)
 
 
+IMAGE_COLUMNS = ("clean", "attacked", "pattern", "pattern_dark")
+
+
+def optional_image(
+    folder: Path, table: pd.DataFrame, row: pd.Series, column: str, size
+) -> torch.Tensor | None:
+    """The image a row names in an optional column (None where the column is absent or the cell empty)."""
+    if column in table.columns and isinstance(row[column], str) and row[column]:
+        return load_rgb(folder / row[column], size=size)
+    return None
+
+
 def load_pairs(folder: Path, *, max_side: int) -> list[Pair]:
     table_path = folder / "pairs.csv"
     if not table_path.is_file():
         raise FileNotFoundError(
-            f"{folder} has no pairs.csv (columns clean,attacked[,pattern][,intensity],...)"
+            f"{folder} has no pairs.csv (columns clean,attacked[,pattern[,pattern_dark]][,intensity],...)"
         )
     table = pd.read_csv(table_path)
     for column in ("clean", "attacked"):
         if column not in table.columns:
             raise ValueError(
-                f"{table_path} lacks column {column!r}; needs clean,attacked[,pattern][,intensity]"
+                f"{table_path} lacks column {column!r}; needs clean,attacked[,pattern[,pattern_dark]][,intensity]"
             )
     pairs = []
     for i, row in table.iterrows():
@@ -148,16 +162,22 @@ def load_pairs(folder: Path, *, max_side: int) -> list[Pair]:
                     f"pair {i}: clean {row['clean']} is {original} but attacked {row['attacked']} is {probe.size}"
                 )
         attacked = load_rgb(folder / str(row["attacked"]), size=size)
-        pattern = None
-        if "pattern" in table.columns and isinstance(row["pattern"], str) and row["pattern"]:
-            pattern = load_rgb(folder / row["pattern"], size=size)
+        pattern = optional_image(folder, table, row, "pattern", size)
+        pattern_dark = optional_image(folder, table, row, "pattern_dark", size)
+        if pattern_dark is not None and pattern is None:
+            raise ValueError(
+                f"pair {i}: pattern_dark {row['pattern_dark']} is the pattern's capture with the source off, but "
+                "the pair has no pattern"
+            )
         intensity = 1.0
         if "intensity" in table.columns and not pd.isna(row["intensity"]):
             intensity = float(row["intensity"])
             if not 0.0 <= intensity <= 1.0:
                 raise ValueError(f"pair {i}: intensity must lie in [0, 1], got {intensity}")
-        extra = {k: row[k] for k in table.columns if k not in ("clean", "attacked", "pattern", "intensity")}
-        pairs.append(Pair(str(row["attacked"]), clean, attacked, pattern, intensity, extra, original))
+        extra = {k: row[k] for k in table.columns if k not in (*IMAGE_COLUMNS, "intensity")}
+        pairs.append(
+            Pair(str(row["attacked"]), clean, attacked, pattern, intensity, extra, original, pattern_dark)
+        )
     if len(pairs) < 2:
         raise ValueError(
             f"{table_path}: need at least 2 pairs (one to fit, one to hold out), got {len(pairs)}"
@@ -172,8 +192,15 @@ class FrameProblem(Problem):
     units = "grey levels (0-255)"
     item_name = "whole image pairs"
     structure_values_per_pair = 4000
+    # whether the model reads a pattern's dark frame (pairs.csv's pattern_dark); one it would ignore is refused
+    reads_pattern_dark = False
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
+        if not self.reads_pattern_dark and any(p.pattern_dark is not None for p in pairs):
+            raise ValueError(
+                f"{self.attack}'s frame model reads no pattern_dark (a dark frame of the pattern's capture; "
+                "laser_blinding reads one): drop the column"
+            )
         self.pairs = pairs
         self.seed = seed
 

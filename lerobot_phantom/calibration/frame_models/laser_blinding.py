@@ -5,7 +5,12 @@ as laser irradiance instead, which needs three corrections any capture of a lase
 
 * the capture's dark level (the dark room's residual light and the sensor's black level) is not laser light and
   does not grow with the laser's power: the per-channel median of the tenth of the capture's pixels farthest from
-  the spot is subtracted in linear light;
+  the spot is subtracted in linear light. One level misreads a dark room whose light varies over the frame: the
+  capture is scaled to the attack's power by a gain of tens to a hundred, and the room's gradient, read as laser
+  light, lit the frames by up to a tenth of a full well and stood in for glare (on the independent simulator's halo
+  case the glare's fit ran to its bound, docs/bench/session79.md). With a dark frame (``pattern_dark``: the capture
+  repeated with the laser off, as beam profilers record one), the level varies over the frame as the dark frame's
+  light does (:func:`dark_field`);
 * where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
   extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
   radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
@@ -257,6 +262,40 @@ def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tens
     return pattern.reshape(3, -1)[:, far].median(dim=1).values
 
 
+def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
+    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): a quadratic surface per channel
+    fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
+    towards the corners), a capture's noise from pixel to pixel."""
+    light = physics.srgb_to_linear(dark_frame)
+    _, height, width = light.shape
+    ys, xs = torch.meshgrid(
+        torch.linspace(-0.5, 0.5, height, dtype=torch.float64),
+        torch.linspace(-0.5, 0.5, width, dtype=torch.float64),
+        indexing="ij",
+    )
+    terms = torch.stack([torch.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys]).reshape(6, -1).T
+    coefficients = torch.linalg.lstsq(terms, light.reshape(3, -1).T).solution
+    return (terms @ coefficients).T.reshape(3, height, width)
+
+
+def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
+    """(3, H, W) encoded: the capture's dark level at every pixel, :func:`dark_level` where it is read. With the
+    pair's dark frame, the room's light departs from its level as the frame's :func:`dark_surface` departs from its
+    own median there: the capture, that departure taken out, is read as a capture of a uniform room (its median
+    holding the glare at :func:`dark_level_radius`, which the halo adds back), and the departure put back.
+    Subtracted whole (the surface, no glare added back), the dark frame leaves the capture's faint glare a few
+    noise deviations above it, which the beam then reads pixel by pixel, noise and all, times the gain, where the
+    halo had modelled it: on camsim's glare case the halo was named on fewer draws (docs/bench/session80.md)."""
+    if pair.pattern_dark is None:
+        return dark_level(pair.pattern, centre).reshape(3, 1, 1).expand_as(pair.pattern)
+    surface = dark_surface(pair.pattern_dark)
+    _, far = dark_region(pair.pattern, centre)
+    departure = surface - surface.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
+    flattened = physics.linear_to_srgb((physics.srgb_to_linear(pair.pattern) - departure).clamp(min=0.0))
+    level = physics.srgb_to_linear(dark_level(flattened, centre)).reshape(3, 1, 1)
+    return physics.linear_to_srgb((level + departure).clamp(min=0.0))
+
+
 def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> float:
     """Capture pixels from the spot at which :func:`dark_level` reads the laser's glare: glare falls with the
     distance, so the median over the farthest pixels holds its value at their median distance, and subtracting the
@@ -292,8 +331,9 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     ratio between the frames and the capture (tens, for a beam-profile exposure), the noise would be amplified
     into the frames too. So the capture is smoothed over ``BEAM_SMOOTHING_PX`` (a beam profile varies slowly on
     that scale, pixel noise does not), and values within ``NOISE_FLOOR_SIGMAS`` noise deviations of the dark level
-    (the robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read
-    as measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
+    ``dark`` (encoded: one level per channel, (3,), or a field, (3, H, W), :func:`dark_field`; the noise is the
+    robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read as
+    measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
     the frames far around the spot. There it is continued with the fall-off of its measured edge (light
     ``EDGE_FLOORS`` floors above the dark level): in the laser's own channel (the one holding the most light), a
     Gaussian in the distance from the spot, ``exp(a - r^2 / (2 s^2))``, fitted in linear light (sRGB) and capped
@@ -326,9 +366,10 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     detail = (pattern - smooth).reshape(3, -1)[:, flat_radius >= flat_radius.median()]
     spread = torch.from_numpy(stats.median_abs_deviation(detail.numpy(), axis=1, scale="normal"))
     noise = torch.sqrt(spread**2 + 1.0 / (12.0 * 255.0**2))
-    dark_linear = physics.srgb_to_linear(dark).reshape(3, 1, 1)
+    dark = dark.reshape(3, 1, 1) if dark.dim() == 1 else dark
+    dark_linear = physics.srgb_to_linear(dark)
     light = physics.srgb_to_linear(smooth) - dark_linear
-    floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise).reshape(3, 1, 1) - dark_linear
+    floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise.reshape(3, 1, 1)) - dark_linear
     measured = light > floor
     beam = torch.where(measured, light, torch.zeros_like(light))
     laser = int(light.clamp(min=0.0).sum(dim=(1, 2)).argmax())
@@ -339,7 +380,7 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     if int(edge.sum()) >= MIN_EDGE_PIXELS:
         slope, offset = np.polyfit((radius[edge] ** 2).numpy(), torch.log(light[laser][edge]).numpy(), 1)
     if slope < 0.0:
-        tail = torch.exp(offset + slope * radius**2).clamp(max=float(floor[laser]))
+        tail = torch.minimum(torch.exp(offset + slope * radius**2), floor[laser])
         beam[laser] = torch.where(measured[laser], beam[laser], tail)
     else:
         logger.warning(
@@ -422,6 +463,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
     base_model = "alpha blend of the scene and the laser pattern (the paper's laser blinding)"
     extended_model = "physical laser injection"
     candidates = BLINDING_EFFECTS
+    reads_pattern_dark = True
     # on a filmic camera with auto-exposure, linear light needs both the meter and the tone curve: with either
     # alone it fits no better than the blend, and only the three together do (camsim: 23.7 -> 12.5 grey levels,
     # docs/bench/camsim_session16.md)
@@ -437,13 +479,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         super().__init__(pairs, seed)
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
         self.centres = [pattern_centre(p.pattern) for p in pairs]
-        self.dark_levels = [dark_level(p.pattern, c) for p, c in zip(pairs, self.centres, strict=True)]
+        self.dark_fields = [dark_field(p, c) for p, c in zip(pairs, self.centres, strict=True)]
         self.dark_radii = [
             dark_level_radius(p.pattern, c) * p.to_reference for p, c in zip(pairs, self.centres, strict=True)
         ]
         self.beams = [
             beam_profile(p.pattern, d, c)
-            for p, d, c in zip(pairs, self.dark_levels, self.centres, strict=True)
+            for p, d, c in zip(pairs, self.dark_fields, self.centres, strict=True)
         ]
         self.core_depths = [saturated_depth(p.pattern) * p.to_reference for p in pairs]
         # equivalent radius (reference pixels) of each channel's saturated area
@@ -470,6 +512,23 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             for k in self.features(0, self.probes[0])
         }
 
+    def recording_facts(self) -> dict[str, str]:
+        with_frame = sum(p.pattern_dark is not None for p in self.pairs)
+        if with_frame == 0:
+            source = (
+                "one level per channel: the median of the capture's farthest tenth (no pattern_dark column)"
+            )
+        elif with_frame == len(self.pairs):
+            source = (
+                "the median of the capture's farthest tenth, varying over the frame as a quadratic surface fitted "
+                "to its dark frame does (pairs.csv column pattern_dark)"
+            )
+        else:
+            source = (
+                f"a dark frame (pattern_dark) for {with_frame} of {len(self.pairs)} pairs, else one level"
+            )
+        return {"capture_dark_level": source}
+
     def centre(self, index: int) -> tuple[float, float]:
         return self.centres[index]
 
@@ -495,7 +554,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "pattern": flat_pixels(pair.pattern, pixels),
             "beam": flat_pixels(self.beams[index].profile, pixels),
             "unmeasured": self.unmeasured(index, pixels),
-            "dark": self.dark_levels[index].reshape(1, 3).expand(n, 3),
+            "dark": flat_pixels(self.dark_fields[index], pixels),
             "core_depth": flat_pixels(self.core_depths[index], pixels),
             "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
             "radius": radius,
