@@ -12,7 +12,7 @@ the same, checked here), into ``OUTDIR/bt_SEED/ARM/``. The dark frame is read th
 The last two replace ``dark_field`` and put ``dark_level_radius`` at 1e30 px (the halo there is at most 1e-6 of its
 amplitude, its exponent's lowest bound being 0.2). Prints per arm the named causes, the test's verdict, the
 extended model's held-out RMSE, the cross-validated scores of linear light alone and with the glare (the selection's
-first and second steps) and the glare's fitted level and exponent beside the planted exponent.
+first step: the room's gradient read as laser light shows in the first) and the glare's fitted level and exponent beside the planted exponent.
 
 Usage: ``PYTHONPATH=. python docs/bench/session80/dark_frame_ab.py OUTDIR [--arms plain,shape,whole,smoothed]
 SEED...``
@@ -77,6 +77,16 @@ def render_with_dark_frame(camsim, rng: np.random.Generator, camera, n_pairs: in
     return pairs, seen["exponent"]
 
 
+def glare_beside_linear_light(steps: list[dict]) -> str:
+    """The selection's first step: the cross-validated score of linear light alone, and with the glare (and the
+    glare's share under it) where that pair was scored."""
+    tried = steps[0]["tried"]
+    linear, with_glare = tried["linear_light_saturation"], tried.get("linear_light_saturation+halo_power_law")
+    if with_glare is None:
+        return f"CV linear light {linear:.3f}, with the glare not scored"
+    return f"CV linear light {linear:.3f}, with the glare {with_glare:.3f} ({100 * (1 - with_glare / linear):+.1f}%)"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser()
     parser.add_argument("out", type=Path)
@@ -121,17 +131,11 @@ def main() -> None:
                 if "halo_level" in params
                 else "no glare"
             )
-            steps = report["selection"]["steps"]
-            linear = steps[0]["tried"]["linear_light_saturation"]
-            with_glare = steps[0]["tried"].get("linear_light_saturation+halo_power_law")
-            if len(steps) > 1 and steps[1]["effects"] == ["linear_light_saturation"]:
-                with_glare = steps[1]["tried"].get("halo_power_law", with_glare)
             print(
                 f"{master} {arm}: named {sorted(sim.named_causes(report))} "
                 f"{'pass' if sim.passes(case, report, camera) else 'MISS'}; held-out RMSE base "
                 f"{report['base']['heldout_rmse']:.3f} extended {report['extended']['heldout_rmse']:.3f}; "
-                f"CV linear light {linear:.3f}, with the glare {with_glare:.3f} "
-                f"({100 * (1 - with_glare / linear):+.1f}%); {glare} (planted exponent {exponent:.2f}); {time.perf_counter() - began:.0f} s",
+                f"{glare_beside_linear_light(report['selection']['steps'])}; {glare} (planted exponent {exponent:.2f}); {time.perf_counter() - began:.0f} s",
                 flush=True,
             )
 
