@@ -353,6 +353,17 @@ CASES = [
         # every other case keeps its case seed)
         lambda rng, cam: cs.em_truncation_pairs(rng, cam, N_PAIRS, count_spread=rng.uniform(0.05, 0.1)),
     ),
+    Case(
+        "blinding_halo_dark_frame",
+        "laser_blinding",
+        "effect",
+        # blinding_halo with the laser capture repeated with the laser off, which gives the dark room's shape (its
+        # gradient, read as one level, is laser light at the gain: docs/bench/session79.md); after the others, so
+        # that every case keeps its case seed
+        lambda rng, cam: cs.laser_blinding_pairs(rng, cam, N_PAIRS, halo=True, dark_frame=True),
+        planted=frozenset({"linear_light_saturation", "halo_power_law"}),
+        tolerated=LINEAR_LIGHT,
+    ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
 # the cases CAMSIM_CASES=core runs: every named frame-pair effect of the library, all six nulls and two unnamed
