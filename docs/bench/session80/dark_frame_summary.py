@@ -49,7 +49,8 @@ def main() -> None:
         if arm == "plain":
             continue
         common = sorted(set(draws) & set(runs["plain"]))
-        print(f"\n{arm} against plain, draw by draw ({len(common)} draws):")
+        lower = sum(float(draws[d]["heldout"]) < float(runs["plain"][d]["heldout"]) for d in common)
+        print(f"\n{arm} against plain, draw by draw ({len(common)} draws; held-out RMSE lower on {lower}):")
         for seed in common:
             a, b = runs["plain"][seed], draws[seed]
             print(
