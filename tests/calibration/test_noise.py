@@ -35,8 +35,11 @@ FULL_WELL = 400.0  # electrons at saturation: photon noise of several grey level
 
 @dataclass
 class Frames:
+    """The part of a frame pair (``frame_models.common.Pair``) a frame problem reads."""
+
     attacked: torch.Tensor
     clean: torch.Tensor
+    pattern_dark: torch.Tensor | None = None
 
 
 class IdentityProblem(FrameProblem):
