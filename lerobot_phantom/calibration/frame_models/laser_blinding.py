@@ -7,10 +7,10 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   does not grow with the laser's power: the per-channel median of the tenth of the capture's pixels farthest from
   the spot is subtracted in linear light. One level misreads a dark room whose light varies over the frame: the
   capture is scaled to the attack's power by a gain of tens to a hundred, and the room's gradient, read as laser
-  light, lit the frames by up to a tenth of a full well and stood in for glare (on the independent simulator's halo
-  case the glare's fit ran to its bound, docs/bench/session79.md). With a dark frame (``pattern_dark``: the capture
-  repeated with the laser off, as beam profilers record one), the level varies over the frame as the dark frame's
-  light does (:func:`dark_field`);
+  light, lit the frames by up to 0.12 full wells per unit intensity and stood in for glare (on the independent
+  simulator's halo case the glare's fit ran to its bound, docs/bench/session79.md). With a dark frame
+  (``pattern_dark``: the capture repeated with the laser off, as beam profilers record one), the level varies over
+  the frame as the dark frame's light does (:func:`dark_field`);
 * where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
   extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
   radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
