@@ -197,6 +197,24 @@ def test_a_dark_frame_reads_a_dark_room_whose_light_varies():
     assert float(from_frame.max()) < 0.15
 
 
+def test_the_report_says_which_pairs_had_a_dark_frame():
+    """Each pair is read with its own dark frame or without one, and the recording facts say which."""
+    without, with_frame = (
+        glare_capture(100.0, room_slope=0.3, dark_frame=f)[0].pairs[0] for f in (False, True)
+    )
+    facts = {
+        n: BlindingFrames(pairs, seed=0).recording_facts()["capture_dark_level"]
+        for n, pairs in {0: [without, without], 1: [without, with_frame], 2: [with_frame, with_frame]}.items()
+    }
+    assert facts[0].startswith("one level per channel") and "dark frame" not in facts[0]
+    assert "for 1 of 2 pairs" in facts[1]
+    assert "quadratic surface fitted to its dark frame" in facts[2]
+    mixed = BlindingFrames([without, with_frame], seed=0)
+    alone = [BlindingFrames([p], seed=0).dark_fields[0] for p in (without, with_frame)]
+    assert all(torch.equal(a, b) for a, b in zip(mixed.dark_fields, alone, strict=True))
+    assert not torch.equal(mixed.dark_fields[0], mixed.dark_fields[1])
+
+
 def test_pairs_with_a_dark_frame_load_it_and_other_attacks_refuse_it(tmp_path):
     from PIL import Image
 

@@ -128,13 +128,10 @@ class Pair:
 IMAGE_COLUMNS = ("clean", "attacked", "pattern", "pattern_dark")
 
 
-def optional_image(
-    folder: Path, table: pd.DataFrame, row: pd.Series, column: str, size
-) -> torch.Tensor | None:
+def optional_image(folder: Path, row: pd.Series, column: str, size) -> torch.Tensor | None:
     """The image a row names in an optional column (None where the column is absent or the cell empty)."""
-    if column in table.columns and isinstance(row[column], str) and row[column]:
-        return load_rgb(folder / row[column], size=size)
-    return None
+    name = row.get(column)
+    return load_rgb(folder / name, size=size) if isinstance(name, str) and name else None
 
 
 def load_pairs(folder: Path, *, max_side: int) -> list[Pair]:
@@ -162,8 +159,8 @@ def load_pairs(folder: Path, *, max_side: int) -> list[Pair]:
                     f"pair {i}: clean {row['clean']} is {original} but attacked {row['attacked']} is {probe.size}"
                 )
         attacked = load_rgb(folder / str(row["attacked"]), size=size)
-        pattern = optional_image(folder, table, row, "pattern", size)
-        pattern_dark = optional_image(folder, table, row, "pattern_dark", size)
+        pattern = optional_image(folder, row, "pattern", size)
+        pattern_dark = optional_image(folder, row, "pattern_dark", size)
         if pattern_dark is not None and pattern is None:
             raise ValueError(
                 f"pair {i}: pattern_dark {row['pattern_dark']} is the pattern's capture with the source off, but "
