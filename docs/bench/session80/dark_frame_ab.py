@@ -1,20 +1,17 @@
 """A dark frame's worth on camsim's glare case: each master seed's ``blinding_halo`` draw calibrated as the test
 renders it (arm ``plain``) and with the laser capture's dark frame added (camsim's ``dark_frame``: every other draw
-the same, checked here), into ``OUTDIR/bt_SEED/ARM/``. The dark frame is read three ways:
+the same, checked here), into ``OUTDIR/bt_SEED/ARM/``. The dark frame is read two ways:
 
 - ``shape``: as the package reads it (``laser_blinding.dark_field``: the room's shape, a quadratic surface fitted to
   the dark frame, taken out of the capture, whose dark level is then read as without a dark frame, and put back;
   the halo adds back the glare that level holds);
-- ``whole``: the quadratic surface subtracted whole, and no glare added back (a dark frame holds none);
-- ``smoothed``: the dark frame smoothed over 8 reference px (a Gaussian, in linear light) subtracted whole, no glare
-  added back.
-
-The last two replace ``dark_field`` and put ``dark_level_radius`` at 1e30 px (the halo there is at most 1e-6 of its
-amplitude, its exponent's lowest bound being 0.2). Prints per arm the named causes, the test's verdict, the
+- ``whole``: the quadratic surface subtracted whole, and no glare added back (a dark frame holds none): it replaces
+  ``dark_field`` and puts ``dark_level_radius`` at 1e30 px (the halo there is at most 1e-6 of its amplitude, its
+  exponent's lowest bound being 0.2). Prints per arm the named causes, the test's verdict, the
 extended model's held-out RMSE, the cross-validated scores of linear light alone and with the glare (the selection's
 first step: the room's gradient read as laser light shows in the first) and the glare's fitted level and exponent beside the planted exponent.
 
-Usage: ``PYTHONPATH=. python docs/bench/session80/dark_frame_ab.py OUTDIR [--arms plain,shape,whole,smoothed]
+Usage: ``PYTHONPATH=. python docs/bench/session80/dark_frame_ab.py OUTDIR [--arms plain,shape,whole]
 SEED...``
 """
 
@@ -29,9 +26,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import torch
 from camsim_case_cameras import case_draws
-from scipy import ndimage
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.frame_models import laser_blinding
@@ -45,19 +40,10 @@ def whole_surface(pair, centre):
     return physics.linear_to_srgb(laser_blinding.dark_surface(pair.pattern_dark).clamp(min=0.0))
 
 
-def whole_smoothed(pair, centre):
-    sigma = 8.0 / pair.to_reference
-    light = physics.srgb_to_linear(pair.pattern_dark).numpy()
-    return physics.linear_to_srgb(
-        torch.from_numpy(ndimage.gaussian_filter(light, (0, sigma, sigma), mode="nearest"))
-    )
-
-
 READINGS = {
     "plain": PACKAGE,
     "shape": PACKAGE,
     "whole": (whole_surface, lambda pattern, centre: 1e30),
-    "smoothed": (whole_smoothed, lambda pattern, centre: 1e30),
 }
 
 
