@@ -259,7 +259,12 @@ def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tens
     """Per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
     room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
     _, far = dark_region(pattern, centre)
-    return pattern.reshape(3, -1)[:, far].median(dim=1).values
+    return far_median(pattern, far).flatten()
+
+
+def far_median(values: torch.Tensor, far: torch.Tensor) -> torch.Tensor:
+    """(3, 1, 1): each channel's median over the ``far`` pixels of (3, H, W) ``values``."""
+    return values.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
 
 
 def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
@@ -290,9 +295,9 @@ def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
         return dark_level(pair.pattern, centre).reshape(3, 1, 1).expand_as(pair.pattern)
     surface = dark_surface(pair.pattern_dark)
     _, far = dark_region(pair.pattern, centre)
-    departure = surface - surface.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
-    flattened = physics.linear_to_srgb((physics.srgb_to_linear(pair.pattern) - departure).clamp(min=0.0))
-    level = physics.srgb_to_linear(dark_level(flattened, centre)).reshape(3, 1, 1)
+    departure = surface - far_median(surface, far)
+    # read in linear light: the median commutes with the tone curve, so this is dark_level of the flattened capture
+    level = far_median((physics.srgb_to_linear(pair.pattern) - departure).clamp(0.0, 1.0), far)
     return physics.linear_to_srgb((level + departure).clamp(min=0.0))
 
 
