@@ -256,10 +256,10 @@ def dark_region(pattern: torch.Tensor, centre: tuple[float, float]) -> tuple[tor
 
 
 def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
-    """Per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
+    """(3, 1, 1): per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
     room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
     _, far = dark_region(pattern, centre)
-    return far_median(pattern, far).flatten()
+    return far_median(pattern, far)
 
 
 def far_median(values: torch.Tensor, far: torch.Tensor) -> torch.Tensor:
@@ -292,7 +292,7 @@ def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
     noise deviations above it, which the beam then reads pixel by pixel, noise and all, times the gain, where the
     halo had modelled it: on camsim's glare case the halo was named on fewer draws (docs/bench/session80.md)."""
     if pair.pattern_dark is None:
-        return dark_level(pair.pattern, centre).reshape(3, 1, 1).expand_as(pair.pattern)
+        return dark_level(pair.pattern, centre).expand_as(pair.pattern)
     surface = dark_surface(pair.pattern_dark)
     _, far = dark_region(pair.pattern, centre)
     departure = surface - far_median(surface, far)
@@ -336,7 +336,7 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     ratio between the frames and the capture (tens, for a beam-profile exposure), the noise would be amplified
     into the frames too. So the capture is smoothed over ``BEAM_SMOOTHING_PX`` (a beam profile varies slowly on
     that scale, pixel noise does not), and values within ``NOISE_FLOOR_SIGMAS`` noise deviations of the dark level
-    ``dark`` (encoded: one level per channel, (3,), or a field, (3, H, W), :func:`dark_field`; the noise is the
+    ``dark`` (encoded: one level per channel, (3, 1, 1), or a field, (3, H, W), :func:`dark_field`; the noise is the
     robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read as
     measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
     the frames far around the spot. There it is continued with the fall-off of its measured edge (light
@@ -371,7 +371,6 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     detail = (pattern - smooth).reshape(3, -1)[:, flat_radius >= flat_radius.median()]
     spread = torch.from_numpy(stats.median_abs_deviation(detail.numpy(), axis=1, scale="normal"))
     noise = torch.sqrt(spread**2 + 1.0 / (12.0 * 255.0**2))
-    dark = dark.reshape(3, 1, 1) if dark.dim() == 1 else dark
     dark_linear = physics.srgb_to_linear(dark)
     light = physics.srgb_to_linear(smooth) - dark_linear
     floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise.reshape(3, 1, 1)) - dark_linear
