@@ -32,7 +32,9 @@ The rule (:func:`identify`): an extension is a named cause only if
    bound of their ranges (one drift per recording, each >= 0), it reduces to the model without it only in a draw
    that has every one of them at its null, so the interval of the largest distance from the null among them (a
    share of each range, :func:`joint_null_interval`) excluding 0 suffices: evidence held by few items of each
-   parameter leaves each one at its null in some draws, and the extension in none;
+   parameter leaves each one at its null in some draws, and the extension in none. A parameter the fit items do not
+   depend on (:func:`unmeasured_params`) excludes nothing: its draws all stay where the search left it, and a null
+   elsewhere would look excluded by an interval of zero width;
 5. the problem's own adequacy checks of the effect's physics pass, where it has any
    (``problem.identification_checks(effect, fit, items) -> [reasons]``; e.g. a stabiliser's motion blur must be one
    path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
@@ -59,7 +61,7 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -86,6 +88,10 @@ LEVEL = 0.9  # two-sided coverage of every reported interval
 # range swallowed a real end (a read noise of 0.21 us on a 0-1365 us range, session 34)
 NULL_AT_BOUND_TOLERANCE = 1e-6
 JOINT_NULL_STATISTIC = "largest distance from the null, as a share of each range"
+# moves of a parameter, in its search scale (``core.Param.scale``), each way, that must each change the fit items'
+# squared error by more than ``UNMEASURED_TOLERANCE`` of it for the parameter to count as measured
+UNMEASURED_MOVES = (1e-3, 1.0)
+UNMEASURED_TOLERANCE = 1e-9
 # draws of the intervals that only re-sum per-item terms (the error ratio of rule 2, the held-out RMSE, the residual
 # structure's statistics): a draw costs a weighted sum, not a refit. With 200 draws (until session 44) the 5% end of
 # a ratio was Monte Carlo noise that decided rule 2: drawn stripe camera 4111198912 (lit frames), integration offset,
@@ -105,9 +111,12 @@ class Interval:
     high: float
     level: float = LEVEL
     draws: int = 0
+    # False when the items do not depend on the parameter (:func:`unmeasured_params`): the draws then repeat the
+    # estimate, and the interval measures nothing
+    measured: bool = True
 
     def excludes(self, value: float) -> bool:
-        return value < self.low or value > self.high
+        return self.measured and (value < self.low or value > self.high)
 
     def as_dict(self) -> dict:
         return {
@@ -116,6 +125,7 @@ class Interval:
             "high": self.high,
             "level": self.level,
             "draws": self.draws,
+            "measured": self.measured,
         }
 
 
@@ -335,6 +345,12 @@ def parameter_checks(
     ``joint_null``: the interval of :func:`joint_null_interval`, which passes rule 4 when it excludes 0."""
     reasons, notes = [], []
     for name, value in params.items():
+        if name in intervals and not intervals[name].measured:
+            notes.append(
+                f"{name} = {value:.4g} is not measured: the fit items do not depend on it, and the value is where "
+                "the search left it"
+            )
+            continue
         side = at_bound(value, *bounds[name])
         limit = limits.get(name, {}).get(side, "")
         if limit:
@@ -369,7 +385,11 @@ def parameter_checks(
             reasons.append(
                 "the interval of "
                 + ", ".join(
-                    f"{n} ({intervals[n].low:.4g}-{intervals[n].high:.4g})" for n in nulls if n in intervals
+                    f"{n} ({intervals[n].low:.4g}-{intervals[n].high:.4g})"
+                    if intervals[n].measured
+                    else f"{n} (not measured)"
+                    for n in nulls
+                    if n in intervals
                 )
                 + " includes the null value "
                 + ", ".join(f"{n} = {v:g}" for n, v in nulls.items())
@@ -416,18 +436,58 @@ def parameter_draws(
     return [problem.fit(fit.effects, resample(items, rng), start=fit).params for _ in range(draws)]
 
 
-def draw_intervals(fit: Fit, samples: Sequence[Mapping[str, float]]) -> dict[str, Interval]:
-    """Percentile intervals of every fitted parameter of ``fit`` over bootstrap refits (``parameter_draws``)."""
-    return {
+def unmeasured_params(problem: Problem, fit: Fit, items: np.ndarray) -> set[str]:
+    """The parameters of ``fit`` the ``items`` do not depend on: no move of ``UNMEASURED_MOVES`` search scales
+    either way (inside the bounds) changes their squared error by ``UNMEASURED_TOLERANCE`` of it. Such a value is
+    wherever the search left it, and every bootstrap refit leaves it there: camsim's laser blinding halo case
+    reported the beam width behind a capture's saturated core as 20 [20, 20] reference pixels for a capture with
+    no saturated pixel (docs/bench/session81.md)."""
+    specs = problem.param_specs(fit.effects)
+    if not specs:
+        return set()
+    total, _ = problem.squared_errors(fit, items)
+    unmeasured = set()
+    for spec in specs:
+        value = fit.params[spec.name]
+        moved = {
+            min(max(value + sign * step * spec.scale, spec.low), spec.high)
+            for step in UNMEASURED_MOVES
+            for sign in (-1.0, 1.0)
+        } - {value}
+        if all(
+            abs(
+                problem.squared_errors(Fit(fit.effects, {**fit.params, spec.name: v}, fit.extra), items)[0]
+                - total
+            )
+            <= UNMEASURED_TOLERANCE * total
+            for v in moved
+        ):
+            unmeasured.add(spec.name)
+    return unmeasured
+
+
+def draw_intervals(
+    problem: Problem, fit: Fit, items: np.ndarray, samples: Sequence[Mapping[str, float]]
+) -> dict[str, Interval]:
+    """Percentile intervals of every fitted parameter of ``fit`` over bootstrap refits on resamples of ``items``
+    (``parameter_draws``), those of :func:`unmeasured_params` marked as measuring nothing."""
+    unmeasured = unmeasured_params(problem, fit, items)
+    intervals = {
         k: percentile_interval(fit.params[k], [float(s.get(k, np.nan)) for s in samples]) for k in fit.params
     }
+    return {k: replace(v, measured=k not in unmeasured) for k, v in intervals.items()}
+
+
+def measured_nulls(nulls: Mapping[str, float], intervals: Mapping[str, Interval]) -> dict[str, float]:
+    """The ``nulls`` of parameters whose ``intervals`` measure them (rule 4's joint test reads only those)."""
+    return {k: v for k, v in nulls.items() if intervals[k].measured}
 
 
 def parameter_intervals(
     problem: Problem, fit: Fit, items: np.ndarray, *, draws: int, rng: np.random.Generator
 ) -> dict[str, Interval]:
     """Percentile intervals of every fitted parameter over ``draws`` bootstrap refits (``parameter_draws``)."""
-    return draw_intervals(fit, parameter_draws(problem, fit, items, draws=draws, rng=rng))
+    return draw_intervals(problem, fit, items, parameter_draws(problem, fit, items, draws=draws, rng=rng))
 
 
 def implied_results(
@@ -521,7 +581,7 @@ def identify_selection(
     not made)."""
     selected_fit = chain[-1]
     samples = parameter_draws(problem, selected_fit, fit_items, draws=draws, rng=rng)
-    intervals = draw_intervals(selected_fit, samples)
+    intervals = draw_intervals(problem, selected_fit, fit_items, samples)
     entries = selection_entries(steps)
     own = own_evidence_results(
         problem,
@@ -631,7 +691,9 @@ def own_evidence_results(
         params = {p.name: selected_fit.params[p.name] for p in specs}
         nulls = {k: v for k, v in problem.null_values(effect).items() if k in selected_fit.params}
         bounds = {p.name: (p.low, p.high) for p in specs}
-        joint_null = joint_null_interval(nulls, bounds, selected_fit.params, samples)
+        joint_null = joint_null_interval(
+            measured_nulls(nulls, intervals), bounds, selected_fit.params, samples
+        )
         outcome = identify(
             effect,
             selected=True,
@@ -710,7 +772,7 @@ def refit_identified(
         start = max((f for f in chain if f.effects <= kept), key=lambda f: len(f.effects))
         final = start if start.effects == kept else problem.fit(kept, fit_items, start)
         final_samples = parameter_draws(problem, final, fit_items, draws=draws, rng=rng)
-        final_intervals = draw_intervals(final, final_samples)
+        final_intervals = draw_intervals(problem, final, fit_items, final_samples)
         failing = {
             effect: reasons
             for effect in sorted(kept)
@@ -812,7 +874,7 @@ def refit_reasons(
         intervals,
         nulls,
         physical_limits(specs),
-        joint_null_interval(nulls, bounds, fit.params, samples),
+        joint_null_interval(measured_nulls(nulls, intervals), bounds, fit.params, samples),
     )
     return [f"refitted without {', '.join(sorted(dropped))}, {reason}" for reason in reasons]
 

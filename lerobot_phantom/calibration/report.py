@@ -1,6 +1,7 @@
 """Writing the calibration's outputs: report.json, report.md (+ figures) and calibrated.json.
 
-report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percentile bootstrap over items):
+report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percentile bootstrap over items; a
+parameter's also has ``measured``, false when the fit items do not depend on it, identify.unmeasured_params):
 
 - ``attack``, ``input`` {path, kind, recording: the facts of the recording the models depend on, each with where
   it was read}, ``units``, ``n_fit``, ``n_heldout``, ``split`` {seed, items};
@@ -604,6 +605,8 @@ def _step_lines(steps: list[dict], score: str) -> list[str]:
 def _interval(interval: dict | None) -> str:
     if not interval or interval.get("low") is None:
         return ""
+    if interval.get("measured") is False:
+        return "(not measured: the fit items do not depend on it)"
     return f"[{interval['low']:.4g}, {interval['high']:.4g}]"
 
 

@@ -26,7 +26,7 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     halo_amplitude,
     laser_gain,
 )
-from lerobot_phantom.calibration.identify import at_bound
+from lerobot_phantom.calibration.identify import at_bound, unmeasured_params
 from lerobot_phantom.calibration.tone import TONE_PARAMS
 from lerobot_phantom.transforms import physics
 
@@ -85,15 +85,33 @@ def test_a_shoulder_lifts_the_shadows_above_srgb():
     assert float(srgb_decode(physics.encode(faint, None))) == pytest.approx(0.01, rel=1e-9)
 
 
-def one_pair_problem() -> BlindingFrames:
-    """A blinding frame model of one small pair: a grey scene, and a laser spot whose capture saturates its core."""
+def one_pair_problem(peak: float = 1.5) -> BlindingFrames:
+    """A blinding frame model of one small pair: a grey scene, and a laser spot whose capture peaks at ``peak``
+    full wells (above 1: the capture saturates its core)."""
     ys, xs = torch.meshgrid(torch.arange(24.0), torch.arange(32.0), indexing="ij")
     spot = torch.exp(-((xs - 16) ** 2 + (ys - 12) ** 2) / (2 * 3.0**2)).double()
-    pattern = (1.5 * spot * torch.tensor([1.0, 0.1, 0.05], dtype=torch.float64).reshape(3, 1, 1)).clamp(
+    pattern = (peak * spot * torch.tensor([1.0, 0.1, 0.05], dtype=torch.float64).reshape(3, 1, 1)).clamp(
         max=1.0
     )
     scene = torch.full((3, 24, 32), 0.4, dtype=torch.float64)
     return BlindingFrames([Pair("spot", scene, (scene + pattern).clamp(max=1.0), pattern, 1.0)], seed=0)
+
+
+@pytest.mark.parametrize(
+    "peak, gain, unmeasured",
+    [(1.5, 0.3, set()), (1.5, 1.0, {"core_sigma_ref_px"}), (0.8, 0.3, {"core_sigma_ref_px"})],
+)
+def test_the_beam_width_behind_the_core_is_measured_only_where_a_saturated_core_lights_the_frame(
+    peak, gain, unmeasured
+):
+    """The width extrapolates the beam behind the capture's clipped core: without a saturated pixel (camsim's halo
+    case on master seed 2887441637 reported it as 20 [20, 20], its starting value), or where the frame clips the
+    core's light anyway, no prediction depends on it, and the report says it is not measured."""
+    problem = one_pair_problem(peak)
+    fit = Fit(
+        frozenset({"linear_light_saturation"}), {"log10_gain": math.log10(gain), "core_sigma_ref_px": 20.0}
+    )
+    assert unmeasured_params(problem, fit, np.arange(problem.n_items)) == unmeasured
 
 
 @pytest.mark.parametrize("gain", [0.18, 1.0, 30.0, 150.0, 200.0, 1000.0])

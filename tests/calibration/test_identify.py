@@ -47,6 +47,7 @@ from lerobot_phantom.calibration.identify import (
     resummed_totals,
     rmse_interval,
     select_and_identify,
+    unmeasured_params,
 )
 from lerobot_phantom.calibration.report import build_report, write_markdown
 from lerobot_phantom.transforms import physics
@@ -268,7 +269,25 @@ def test_a_change_of_functional_form_needs_no_null_value():
     assert identified(nulls={}).identified
 
 
-class ParentAndChild(Problem):
+class MeasuredEverywhere(Problem):
+    """A toy problem whose squared errors are its model's (``model_squared_errors``: one per item unless given) at
+    its fit on the items, and grow with every parameter's distance from that fit: each parameter is measured
+    (``identify.unmeasured_params``), as the toy's fits, which follow the items, say."""
+
+    # parameters no error depends on (none unless a toy says so)
+    ignored: frozenset[str] = frozenset()
+
+    def model_squared_errors(self, effects: frozenset[str], items: np.ndarray) -> tuple[float, int]:
+        return float(len(items)), len(items)
+
+    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
+        total, count = self.model_squared_errors(fit.effects, items)
+        best = self.fit(fit.effects, items).params
+        distance = sum((v - best[k]) ** 2 for k, v in fit.params.items() if k not in self.ignored)
+        return total * (1.0 + distance), count
+
+
+class ParentAndChild(MeasuredEverywhere):
     """A parent extension and a child that builds on it; without the parent the model has neither parameter (as
     a stripe model without the exposure overlap has no detection threshold). The child's parameter sits at its
     bound on every fit."""
@@ -345,7 +364,7 @@ def test_a_group_of_three_taken_in_one_step_is_compared_with_the_model_before_th
         Step(["a", "b", "c"], 0.9, {}, PER_ITEM),
     ]
 
-    class ThreeTogether(Problem):
+    class ThreeTogether(MeasuredEverywhere):
         candidates = tuple(Effect(name, "one of three") for name in "abc")
 
         def param_specs(self, effects):
@@ -477,7 +496,7 @@ def test_a_member_of_a_group_is_judged_with_what_its_partner_hosts():
     the noise, and is named (drawn camera 4111198912, lit frames: judged at the pair's step, the offset was withdrawn
     and the written model erred by 341 rows held-out, 2.8 with it)."""
 
-    class PairThenChild(Problem):
+    class PairThenChild(MeasuredEverywhere):
         candidates = (
             Effect("host", "a threshold"),
             Effect("partner", "an offset"),
@@ -509,7 +528,7 @@ def test_a_member_of_a_group_is_judged_with_what_its_partner_hosts():
     assert sorted(selection.identified) == ["child", "host", "partner"]
 
 
-class MeterBalancingAGlare(Problem):
+class MeterBalancingAGlare(MeasuredEverywhere):
     """A meter that passes every condition in the model with a glare, but only balanced it: refitted without the
     glare (whose level sits at its bound), the meter falls to its null value 0, the low bound of its range."""
 
@@ -546,7 +565,7 @@ def test_an_effect_that_falls_to_its_null_in_the_refit_is_not_identified():
     assert selection.identified == [] and selection.fit.effects == frozenset()
 
 
-class DriftPerRecording(Problem):
+class DriftPerRecording(MeasuredEverywhere):
     """One effect with a drift per recording (each >= 0, null 0), fitted on a recording's evidence items alone:
     a drift is 0.3 in a resample holding any of its recording's evidence items, else at its null, as a locked
     recording's drift is. ``evidence``: recording -> its evidence items among 20."""
@@ -605,7 +624,7 @@ def test_the_refit_without_a_rejected_effect_judges_its_drifts_jointly_too():
     problem = DriftPerRecording({"drift_a": (0,), "drift_b": (1,)})
     fit = Fit(frozenset({"drift"}), {"drift_a": 0.3, "drift_b": 0.3})
     samples = [{"drift_a": 0.3, "drift_b": 0.0}, {"drift_a": 0.0, "drift_b": 0.3}] * 10
-    intervals = draw_intervals(fit, samples)
+    intervals = draw_intervals(problem, fit, np.arange(2), samples)
     assert refit_reasons(problem, fit, intervals, "drift", frozenset({"glare"}), samples) == []
     (reason,) = refit_reasons(problem, fit, intervals, "drift", frozenset({"glare"}), ())
     assert reason.startswith("refitted without glare, the interval of drift_a (0-0.3)"), reason
@@ -623,7 +642,69 @@ def test_a_joint_null_is_judged_only_for_several_nulls_all_at_bounds():
     assert joint.low == joint.high == 0.5
 
 
-class ShoulderedCurve(Problem):
+class GlareWithAnUnseenParameter(MeasuredEverywhere):
+    """A glare whose level (null 0) and inner scale follow the items, except those the items do not depend on
+    (``ignored``), which every fit leaves at their start, as the fits left the beam width behind a capture with no
+    saturated core (camsim's halo case, master seed 2887441637: 20 [20, 20] reference pixels)."""
+
+    candidates = (Effect("glare", "scattered light"),)
+
+    def __init__(self, ignored: set[str]) -> None:
+        self.ignored = frozenset(ignored)
+
+    def param_specs(self, effects):
+        if "glare" not in effects:
+            return []
+        return [Param("level", 0.02, 0.0, 5.0, scale=0.02), Param("inner", 1.0, 0.3, 200.0)]
+
+    def null_values(self, effect):
+        return {"level": 0.0} if effect == "glare" else {}
+
+    def fit(self, effects, items, start=None) -> Fit:
+        moved = {"level": 0.5 + 0.001 * float(np.mean(items)), "inner": 3.0 + 0.01 * float(np.mean(items))}
+        return Fit(
+            effects,
+            {p.name: p.init if p.name in self.ignored else moved[p.name] for p in self.param_specs(effects)},
+        )
+
+
+GLARE_STEPS = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["glare"], 1.0, {}, PER_ITEM)]
+
+
+def select_glare(ignored: set[str]):
+    problem, items = GlareWithAnUnseenParameter(ignored), np.arange(20)
+    chain = [problem.fit(frozenset(s.effects), items) for s in GLARE_STEPS]
+    return problem, identify_selection(
+        problem, GLARE_STEPS, chain, items, draws=20, rng=np.random.default_rng(4)
+    )
+
+
+def test_a_parameter_the_items_do_not_depend_on_is_reported_as_not_measured(tmp_path):
+    problem, selection = select_glare({"inner"})
+    assert unmeasured_params(problem, selection.fit, np.arange(20)) == {"inner"}
+    (result,) = selection.results
+    assert result["identified"], result["reasons"]
+    assert result["intervals"]["inner"]["measured"] is False and result["intervals"]["level"]["measured"]
+    assert any(note.startswith("inner = 1 is not measured") for note in result["notes"]), result["notes"]
+    report = report_on_twenty_items(problem, selection, GLARE_STEPS)
+    write_markdown(report, [], tmp_path / "report.md")
+    text = (tmp_path / "report.md").read_text()
+    assert "`inner` = 1 (not measured: the fit items do not depend on it)" in text
+    assert "`level` = 0.5" in text and "[0.5" in text
+
+
+def test_a_null_parameter_the_items_do_not_depend_on_excludes_nothing():
+    """Left at its start, 0.02, by every draw, the level's interval has zero width away from its null 0: read as a
+    measurement, it would exclude the null and pass rule 4."""
+    _problem, selection = select_glare({"level"})
+    (result,) = selection.results
+    level = result["intervals"]["level"]
+    assert level["low"] == level["high"] == 0.02 and level["measured"] is False
+    assert not result["identified"]
+    assert any("the interval of level (not measured) includes the null value" in r for r in result["reasons"])
+
+
+class ShoulderedCurve(MeasuredEverywhere):
     """One effect, a tone curve whose form also asserts an encoding it has no term for (``implies``); its fitted
     parameter follows the items, so the bootstrap over items sets the spread of the implied statistic."""
 
@@ -645,8 +726,8 @@ class ShoulderedCurve(Problem):
     def implied_statistic(self, effect, implied, params):
         return "equivalent", 1.0 + params["s"], 1.0
 
-    def squared_errors(self, fit, items):
-        return (1.0 if fit.effects else 4.0) * len(items), len(items)
+    def model_squared_errors(self, effects, items):
+        return (1.0 if effects else 4.0) * len(items), len(items)
 
 
 CURVE_STEPS = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["curve"], 1.0, {}, PER_ITEM)]
@@ -685,7 +766,7 @@ def test_a_form_that_is_not_identified_implies_nothing():
     assert not selection.results[0]["identified"] and selection.identified == []
 
 
-class TwoForms(Problem):
+class TwoForms(MeasuredEverywhere):
     """One term in two forms: a power law (one parameter) and a shouldered curve (two) whose knee exponent sits at
     its bound on every fit, as a shoulder fitted to a power-law camera does."""
 
@@ -708,8 +789,8 @@ class TwoForms(Problem):
         values = {"gamma": 2.1 + shift, "s": 1.5 + shift, "n": 0.25}
         return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
 
-    def squared_errors(self, fit, items):
-        return (1.0 if fit.effects else 4.0) * len(items), len(items)
+    def model_squared_errors(self, effects, items):
+        return (1.0 if effects else 4.0) * len(items), len(items)
 
 
 def two_forms_steps(power_terms: np.ndarray, set_aside: dict | None = None) -> list[Step]:
@@ -835,7 +916,7 @@ def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identifi
     )
 
 
-class FixedErrorsOnTwentyItems(Problem):
+class FixedErrorsOnTwentyItems(MeasuredEverywhere):
     """A problem whose error is fixed per model (``errors``, by the effects' names joined with "+") and the same on
     each of its 20 items."""
 
@@ -845,8 +926,8 @@ class FixedErrorsOnTwentyItems(Problem):
     def n_items(self) -> int:
         return 20
 
-    def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
-        return self.errors["+".join(sorted(fit.effects))] ** 2 * len(items), len(items)
+    def model_squared_errors(self, effects: frozenset[str], items: np.ndarray) -> tuple[float, int]:
+        return self.errors["+".join(sorted(effects))] ** 2 * len(items), len(items)
 
 
 class GreedyPowerLaw(FixedErrorsOnTwentyItems):
