@@ -339,23 +339,31 @@ class MultiCapture(Problem):
         }
         return Fit(effects, params, {"fits": fits})
 
+    def capture_fits(self, fit: Fit) -> list[Fit]:
+        """Each capture's fit, its parameters read from ``fit.params``, where they are reported (and moved:
+        ``identify.unmeasured_params``)."""
+        return [
+            Fit(f.effects, {k: fit.params[f"{c.path.name}.{k}"] for k in f.params}, f.extra)
+            for c, f in zip(self.captures, fit.extra["fits"], strict=True)
+        ]
+
     def squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[float, int]:
         total, count = 0.0, 0
+        fits = self.capture_fits(fit)
         for k, capture, chosen in self.local(items):
             if len(chosen):
-                sq, n = capture.squared_errors(fit.extra["fits"][k], chosen)
+                sq, n = capture.squared_errors(fits[k], chosen)
                 total, count = total + sq, count + n
         return total, count
 
     def item_squared_errors(self, fit: Fit, items: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         sq, counts = np.zeros(len(items)), np.zeros(len(items))
         items = np.asarray(items)
+        fits = self.capture_fits(fit)
         for k, capture in enumerate(self.captures):
             mine = np.flatnonzero((items >= self.offsets[k]) & (items < self.offsets[k + 1]))
             if len(mine):
-                sq[mine], counts[mine] = capture.item_squared_errors(
-                    fit.extra["fits"][k], items[mine] - self.offsets[k]
-                )
+                sq[mine], counts[mine] = capture.item_squared_errors(fits[k], items[mine] - self.offsets[k])
         return sq, counts
 
     def param_specs(self, effects: frozenset[str]) -> list[Param]:
@@ -366,38 +374,42 @@ class MultiCapture(Problem):
         ]
 
     def per_capture_rmse(self, fit: Fit, items: np.ndarray) -> dict[str, float]:
+        fits = self.capture_fits(fit)
         return {
-            capture.path.name: capture.rmse(fit.extra["fits"][k], chosen)
+            capture.path.name: capture.rmse(fits[k], chosen)
             for k, capture, chosen in self.local(items)
             if len(chosen)
         }
 
     def analyse(self, fit: Fit, items: np.ndarray) -> dict:
+        fits = self.capture_fits(fit)
         return {
             f"{capture.path.name}:{name}": values
             for k, capture, chosen in self.local(items)
-            for name, values in capture.analyse(fit.extra["fits"][k], chosen).items()
+            for name, values in capture.analyse(fits[k], chosen).items()
             if name == "radius_px"
         }
 
     def evidence(self, effect: str, before: Fit, after: Fit, items: np.ndarray) -> str:
+        befores, afters = self.capture_fits(before), self.capture_fits(after)
         return "; ".join(
-            f"{capture.path.name}: {capture.evidence(effect, before.extra['fits'][k], after.extra['fits'][k], chosen)}"
+            f"{capture.path.name}: {capture.evidence(effect, befores[k], afters[k], chosen)}"
             for k, capture, chosen in self.local(items)
         )
 
     def residual_sample(self, fit: Fit, items: np.ndarray, rng: np.random.Generator) -> ResidualSample:
         sample = ResidualSample([], {"radius_px": [], "measured_level": [], "channel": []})
+        fits = self.capture_fits(fit)
         for k, capture, chosen in self.local(items):
             if len(chosen):
-                part = capture.residual_sample(fit.extra["fits"][k], chosen, rng)
+                part = capture.residual_sample(fits[k], chosen, rng)
                 sample.residual += part.residual
                 for name in sample.covariates:
                     sample.covariates[name] += part.covariates[name]
         return sample
 
     def derived(self, fit: Fit) -> dict:
-        per_capture = [c.derived(f) for c, f in zip(self.captures, fit.extra["fits"], strict=True)]
+        per_capture = [c.derived(f) for c, f in zip(self.captures, self.capture_fits(fit), strict=True)]
         out: dict = {"captures": per_capture}
         for key in ("halo_exponent", "saturation_radius_px", "saturation_radius_ref_px", "core_sigma_px"):
             values = [d[key] for d in per_capture if key in d]
@@ -426,11 +438,12 @@ class MultiCapture(Problem):
         import matplotlib.pyplot as plt
 
         names = []
+        bases, extendeds = self.capture_fits(base), self.capture_fits(extended)
         for k, capture in enumerate(self.captures):
             fig, axes = plt.subplots(1, 4, figsize=(15, 4))
             measured = capture.image
-            base_img = capture.render(base.extra["fits"][k])
-            ext_img = capture.render(extended.extra["fits"][k])
+            base_img = capture.render(bases[k])
+            ext_img = capture.render(extendeds[k])
             for ax, image, title in zip(
                 axes[:3],
                 (measured, base_img, ext_img),
@@ -440,7 +453,7 @@ class MultiCapture(Problem):
                 ax.imshow(image.permute(1, 2, 0).numpy())
                 ax.set_title(title)
                 ax.axis("off")
-            p = extended.extra["fits"][k].params
+            p = extendeds[k].params
             cy = int(np.clip(round(p["cy"]), 0, measured.shape[1] - 1))
             for image, label in ((measured, "measured"), (base_img, "base"), (ext_img, "extended")):
                 axes[3].plot(255 * image.max(0).values[cy].numpy(), label=label)

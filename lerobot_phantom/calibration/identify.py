@@ -60,7 +60,7 @@ costs least first (backward elimination: without it, the others may pay again)
 from __future__ import annotations
 
 import itertools
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -111,22 +111,22 @@ class Interval:
     high: float
     level: float = LEVEL
     draws: int = 0
-    # False when the items do not depend on the parameter (:func:`unmeasured_params`): the draws then repeat the
-    # estimate, and the interval measures nothing
-    measured: bool = True
+    # a parameter's interval: False when the items do not depend on it (:func:`unmeasured_params`), as the draws
+    # then repeat the estimate and the interval measures nothing; None for other statistics
+    measured: bool | None = None
 
     def excludes(self, value: float) -> bool:
-        return self.measured and (value < self.low or value > self.high)
+        return self.measured is not False and (value < self.low or value > self.high)
 
     def as_dict(self) -> dict:
-        return {
+        values = {
             "estimate": self.estimate,
             "low": self.low,
             "high": self.high,
             "level": self.level,
             "draws": self.draws,
-            "measured": self.measured,
         }
+        return values if self.measured is None else {**values, "measured": self.measured}
 
 
 def percentile_interval(estimate: float, draws: Sequence[float], level: float = LEVEL) -> Interval:
@@ -345,7 +345,7 @@ def parameter_checks(
     ``joint_null``: the interval of :func:`joint_null_interval`, which passes rule 4 when it excludes 0."""
     reasons, notes = [], []
     for name, value in params.items():
-        if name in intervals and not intervals[name].measured:
+        if name in intervals and intervals[name].measured is False:
             notes.append(
                 f"{name} = {value:.4g} is not measured: the fit items do not depend on it, and the value is where "
                 "the search left it"
@@ -386,7 +386,7 @@ def parameter_checks(
                 "the interval of "
                 + ", ".join(
                     f"{n} ({intervals[n].low:.4g}-{intervals[n].high:.4g})"
-                    if intervals[n].measured
+                    if intervals[n].measured is not False
                     else f"{n} (not measured)"
                     for n in nulls
                     if n in intervals
@@ -436,13 +436,15 @@ def parameter_draws(
     return [problem.fit(fit.effects, resample(items, rng), start=fit).params for _ in range(draws)]
 
 
-def unmeasured_params(problem: Problem, fit: Fit, items: np.ndarray) -> set[str]:
-    """The parameters of ``fit`` the ``items`` do not depend on: no move of ``UNMEASURED_MOVES`` search scales
-    either way (inside the bounds) changes their squared error by ``UNMEASURED_TOLERANCE`` of it. Such a value is
-    wherever the search left it, and every bootstrap refit leaves it there: camsim's laser blinding halo case
-    reported the beam width behind a capture's saturated core as 20 [20, 20] reference pixels for a capture with
-    no saturated pixel (docs/bench/session81.md)."""
-    specs = problem.param_specs(fit.effects)
+def unmeasured_params(
+    problem: Problem, fit: Fit, items: np.ndarray, names: Collection[str] | None = None
+) -> set[str]:
+    """The parameters of ``fit`` (those in ``names``, default all) the ``items`` do not depend on: no move of
+    ``UNMEASURED_MOVES`` search scales either way (inside the bounds) changes their squared error by
+    ``UNMEASURED_TOLERANCE`` of it. Such a value is wherever the search left it, and every bootstrap refit leaves it
+    there: camsim's laser blinding halo case reported the beam width behind a capture's saturated core as 20 [20, 20]
+    reference pixels for a capture with no saturated pixel (docs/bench/session81.md)."""
+    specs = [p for p in problem.param_specs(fit.effects) if names is None or p.name in names]
     if not specs:
         return set()
     total, _ = problem.squared_errors(fit, items)
@@ -470,17 +472,22 @@ def draw_intervals(
     problem: Problem, fit: Fit, items: np.ndarray, samples: Sequence[Mapping[str, float]]
 ) -> dict[str, Interval]:
     """Percentile intervals of every fitted parameter of ``fit`` over bootstrap refits on resamples of ``items``
-    (``parameter_draws``), those of :func:`unmeasured_params` marked as measuring nothing."""
-    unmeasured = unmeasured_params(problem, fit, items)
-    intervals = {
-        k: percentile_interval(fit.params[k], [float(s.get(k, np.nan)) for s in samples]) for k in fit.params
+    (``parameter_draws``). One that no refit moved and :func:`unmeasured_params` finds the items do not depend on is
+    marked as measuring nothing. Both are asked: a prediction flat around the estimate may still be moved by a refit
+    (a locked stripe recording's drift moves the predicted rows only past a step), and a problem's refits may leave
+    a parameter the items do measure where it was (a value found on a grid)."""
+    draws = {k: [float(s.get(k, np.nan)) for s in samples] for k in fit.params}
+    unmoved = [k for k, values in draws.items() if values and all(v == fit.params[k] for v in values)]
+    unmeasured = unmeasured_params(problem, fit, items, unmoved) if unmoved else set()
+    return {
+        k: replace(percentile_interval(fit.params[k], values), measured=k not in unmeasured)
+        for k, values in draws.items()
     }
-    return {k: replace(v, measured=k not in unmeasured) for k, v in intervals.items()}
 
 
 def measured_nulls(nulls: Mapping[str, float], intervals: Mapping[str, Interval]) -> dict[str, float]:
     """The ``nulls`` of parameters whose ``intervals`` measure them (rule 4's joint test reads only those)."""
-    return {k: v for k, v in nulls.items() if intervals[k].measured}
+    return {k: v for k, v in nulls.items() if intervals[k].measured is not False}
 
 
 def parameter_intervals(

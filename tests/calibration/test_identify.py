@@ -645,12 +645,14 @@ def test_a_joint_null_is_judged_only_for_several_nulls_all_at_bounds():
 class GlareWithAnUnseenParameter(MeasuredEverywhere):
     """A glare whose level (null 0) and inner scale follow the items, except those the items do not depend on
     (``ignored``), which every fit leaves at their start, as the fits left the beam width behind a capture with no
-    saturated core (camsim's halo case, master seed 2887441637: 20 [20, 20] reference pixels)."""
+    saturated core (camsim's halo case, master seed 2887441637: 20 [20, 20] reference pixels), unless
+    ``refits_move_them`` (as a refit moves a locked stripe recording's drift past a step its rows see)."""
 
     candidates = (Effect("glare", "scattered light"),)
 
-    def __init__(self, ignored: set[str]) -> None:
+    def __init__(self, ignored: set[str], refits_move_them: bool = False) -> None:
         self.ignored = frozenset(ignored)
+        self.left_at_start = frozenset() if refits_move_them else self.ignored
 
     def param_specs(self, effects):
         if "glare" not in effects:
@@ -664,15 +666,18 @@ class GlareWithAnUnseenParameter(MeasuredEverywhere):
         moved = {"level": 0.5 + 0.001 * float(np.mean(items)), "inner": 3.0 + 0.01 * float(np.mean(items))}
         return Fit(
             effects,
-            {p.name: p.init if p.name in self.ignored else moved[p.name] for p in self.param_specs(effects)},
+            {
+                p.name: p.init if p.name in self.left_at_start else moved[p.name]
+                for p in self.param_specs(effects)
+            },
         )
 
 
 GLARE_STEPS = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["glare"], 1.0, {}, PER_ITEM)]
 
 
-def select_glare(ignored: set[str]):
-    problem, items = GlareWithAnUnseenParameter(ignored), np.arange(20)
+def select_glare(ignored: set[str], refits_move_them: bool = False):
+    problem, items = GlareWithAnUnseenParameter(ignored, refits_move_them), np.arange(20)
     chain = [problem.fit(frozenset(s.effects), items) for s in GLARE_STEPS]
     return problem, identify_selection(
         problem, GLARE_STEPS, chain, items, draws=20, rng=np.random.default_rng(4)
@@ -691,6 +696,15 @@ def test_a_parameter_the_items_do_not_depend_on_is_reported_as_not_measured(tmp_
     text = (tmp_path / "report.md").read_text()
     assert "`inner` = 1 (not measured: the fit items do not depend on it)" in text
     assert "`level` = 0.5" in text and "[0.5" in text
+
+
+def test_a_parameter_a_refit_moves_is_measured_though_the_items_are_flat_around_the_estimate():
+    problem, selection = select_glare({"inner"}, refits_move_them=True)
+    assert unmeasured_params(problem, selection.fit, np.arange(20)) == {"inner"}
+    (result,) = selection.results
+    inner = result["intervals"]["inner"]
+    assert inner["measured"] is True and inner["low"] < inner["high"]
+    assert not any("not measured" in note for note in result["notes"])
 
 
 def test_a_null_parameter_the_items_do_not_depend_on_excludes_nothing():

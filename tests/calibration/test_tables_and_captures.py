@@ -15,6 +15,7 @@ import calibration_testkit as kit
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate, main
 from lerobot_phantom.calibration.core import Fit, fit_least_squares
+from lerobot_phantom.calibration.identify import unmeasured_params
 from lerobot_phantom.calibration.projection import (
     TRIPLE_COLUMNS,
     TripleProblem,
@@ -177,6 +178,28 @@ def test_capture_pixel_samples_follow_the_seed(tmp_path):
     assert not np.array_equal(samples[0], samples[2])
     # a tile drawn twice (a bootstrap draw) counts twice
     assert len(problems[0].pixels(np.array([3, 3]))) == 2 * len(problems[0].pixels(np.array([3])))
+
+
+def test_a_set_of_captures_is_scored_by_the_parameters_it_reports(tmp_path):
+    """Each capture is fitted on its own and the set reports their parameters; its errors come from those reported
+    values, so moving any one moves them (until session 81 they came from copies the report never showed, and
+    every parameter read as one no item depends on)."""
+    from lerobot_phantom.calibration.captures import MultiCapture
+
+    rng = np.random.default_rng(5)
+    ys, xs = np.mgrid[0:48, 0:48]
+    for i, (cx, cy) in enumerate([(20.0, 25.0), (28.0, 18.0)]):
+        spot = np.exp(-0.5 * (np.hypot(xs - cx, ys - cy) / 4.0) ** 2)
+        kit.save(
+            tmp_path / f"laser_{i}.png",
+            kit.srgb_encode(np.array([0.8, 0.1, 0.05]) * spot[..., None] + 0.02),
+            rng,
+        )
+    problem = MultiCapture(tmp_path, max_side=48, seed=0)
+    items = np.arange(problem.n_items)
+    fit = problem.fit(frozenset(), items)
+    assert len(fit.params) == 2 * len(problem.captures[0].param_specs(frozenset()))
+    assert unmeasured_params(problem, fit, items) == set()
 
 
 @pytest.mark.slow
