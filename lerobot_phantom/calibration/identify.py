@@ -32,9 +32,9 @@ The rule (:func:`identify`): an extension is a named cause only if
    bound of their ranges (one drift per recording, each >= 0), it reduces to the model without it only in a draw
    that has every one of them at its null, so the interval of the largest distance from the null among them (a
    share of each range, :func:`joint_null_interval`) excluding 0 suffices: evidence held by few items of each
-   parameter leaves each one at its null in some draws, and the extension in none. A parameter the fit items do not
-   depend on (:func:`unmeasured_params`) excludes nothing: its draws all stay where the search left it, and a null
-   elsewhere would look excluded by an interval of zero width;
+   parameter leaves each one at its null in some draws, and the extension in none. A parameter no refit moved and
+   the fit items do not depend on (:func:`draw_intervals`) excludes nothing: it stays where the search left it, and
+   a null elsewhere would look excluded by an interval of zero width;
 5. the problem's own adequacy checks of the effect's physics pass, where it has any
    (``problem.identification_checks(effect, fit, items) -> [reasons]``; e.g. a stabiliser's motion blur must be one
    path for the whole frame, so a blur that is not a motion of the image is not named a resonance).
@@ -111,8 +111,8 @@ class Interval:
     high: float
     level: float = LEVEL
     draws: int = 0
-    # a parameter's interval: False when the items do not depend on it (:func:`unmeasured_params`), as the draws
-    # then repeat the estimate and the interval measures nothing; None for other statistics
+    # a parameter's interval: False when no draw moved it and the items do not depend on it (:func:`draw_intervals`):
+    # the interval then measures nothing; None for other statistics
     measured: bool | None = None
 
     def excludes(self, value: float) -> bool:

@@ -1,7 +1,8 @@
 """Writing the calibration's outputs: report.json, report.md (+ figures) and calibrated.json.
 
 report.json (intervals are ``{estimate, low, high, level, draws}``: 90% percentile bootstrap over items; a
-parameter's also has ``measured``, false when the fit items do not depend on it, identify.unmeasured_params):
+parameter's also has ``measured``, false when no refit moved it and the fit items do not depend on it,
+identify.draw_intervals):
 
 - ``attack``, ``input`` {path, kind, recording: the facts of the recording the models depend on, each with where
   it was read}, ``units``, ``n_fit``, ``n_heldout``, ``split`` {seed, items};
