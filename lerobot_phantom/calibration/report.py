@@ -203,11 +203,10 @@ def finding(problem: Problem, result: dict, steps: list[Step], base: Fit, extend
             f"; beside the other selected effects, the model without it: ratio {without['estimate']:.3f} "
             f"({without['low']:.3f}-{without['high']:.3f})"
         )
-    if result["intervals"]:
-        evidence += "; " + ", ".join(
-            f"{k} = {v['estimate']:.4g} [{v['low']:.4g}, {v['high']:.4g}]"
-            for k, v in result["intervals"].items()
-        )
+    # a parameter not measured has no interval to quote: its note says so
+    measured = {k: v for k, v in result["intervals"].items() if v.get("measured") is not False}
+    if measured:
+        evidence += "; " + ", ".join(f"{k} = {v['estimate']:.4g} {_interval(v)}" for k, v in measured.items())
     if result.get("notes"):
         evidence += "; " + "; ".join(result["notes"])
     # the base's residual on the fit items; an implied cause has no term of its own to add to the base

@@ -692,6 +692,9 @@ def test_a_parameter_the_items_do_not_depend_on_is_reported_as_not_measured(tmp_
     assert result["intervals"]["inner"]["measured"] is False and result["intervals"]["level"]["measured"]
     assert any(note.startswith("inner = 1 is not measured") for note in result["notes"]), result["notes"]
     report = report_on_twenty_items(problem, selection, GLARE_STEPS)
+    (finding,) = report["findings"]
+    assert "inner = 1 [" not in finding["evidence"] and "inner = 1 is not measured" in finding["evidence"]
+    assert "level = 0.5" in finding["evidence"]
     write_markdown(report, [], tmp_path / "report.md")
     text = (tmp_path / "report.md").read_text()
     assert "`inner` = 1 (not measured: the fit items do not depend on it)" in text
