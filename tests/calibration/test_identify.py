@@ -618,6 +618,32 @@ def test_drifts_each_reaching_their_null_in_some_draws_are_identified_when_no_dr
         assert any("together they leave it" in note for note in result["notes"]), result["notes"]
 
 
+class DriftOfAnUnseenRecording(DriftPerRecording):
+    """As above, but recording b's items do not depend on its drift, which every fit leaves at its start, 0.1."""
+
+    ignored = frozenset({"drift_b"})
+
+    def fit(self, effects, items, start=None) -> Fit:
+        fit = super().fit(effects, items, start)
+        if "drift_b" in fit.params:
+            fit.params["drift_b"] = 0.1
+        return fit
+
+
+def test_a_drift_the_items_do_not_measure_takes_no_part_in_the_joint_null_test():
+    """Drift a reaches its null in some draws; drift b, left at 0.1 by every fit, would keep every draw's largest
+    distance from the null at 0.1 or more and pass the joint test alone. Read as not measured, it is left out of the
+    joint test, which then has one drift and judges nothing: the effect is not identified."""
+    problem, items = DriftOfAnUnseenRecording({"drift_a": (0, 1), "drift_b": (2, 3)}), np.arange(20)
+    steps = [Step([], 2.0, {}, 4.0 * PER_ITEM), Step(["drift"], 1.0, {}, PER_ITEM)]
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(problem, steps, chain, items, draws=100, rng=np.random.default_rng(3))
+    (result,) = selection.results
+    assert result["intervals"]["drift_b"]["measured"] is False and result["intervals"]["drift_a"]["measured"]
+    assert "joint_null" not in result and not result["identified"]
+    assert any("drift_b (not measured)" in r for r in result["reasons"]), result["reasons"]
+
+
 def test_the_refit_without_a_rejected_effect_judges_its_drifts_jointly_too():
     """``refit_reasons`` holds the refit's effects to rule 4 with its own bootstrap draws: drifts that are each at
     their null in some draw, never together, pass; with no draws to judge them jointly they fail."""
