@@ -7,6 +7,7 @@ import os
 
 import numpy as np
 import pytest
+import torch
 from PIL import Image
 
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
@@ -178,6 +179,38 @@ def test_capture_pixel_samples_follow_the_seed(tmp_path):
     assert not np.array_equal(samples[0], samples[2])
     # a tile drawn twice (a bootstrap draw) counts twice
     assert len(problems[0].pixels(np.array([3, 3]))) == 2 * len(problems[0].pixels(np.array([3])))
+
+
+@pytest.mark.parametrize("suffix", [".png", ".tif"])
+def test_a_sixteen_bit_grey_capture_is_read_at_its_own_range(tmp_path, suffix):
+    """A machine-vision camera's 16-bit grey capture reads as the values it stores, in every channel, and resized
+    as their area average (Pillow's RGB conversion clips it at 255 of 65535: every pixel above the darkest 0.4%
+    read white)."""
+    from lerobot_phantom.calibration.captures import CaptureProblem
+
+    ys, xs = np.mgrid[0:40, 0:56]
+    spot = np.exp(-0.5 * (np.hypot(xs - 30.0, ys - 17.0) / 5.0) ** 2)
+    stored = np.round(kit.srgb_encode(3.0 * spot + 0.01 + 0.002 * xs) * 65535) / 65535
+    Image.fromarray((stored * 65535).astype(np.uint16)).save(tmp_path / f"laser{suffix}")
+    halved = stored.reshape(20, 2, 28, 2).mean(axis=(1, 3))
+    for max_side, expected in ((56, stored), (28, halved)):
+        image = CaptureProblem(tmp_path / f"laser{suffix}", max_side=max_side, seed=0).image
+        assert image.shape == (3, *expected.shape)
+        assert torch.equal(image[0], image[1]) and torch.equal(image[0], image[2])
+        assert np.max(np.abs(image[0].numpy() - expected)) < 1e-6
+        assert float(image.max()) == 1.0 and float(image.min()) < 0.2
+
+
+def test_a_capture_of_unstated_range_is_refused_with_the_modes_that_read(tmp_path):
+    Image.fromarray(np.full((8, 8), 0.5, np.float32)).save(tmp_path / "laser.tif")
+    with pytest.raises(
+        ValueError, match=r"laser.tif: a TIFF image of Pillow mode 'F'.*readable modes: .*I;16"
+    ):
+        calibrate(
+            CalibrateConfig(
+                attack="laser_blinding", measured=str(tmp_path / "laser.tif"), out=str(tmp_path / "o")
+            )
+        )
 
 
 def test_a_set_of_captures_is_scored_by_the_parameters_it_reports(tmp_path):

@@ -87,16 +87,36 @@ SENSOR_GAMMA = Effect(
 )
 
 
+SIXTEEN_BIT_GREY_MODES = ("I;16", "I;16B", "I;16L", "I;16N")
+"""Pillow's modes of a 16-bit grey image (a machine-vision camera's PNG or TIFF); a PNG's 32-bit "I" holds one too
+(PNG stores at most 16 bits). ``Image.convert("RGB")`` clips these at 255 of 65535, which would read a dark capture
+as white, so they are scaled by their own range."""
+
+
 def load_rgb(path: Path, size: tuple[int, int] | None = None, max_side: int | None = None) -> torch.Tensor:
-    """An image file -> float64 (3, H, W) in [0, 1] (alpha dropped), resized to ``size`` (W, H) or ``max_side``."""
+    """An image file -> float64 (3, H, W) in [0, 1] (alpha dropped; grey repeated in each channel; 16-bit grey
+    scaled by 65535), resized to ``size`` (W, H) or ``max_side`` (area averaging)."""
     if not path.is_file():
         raise FileNotFoundError(f"image not found: {path}")
-    image = Image.open(path).convert("RGB")
+    with Image.open(path) as opened:
+        if opened.mode in SIXTEEN_BIT_GREY_MODES or (opened.mode == "I" and opened.format == "PNG"):
+            image = Image.fromarray(np.asarray(opened, dtype=np.float32) / 65535.0)
+        elif opened.mode in ("I", "F"):
+            raise ValueError(
+                f"{path}: a {opened.format} image of Pillow mode {opened.mode!r} (32-bit values) has no stated "
+                "range of grey levels; store the capture as 8-bit or 16-bit PNG or TIFF (readable modes: any "
+                f"8-bit mode, {', '.join(SIXTEEN_BIT_GREY_MODES)})"
+            )
+        else:
+            image = opened.convert("RGB")
     if size is None and max_side is not None and max(image.size) > max_side:
         factor = max_side / max(image.size)
         size = (max(1, round(image.size[0] * factor)), max(1, round(image.size[1] * factor)))
     if size is not None and image.size != tuple(size):
         image = image.resize(tuple(size), Image.Resampling.BOX)
+    if image.mode == "F":
+        grey = torch.from_numpy(np.asarray(image, dtype=np.float64))
+        return grey.expand(3, *grey.shape).clone()
     return torch.from_numpy(np.asarray(image, dtype=np.float64) / 255.0).permute(2, 0, 1).contiguous()
 
 
