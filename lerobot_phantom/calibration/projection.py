@@ -318,6 +318,30 @@ def is_triple_table(columns) -> bool:
     return set(TRIPLE_COLUMNS) <= set(columns)
 
 
+def check_grey_levels(table: pd.DataFrame, path: Path) -> None:
+    """A colour-triple table's colours are 8-bit grey levels (SLAP's format): a number in [0, 255] in every cell of
+    ``TRIPLE_COLUMNS``. Colours on a 0-1 scale would read as near black, so they are refused, not read."""
+    colours = table[list(TRIPLE_COLUMNS)].apply(pd.to_numeric, errors="coerce").to_numpy(np.float64)
+    unread = ~np.isfinite(colours)
+    if unread.any():
+        row, column = (int(i[0]) for i in np.nonzero(unread))
+        raise ValueError(
+            f"{path}: colour-triple table has {int(unread.sum())} empty or non-numeric colour cells (first: row "
+            f"{row + 1}, {TRIPLE_COLUMNS[column]}); every cell of {list(TRIPLE_COLUMNS)} must be a grey level 0-255"
+        )
+    low, high = float(colours.min()), float(colours.max())
+    if low < 0.0 or high > 255.0:
+        raise ValueError(
+            f"{path}: colour-triple colours span {low:g}-{high:g}; they must be 8-bit grey levels 0-255 (scale a "
+            "16-bit table by 255/65535)"
+        )
+    if high <= 1.0 and np.any(colours != np.round(colours)):
+        raise ValueError(
+            f"{path}: colour-triple colours span {low:g}-{high:g}, a 0-1 scale; they must be 8-bit grey levels "
+            "0-255 (multiply by 255)"
+        )
+
+
 class ProjectionTerms:
     """Light projection's model terms, shared by colour-triple tables and frame pairs (mixed in before the
     problem class, whose abstract methods these answer)."""
@@ -371,6 +395,7 @@ class TripleProblem(ProjectionTerms, Problem):
             raise ValueError(
                 f"{path}: colour-triple table lacks columns {missing}; needs {list(TRIPLE_COLUMNS)}"
             )
+        check_grey_levels(table, path)
         self.path = path
 
         def block(kind: str) -> torch.Tensor:

@@ -6,6 +6,7 @@ import json
 import os
 
 import numpy as np
+import pandas as pd
 import pytest
 import torch
 from PIL import Image
@@ -285,6 +286,37 @@ def test_input_errors_are_clear(tmp_path):
     (pairs / "pairs.csv").write_text("clean,attacked\na.png,a.png\na.png,a.png\n")
     with pytest.raises(ValueError, match="need a 'pattern' column"):
         calibrate(CalibrateConfig(attack="light_projection", measured=str(pairs), out=str(tmp_path / "o")))
+
+
+def test_colour_triples_off_the_8_bit_scale_are_refused_with_the_scale_that_reads(tmp_path):
+    """Colours on a 0-1 scale read as near black and 16-bit ones as over-white: neither is fitted silently."""
+    rng = np.random.default_rng(3)
+    surface, projected = rng.uniform(0.0, 1.0, (2, 40, 3))
+    write_triple_table(tmp_path / "triples.csv", surface, projected, np.clip(surface + 0.5 * projected, 0, 1))
+    table = pd.read_csv(tmp_path / "triples.csv")
+
+    def refusal(name: str, changed: pd.DataFrame) -> str:
+        changed.to_csv(tmp_path / name, index=False)
+        with pytest.raises(ValueError) as refused:
+            calibrate(
+                CalibrateConfig(
+                    attack="light_projection", measured=str(tmp_path / name), out=str(tmp_path / "o")
+                )
+            )
+        return str(refused.value)
+
+    assert "0-1 scale" in refusal("unit.csv", table.astype(float) / 255)
+    assert "scale a 16-bit table by 255/65535" in refusal("wide.csv", table * 257)
+    blank = table.astype(object)
+    blank.loc[6, "outcome_g"] = ""
+    assert "(first: row 7, outcome_g)" in refusal("blank.csv", blank)
+    assert "must be a grey level 0-255" in refusal("blank.csv", blank)
+    report = calibrate(
+        CalibrateConfig(
+            attack="light_projection", measured=str(tmp_path / "triples.csv"), out=str(tmp_path / "o")
+        )
+    )
+    assert report["extended"]["heldout_rmse"] < report["base"]["heldout_rmse"]
 
 
 def test_calibrated_kwargs_errors(tmp_path):
