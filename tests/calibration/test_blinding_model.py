@@ -42,10 +42,12 @@ def test_glare_level_is_the_glare_at_the_reference_distance(level, exponent):
     assert float(glare[2]) == pytest.approx(level * 4.0**-exponent, rel=0.1)
 
 
-def test_glare_and_tone_shoulder_build_on_linear_light():
+def test_glare_tone_shoulder_and_the_meter_build_on_linear_light():
     requires = {e.name: e.requires for e in BlindingFrames.candidates}
     assert requires["halo_power_law"] == ("linear_light_saturation",)
     assert requires["tone_shoulder"] == ("linear_light_saturation",)
+    # a meter reads light; on the blend it would raise the gain where the opacity darkens the scene
+    assert requires["auto_exposure"] == ("linear_light_saturation",)
     assert requires["linear_light_saturation"] == ()
     # frames' own exposures are an auto-exposing camera's
     assert requires["frame_exposure"] == ("linear_light_saturation", "auto_exposure")

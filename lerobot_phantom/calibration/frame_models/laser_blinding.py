@@ -43,7 +43,9 @@ the curve can stretch the light's scale freely, so the laser's gain is no longer
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
 1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
 ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
-average, as centre-weighted meters do when the spot is central).
+average, as centre-weighted meters do when the spot is central). It builds on ``linear_light_saturation``: a meter
+reacts to light the laser adds, which the paper's blend does not add (its opacity darkens the scene, and a meter
+would answer by raising the gain).
 
 ``frame_exposure`` is the light's ratio to the scene changing from frame to frame. An auto-exposing camera exposes
 each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
@@ -141,6 +143,11 @@ BLINDING_EFFECTS = (
         "auto_exposure",
         "the camera's auto-exposure reacts to the injected light by lowering its gain, darkening the whole scene "
         "as the laser grows stronger",
+        # the meter reads light: on the paper's blend, whose opacity darkens the scene wherever the pattern is dark,
+        # it would raise the gain, and fitted there it stood in for light the library has no form for (a lens
+        # flare's ghost on the blend: named on 7 of 13 draws, on none once it builds on linear light;
+        # docs/bench/session82.md)
+        requires=("linear_light_saturation",),
     ),
     SENSOR_GAMMA,
     Effect(
