@@ -11,7 +11,7 @@ import torch
 
 from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
 from lerobot_phantom.calibration.core import seeded_split
-from lerobot_phantom.calibration.frame_models.light_projection import TONE_POSITION_EXCESS
+from lerobot_phantom.calibration.frame_models.common import TONE_POSITION_EXCESS
 
 
 def drawn_problem(name: str, case_seed: int, folder):
@@ -109,3 +109,36 @@ def test_the_verdict_on_given_halves(tmp_path, monkeypatch, whole, halves, reaso
         assert reasons == []
     else:
         assert len(reasons) == 1 and reason in reasons[0], reasons
+
+
+@pytest.mark.parametrize(
+    ("whole", "halves", "reason"),
+    [
+        # session 82's flare-ghost draws 15 and 12 (docs/bench/session82/blinding_gamma_by_position_b4628c1.txt)
+        (1.189, [1.172, 0.940], "times as far, more than 1.5"),
+        (1.233, [1.175, 1.205], None),
+    ],
+)
+def test_a_laser_blinding_gamma_holds_near_the_spot_and_away_from_it(
+    tmp_path, monkeypatch, whole, halves, reason
+):
+    """The same verdict for laser blinding, its halves split at the laser spot (``BlindingFrames.centre``): a gamma
+    fitted to light the library has no form for (a flare's ghost away from the spot) is not the camera's."""
+    problem, items = drawn_problem("blinding_null", 7, tmp_path)
+    inner, _ = problem.position_halves(items)
+    for rows, i in zip(inner, items, strict=True):
+        pair = problem.pairs[int(i)]
+        x_spot, y_spot = problem.centres[int(i)]
+        near = torch.hypot(
+            (rows % pair.width - x_spot) / pair.width, (rows // pair.width - y_spot) / pair.height
+        )
+        assert float(near.max()) < 0.5  # the half nearest the spot, not the frame's centre
+    monkeypatch.setattr(problem, "gamma_by_position", lambda fit, items: halves)
+    fit = problem.fit(frozenset({"sensor_gamma"}), items)
+    fit.params["gamma"] = whole
+    reasons = problem.identification_checks("sensor_gamma", fit, items)
+    if reason is None:
+        assert reasons == []
+    else:
+        assert len(reasons) == 1 and reason in reasons[0] and "nearest the laser spot" in reasons[0], reasons
+    assert problem.identification_checks("linear_light_saturation", fit, items) == []

@@ -399,10 +399,19 @@ def _pixel_sample(pair: Pair, count: int, rng: np.random.Generator) -> np.ndarra
     return np.sort(rng.choice(n, min(count, n), replace=False))
 
 
+# how much farther from 1 the whole frame's gamma may lie than the mean of the gammas fitted on the pixels nearest the
+# frame's centre and on the rest, each half with its own light: a tone curve acts on every pixel alike, so its gamma
+# is the same in both halves and whole (camsim's planted power-law curves: 0.95-1.11 times), while a projector's
+# falloff, its light weaker towards the frame's edges, bends the whole frame's pooled light where each half's is
+# nearly straight (2.18-3.07 times on six master seeds; docs/bench/session59/gamma_by_position_6seeds.txt)
+TONE_POSITION_EXCESS = 1.5
+
+
 class PixelProblem(FrameProblem):
     """Attacks that act pixel by pixel given per-pixel features; fits use a seeded sample of pixels per pair."""
 
     pixels_per_pair = 800
+    centre_name = "the frame's centre"  # what ``centre`` is, for the reports
 
     def __init__(self, pairs: list[Pair], seed: int) -> None:
         super().__init__(pairs, seed)
@@ -457,6 +466,35 @@ class PixelProblem(FrameProblem):
 
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return None if start is None else start.params
+
+    def gamma_by_position(self, fit: Fit, items: np.ndarray) -> list[float]:
+        """The gamma of ``fit``'s model refitted on ``items``' sampled pixels nearest the frame's centre, and on the
+        rest (``position_halves``), each half with all its own parameters."""
+        return [
+            self.fit_on_pixels(fit.effects, items, rows).params["gamma"]
+            for rows in self.position_halves(items)
+        ]
+
+    def tone_position_checks(self, fit: Fit, items: np.ndarray) -> list[str]:
+        """A camera's tone curve acts on every pixel alike: the written model refitted on the fit pairs' pixels
+        nearest ``centre_name`` (``centre``), and on the rest, must find the gamma the whole frame does, within
+        ``TONE_POSITION_EXCESS`` of the halves' mean departure from 1 and on the same side of it; the reasons it
+        does not (none: it does)."""
+        halves = self.gamma_by_position(fit, items)
+        whole, halves_mean = fit.params["gamma"] - 1.0, float(np.mean(halves)) - 1.0
+        fitted = (
+            f"the gamma fitted on the pixels nearest {self.centre_name} ({halves[0]:.3f}) and on the rest "
+            f"({halves[1]:.3f}), each half with its own light,"
+        )
+        if whole * halves_mean <= 0.0:
+            return [f"{fitted} does not depart from 1 on the side the whole frame's ({1.0 + whole:.3f}) does"]
+        if abs(whole) <= TONE_POSITION_EXCESS * abs(halves_mean):
+            return []
+        return [
+            f"{fitted} departs from 1 by {abs(halves_mean):.3f} on average, the whole frame's ({1.0 + whole:.3f}) "
+            f"{abs(whole / halves_mean):.2f} times as far, more than {TONE_POSITION_EXCESS:g}: a tone curve acts on "
+            "every pixel alike, so the whole frame's bends light that changes across the frame"
+        ]
 
     def position_halves(self, items: np.ndarray) -> tuple[list[torch.Tensor], list[torch.Tensor]]:
         """Each item's sampled pixels nearest its frame's centre and the rest, split at their median distance from

@@ -471,6 +471,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
     score and predict through ``LatentFrameProblem`` for those fits and as a plain ``PixelProblem`` for the rest."""
 
     attack = "laser_blinding"
+    centre_name = "the laser spot"
     base_model = "alpha blend of the scene and the laser pattern (the paper's laser blinding)"
     extended_model = "physical laser injection"
     candidates = BLINDING_EFFECTS
@@ -857,8 +858,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         return {}
 
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
-        """Frames' own exposures are the auto-exposure's: named only where the meter reacts to the laser's light
-        with a power of at least ``MIN_METER_REACTION``, as a camera re-exposing every scene does."""
+        """A gamma is the camera's tone curve only if it holds near the laser spot and away from it
+        (``tone_position_checks``): one that only the pooled frame shows stands for light the library has no form
+        for (a lens flare's ghost on the blend was named ``sensor_gamma`` on 5 of 13 draws, docs/bench/session82.md).
+        Frames' own exposures are the auto-exposure's: named only where the meter reacts to the laser's light with a
+        power of at least ``MIN_METER_REACTION``, as a camera re-exposing every scene does."""
+        if effect == "sensor_gamma":
+            return self.tone_position_checks(fit, items)
         if effect != "frame_exposure" or fit.params["auto_exposure"] >= MIN_METER_REACTION:
             return []
         return [

@@ -34,12 +34,6 @@ from lerobot_phantom.transforms.physics import gaussian_spread
 # the parameters the projected light's decoding depends on, and its spreading
 PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma")
 SPREAD_PARAMS = (*PROJECTED_PARAMS, "spread_ref_px")
-# how much farther from 1 the whole frame's gamma may lie than the mean of the gammas fitted on the pixels nearest the
-# frame's centre and on the rest, each half with its own light: a tone curve acts on every pixel alike, so its gamma
-# is the same in both halves and whole (camsim's planted power-law curves: 0.95-1.11 times), while a projector's
-# falloff, its light weaker towards the frame's edges, bends the whole frame's pooled light where each half's is
-# nearly straight (2.18-3.07 times on six master seeds; docs/bench/session59/gamma_by_position_6seeds.txt)
-TONE_POSITION_EXCESS = 1.5
 # a finite-difference Jacobian moves one parameter at a time, so every column but the light's own repeats the
 # decoded and spread light of the point it is taken at (decoding and spreading took 75 of a 101 s calibration,
 # hidden-effects projection case, docs/bench/session37.md): kept for the point and a step of each light parameter,
@@ -152,34 +146,8 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
 
-    def gamma_by_position(self, fit: Fit, items: np.ndarray) -> list[float]:
-        """The gamma of ``fit``'s model refitted on ``items``' sampled pixels nearest the frame's centre, and on the
-        rest (``position_halves``), each half with all its own parameters."""
-        return [
-            self.fit_on_pixels(fit.effects, items, rows).params["gamma"]
-            for rows in self.position_halves(items)
-        ]
-
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
-        """A camera's tone curve acts on every pixel alike: the written model refitted on the fit pairs' pixels
-        nearest the frame's centre, and on the rest, must find the gamma the whole frame does, within
-        ``TONE_POSITION_EXCESS`` of the halves' mean departure from 1 and on the same side of it. A gamma that only
-        the pooled frame shows stands for light that changes across the frame (a projector's falloff): it is then
-        not named the camera's."""
-        if effect != "sensor_gamma":
-            return []
-        halves = self.gamma_by_position(fit, items)
-        whole, halves_mean = fit.params["gamma"] - 1.0, float(np.mean(halves)) - 1.0
-        fitted = (
-            f"the gamma fitted on the pixels nearest the frame's centre ({halves[0]:.3f}) and on the rest "
-            f"({halves[1]:.3f}), each half with its own light,"
-        )
-        if whole * halves_mean <= 0.0:
-            return [f"{fitted} does not depart from 1 on the side the whole frame's ({1.0 + whole:.3f}) does"]
-        if abs(whole) <= TONE_POSITION_EXCESS * abs(halves_mean):
-            return []
-        return [
-            f"{fitted} departs from 1 by {abs(halves_mean):.3f} on average, the whole frame's ({1.0 + whole:.3f}) "
-            f"{abs(whole / halves_mean):.2f} times as far, more than {TONE_POSITION_EXCESS:g}: a tone curve acts on "
-            "every pixel alike, so the whole frame's bends light that changes across the frame"
-        ]
+        """A gamma is named the camera's tone curve only if it holds at every position (``tone_position_checks``):
+        one that only the pooled frame shows stands for light that changes across the frame (a projector's
+        falloff)."""
+        return self.tone_position_checks(fit, items) if effect == "sensor_gamma" else []
