@@ -101,14 +101,20 @@ def test_a_fit_on_given_pixels_is_the_fit_on_those_pixels_as_the_sample(tmp_path
 )
 def test_the_verdict_on_given_halves(tmp_path, monkeypatch, whole, halves, reason):
     problem, items = drawn_problem("projection_null", 7, tmp_path)
-    monkeypatch.setattr(problem, "gamma_by_position", lambda fit, items: halves)
-    fit = problem.fit(frozenset({"sensor_gamma"}), items)
-    fit.params["gamma"] = whole
-    reasons = problem.identification_checks("sensor_gamma", fit, items)
+    reasons = verdict_on_halves(problem, items, monkeypatch, whole, halves)
     if reason is None:
         assert reasons == []
     else:
         assert len(reasons) == 1 and reason in reasons[0], reasons
+
+
+def verdict_on_halves(problem, items, monkeypatch, whole: float, halves: list[float]) -> list[str]:
+    """The tone-position check's reasons for a gamma of ``whole`` on the frame whose halves gave ``halves``."""
+    monkeypatch.setattr(problem, "gamma_by_position", lambda fit, items: halves)
+    fit = problem.fit(frozenset({"sensor_gamma"}), items)
+    fit.params["gamma"] = whole
+    assert problem.identification_checks("additive_light", fit, items) == []  # the check is the tone curve's
+    return problem.identification_checks("sensor_gamma", fit, items)
 
 
 @pytest.mark.parametrize(
@@ -125,20 +131,20 @@ def test_a_laser_blinding_gamma_holds_near_the_spot_and_away_from_it(
     """The same verdict for laser blinding, its halves split at the laser spot (``BlindingFrames.centre``): a gamma
     fitted to light the library has no form for (a flare's ghost away from the spot) is not the camera's."""
     problem, items = drawn_problem("blinding_null", 7, tmp_path)
-    inner, _ = problem.position_halves(items)
-    for rows, i in zip(inner, items, strict=True):
+    for near, far, i in zip(*problem.position_halves(items), items, strict=True):
         pair = problem.pairs[int(i)]
         x_spot, y_spot = problem.centres[int(i)]
-        near = torch.hypot(
-            (rows % pair.width - x_spot) / pair.width, (rows // pair.width - y_spot) / pair.height
-        )
-        assert float(near.max()) < 0.5  # the half nearest the spot, not the frame's centre
-    monkeypatch.setattr(problem, "gamma_by_position", lambda fit, items: halves)
-    fit = problem.fit(frozenset({"sensor_gamma"}), items)
-    fit.params["gamma"] = whole
-    reasons = problem.identification_checks("sensor_gamma", fit, items)
+
+        def from_spot(rows, pair=pair, x_spot=x_spot, y_spot=y_spot):
+            return torch.hypot(
+                (rows % pair.width - x_spot) / pair.width, (rows // pair.width - y_spot) / pair.height
+            )
+
+        assert float(from_spot(near).max()) <= float(
+            from_spot(far).min()
+        )  # split at the spot, not the frame's centre
+    reasons = verdict_on_halves(problem, items, monkeypatch, whole, halves)
     if reason is None:
         assert reasons == []
     else:
         assert len(reasons) == 1 and reason in reasons[0] and "nearest the laser spot" in reasons[0], reasons
-    assert problem.identification_checks("linear_light_saturation", fit, items) == []
