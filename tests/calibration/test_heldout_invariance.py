@@ -74,9 +74,11 @@ def assert_fits_ignore_the_alteration(
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg")
 N_PAIRS = 7  # two held out
 # one planted effect per attack, so selection and identification have something to decide; the kit's seeds of
-# test_hidden_effects.py, where each is named
+# test_hidden_effects.py, where each is named. Laser blinding's is linear light with its glare, as that test plants
+# it: on the kit's plain capture linear light leaves the core's width at its bound, and since auto_exposure builds
+# on linear light (session 82) selection takes nothing there, where it had taken and withdrawn the meter alone
 ATTACKS = [
-    pytest.param("laser_blinding", {"linear_light_saturation"}, 11, marks=SAMPLED),
+    pytest.param("laser_blinding", {"linear_light_saturation", "halo_power_law"}, 11, marks=SAMPLED),
     pytest.param("light_projection", {"additive_light"}, 21, marks=SAMPLED),
     pytest.param("ultrasound_blur", {"sinusoidal_motion"}, 31, marks=SAMPLED),
     ("em_color_strip", {"bayer_phase_flip"}, 41),
