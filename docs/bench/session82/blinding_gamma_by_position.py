@@ -3,7 +3,9 @@ acts on every pixel alike, so the gamma refitted on the fit pairs' pixels neares
 find the whole frame's) applied to laser blinding reports, the centre being the laser spot's.
 
 Usage: PYTHONPATH=. python docs/bench/session82/blinding_gamma_by_position.py CASE_FOLDER... (each with pairs/ and
-out/report.json, as out_of_library_probe.py writes them)"""
+out/report.json, as out_of_library_probe.py writes them). Its output blinding_gamma_by_position_b4628c1.txt was made
+at b4628c1, where TONE_POSITION_EXCESS lived in frame_models/light_projection.py (imported from there then; the
+package's check, fa6fea5, now holds it in frame_models/common.py)."""
 
 import json
 import sys
