@@ -24,6 +24,7 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.frame_models.common import REFERENCE_SIZE, SENSOR_GAMMA, load_rgb
 from lerobot_phantom.calibration.structure import ResidualSample
+from lerobot_phantom.calibration.tone import GAMMA_PARAM
 from lerobot_phantom.transforms import physics
 
 IMAGE_SUFFIXES = (".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff")
@@ -158,7 +159,7 @@ class CaptureProblem(Problem):
                 Param("halo_scale", sigma, 0.1, 4.0 * size, scale=sigma),
             ]
         if "sensor_gamma" in effects:
-            specs.append(Param("gamma", 2.2, 0.3, 5.0, scale=1.0))
+            specs.append(GAMMA_PARAM)
         return specs
 
     def predict(self, effects, p, pixels: torch.Tensor) -> torch.Tensor:

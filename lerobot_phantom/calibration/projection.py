@@ -43,6 +43,7 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.structure import NeighbourPairs, ResidualSample
 from lerobot_phantom.calibration.tone import (
+    GAMMA_PARAM,
     SHOULDER_PARAMS,
     equivalent_power_gamma,
     implied_gamma_statistic,
@@ -116,6 +117,12 @@ SPREAD_HIGH_REF_PX = 8.0
 
 CROSSTALK_NAMES = tuple(f"crosstalk_{i}{j}" for i in range(3) for j in range(3))
 
+# a sensor's white bounds every frame it records: clean pixels brighter than a fitted white in all three channels,
+# by more than compression and noise move a pixel (grey levels), on more than this share of the clean pixels, say
+# the white is not the sensor's
+WHITE_EXCEEDED_MARGIN = 3.0
+WHITE_EXCEEDED_SHARE = 0.01
+
 # What a recorded projected image is, a fact of the recording that no fit can be left to guess: the frame the
 # projector was sent ("emitted": a display's transfer, its EOTF, turns it into light, whatever the camera's tone curve)
 # or the projector's light captured by this camera, e.g. on a white board in the dark ("captured": the camera's own
@@ -167,7 +174,7 @@ def projection_specs(effects: frozenset[str], pattern_record: str) -> list[Param
     if "clipping" in effects:
         specs.append(Param("white", 0.95, 0.2, 1.0, scale=0.1))
     if "sensor_gamma" in effects:
-        specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+        specs.append(GAMMA_PARAM)
     if "tone_shoulder" in effects:
         specs += list(SHOULDER_PARAMS)
     if "light_spread" in effects:
@@ -373,6 +380,33 @@ class ProjectionTerms:
     def transform_kwargs(self, fit: Fit) -> dict:
         return projection_kwargs(fit)
 
+    def clean_colours(self, items: np.ndarray) -> torch.Tensor:
+        """The unattacked colours (N, 3) in [0, 1] that ``items`` recorded with the same camera."""
+        raise NotImplementedError
+
+    def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
+        """``clipping`` is named the sensor's saturation only if the sensor's own clean frames stay under it: the
+        camera that recorded the attacked frames recorded the clean ones, so no more than
+        ``WHITE_EXCEEDED_SHARE`` of the fit items' clean pixels may exceed the fitted white (encoded by the
+        model's tone curve) in every channel by more than ``WHITE_EXCEEDED_MARGIN`` grey levels. Every channel,
+        because white-balance gains or a colour matrix applied after the raw clip leave one channel's white above
+        another's, but none lifts a pixel's lowest channel over the lowest white. A white below what the camera
+        recorded without the attack stands for something that dims bright attacked pixels (an ISP's white balance
+        answering the projected cast, camsim's ``white_balance``), not for the sensor."""
+        if effect != "clipping":
+            return []
+        _, encode = tone_curve(fit.effects, fit.params)
+        white = 255.0 * float(encode(torch.tensor(fit.params["white"], dtype=torch.float64)))
+        lowest_channel = 255.0 * self.clean_colours(items).min(dim=1).values
+        share = float((lowest_channel > white + WHITE_EXCEEDED_MARGIN).double().mean())
+        if share <= WHITE_EXCEEDED_SHARE:
+            return []
+        return [
+            f"{share:.1%} of the fit items' clean pixels exceed the fitted white ({white:.1f} grey levels) in every "
+            f"channel by more than {WHITE_EXCEEDED_MARGIN:g}, over {WHITE_EXCEEDED_SHARE:.0%}: the sensor that "
+            "recorded them saturates higher, so the clip is not the sensor's"
+        ]
+
 
 class TripleProblem(ProjectionTerms, Problem):
     input_kind = "colour_triples"
@@ -407,6 +441,9 @@ class TripleProblem(ProjectionTerms, Problem):
     @property
     def n_items(self) -> int:
         return len(self.captured)
+
+    def clean_colours(self, items: np.ndarray) -> torch.Tensor:
+        return self.surface[torch.as_tensor(items)]
 
     def predict(self, fit_effects, params, items) -> torch.Tensor:
         index = torch.as_tensor(items)

@@ -42,6 +42,11 @@ SHOULDER_PARAMS = (
     Param("shoulder", 1.0, 0.0, 500.0, scale=3.0),
     Param("shoulder_exponent", 1.0, 0.25, 4.0, scale=0.5),
 )
+# ``sensor_gamma``'s power, decoding pixel values to linear light: every camera's encoding (sRGB, Rec. 709, log and
+# filmic curves) compresses light, so the power is at least 1 (1: a linear camera, no gamma to name); a fit that
+# wants less bends something other than a tone curve (camsim's white balance answering a projected cast fitted
+# 0.657, docs/bench/session83.md). 4 is beyond any encoding in use
+GAMMA_PARAM = Param("gamma", 2.2, 1.0, 4.0, scale=1.0)
 # every parameter a fitted tone curve may have: ``sensor_gamma``'s power and the shoulder's two
 TONE_PARAMS = ("gamma", *(p.name for p in SHOULDER_PARAMS))
 

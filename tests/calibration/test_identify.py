@@ -24,7 +24,7 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
-from lerobot_phantom.calibration.frame_models.ultrasound_blur import BlurFrames
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import ACROSS_SHARE_LIMIT, BlurFrames
 from lerobot_phantom.calibration.identify import (
     RESUMMED_DRAWS,
     Interval,
@@ -418,9 +418,25 @@ def rotation_blur(image: torch.Tensor, max_deg: float, samples: int = 16) -> tor
     return out / samples
 
 
+def disc_blur(image: torch.Tensor, diameter: float, samples: int = 64) -> torch.Tensor:
+    """Mean of ``image`` shifted to points filling a disc of ``diameter`` pixels (a sunflower lattice): a defocus
+    blur, spread over an area in every direction at once."""
+    radius = np.sqrt((np.arange(samples) + 0.5) / samples) * diameter / 2
+    angle = np.arange(samples) * np.pi * (3 - np.sqrt(5))
+    one_tap = torch.zeros(1, dtype=image.dtype)
+    shifted = [
+        physics.line_blur(
+            image[None], torch.tensor(r * np.cos(a)), torch.tensor(r * np.sin(a)), one_tap + 1.0
+        )
+        for r, a in zip(radius, angle, strict=True)
+    ]
+    return torch.cat(shifted).mean(0)
+
+
 def blur_pairs(kind: str, seed: int = 0, n_pairs: int = 6) -> BlurFrames:
     """Textured 48x64 frames blurred by one motion of the whole image (a resonance, the library's own sinusoidal
-    path) or by a rotation about the centre (every part of the frame moves a different way)."""
+    path), by a rotation about the centre (every part of the frame moves a different way) or by a defocus disc
+    (no motion: the image spreads over an area)."""
     generator = torch.Generator().manual_seed(seed)
     pairs = []
     for i in range(n_pairs):
@@ -429,13 +445,15 @@ def blur_pairs(kind: str, seed: int = 0, n_pairs: int = 6) -> BlurFrames:
         if kind == "resonance":
             offsets = physics.blur_path_offsets("sinusoidal", 17, dtype=torch.float64)
             attacked = physics.line_blur(clean[None], torch.tensor(6.0), torch.tensor(3.0), offsets)[0]
-        else:
+        elif kind == "rotation":
             attacked = rotation_blur(clean, max_deg=8.0)
+        else:
+            attacked = disc_blur(clean, diameter=7.0)
         pairs.append(Pair(f"pair{i}", clean, attacked, None, 1.0))
     return BlurFrames(pairs, seed)
 
 
-@pytest.mark.parametrize("kind", ["resonance", "rotation"])
+@pytest.mark.parametrize("kind", ["resonance", "rotation", "defocus"])
 def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame(kind):
     problem = blur_pairs(kind)
     items = np.arange(len(problem.pairs))
@@ -447,8 +465,13 @@ def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame
             4 * np.hypot(6, 3), rel=0.1
         )
         assert reasons == []
+        assert problem.across_share(fit, items) < ACROSS_SHARE_LIMIT / 2
+    elif (
+        kind == "rotation"
+    ):  # every part of the frame moves its own way, which pooled spreads over an area too
+        assert any("is not the whole frame's" in r for r in reasons), reasons
     else:
-        assert reasons and all("not one motion of the image" in r for r in reasons)
+        assert any("it covers an area, not the path of one motion" in r for r in reasons), reasons
     assert problem.identification_checks("sensor_gamma", fit, items) == []
 
 

@@ -110,6 +110,7 @@ from lerobot_phantom.calibration.frame_models.common import (
     parameter_values,
 )
 from lerobot_phantom.calibration.tone import (
+    GAMMA_PARAM,
     SHOULDER_PARAMS,
     TONE_PARAMS,
     decode_encode,
@@ -608,7 +609,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             # weigh several times its area in a centre-weighted meter, hence the range up to 4
             specs.append(Param("auto_exposure", 0.5, 0.0, 4.0, scale=0.5))
         if "sensor_gamma" in effects:
-            specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+            specs.append(GAMMA_PARAM)
         if "tone_shoulder" in effects:
             specs += list(SHOULDER_PARAMS)
         if "colour_correction" in effects:

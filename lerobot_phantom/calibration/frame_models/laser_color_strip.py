@@ -17,6 +17,7 @@ from lerobot_phantom.calibration.frame_models.common import (
     parameter_values,
 )
 from lerobot_phantom.calibration.tone import (
+    GAMMA_PARAM,
     SHOULDER_PARAMS,
     TONE_PARAMS,
     decode_encode,
@@ -109,7 +110,7 @@ class StripFrames(LatentFrameProblem):
         if "stripe_period" in effects:
             specs.append(Param("period_share", 0.5, 0.05, 2.0, scale=0.3))
         if "sensor_gamma" in effects:
-            specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+            specs.append(GAMMA_PARAM)
         if "tone_shoulder" in effects:
             specs += list(SHOULDER_PARAMS)
         return specs

@@ -146,8 +146,13 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
     def warm(self, start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
         return projection_warm(start, effects)
 
+    def clean_colours(self, items: np.ndarray) -> torch.Tensor:
+        return torch.cat([self.pairs[int(i)].clean.flatten(1).T for i in items])
+
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """A gamma is named the camera's tone curve only if it holds at every position (``tone_position_checks``):
         one that only the pooled frame shows stands for light that changes across the frame (a projector's
-        falloff)."""
-        return self.tone_position_checks(fit, items) if effect == "sensor_gamma" else []
+        falloff). A clip must lie above the clean frames (``ProjectionTerms.identification_checks``)."""
+        if effect == "sensor_gamma":
+            return self.tone_position_checks(fit, items)
+        return super().identification_checks(effect, fit, items)

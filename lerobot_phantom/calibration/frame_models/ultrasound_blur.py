@@ -13,6 +13,7 @@ import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
+from lerobot_phantom.calibration.tone import GAMMA_PARAM
 from lerobot_phantom.transforms import physics
 
 PATH_PARAMS = ("dx_ref_px", "dy_ref_px")
@@ -24,6 +25,8 @@ PATH_GRID = [
 ]
 PATH_AGREEMENT_DEG = 20.0  # direction tolerance of a quadrant's path against the whole frame's
 PATH_AGREEMENT_SHARE = 0.3  # length tolerance, as a share of the whole frame's path length
+# the widest spread across a motion's path, as a share of its length, that the path's own sampling explains
+ACROSS_SHARE_LIMIT = 0.5
 
 BLUR_EFFECTS = (
     Effect(
@@ -53,7 +56,7 @@ class BlurFrames(FrameProblem):
             Param("dy_ref_px", 0.0, -64.0, 64.0, scale=4.0),
         ]
         if "sensor_gamma" in effects:
-            specs.append(Param("gamma", 2.2, 0.3, 4.0, scale=1.0))
+            specs.append(GAMMA_PARAM)
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
@@ -149,17 +152,57 @@ class BlurFrames(FrameProblem):
             paths.append(np.array([params["dx_ref_px"], params["dy_ref_px"]]))
         return paths
 
+    def across_share(self, fit: Fit, items: np.ndarray) -> float:
+        """The width of a uniform spread across ``fit``'s path, as a share of the path's length, that best fits the
+        attacked frames of ``items`` when added to the fitted blur (in the same light, every other parameter held)."""
+        length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
+        across = np.array([-fit.params["dy_ref_px"], fit.params["dx_ref_px"]]) / max(length, 1e-9)
+        gamma = fit.params.get("gamma", 1.0)
+        offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
+        with torch.no_grad():
+            along = {
+                int(i): physics.decode(self.predict_pair(fit, int(i)).unsqueeze(0), gamma) for i in items
+            }
+
+        def errors(p):
+            parts = []
+            for i, blurred in along.items():
+                pair = self.pairs[i]
+                width = p["across_share"] * length * pair.intensity / pair.to_reference
+                spread = physics.line_blur(blurred, width * across[0], width * across[1], offsets)
+                parts.append((physics.encode(spread, gamma)[0] - pair.attacked).ravel())
+            return torch.cat(parts)
+
+        # a disc is fitted by a width near its diameter, a motion's sampling by a fraction of that: start from both
+        specs = [Param("across_share", 0.1, 0.0, 1.5, scale=0.1)]
+        return fit_least_squares(
+            specs, errors, starts=[{"across_share": 0.8}], jacobian="2-point", max_nfev=30
+        )["across_share"]
+
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
-        """A stabiliser moves the whole image, so a motion path is one path for the whole frame: the path fitted
-        on each quadrant alone must agree with the whole frame's, within ``PATH_AGREEMENT_DEG`` in direction
-        (modulo 180 degrees for a centred path, which is its own reverse) and ``PATH_AGREEMENT_SHARE`` in length.
-        A blur that is not one motion of the image (a rotation, a lens-dependent smear) fits a resonant path
-        better than the paper's one-way path without being a resonance: it is then not named."""
+        """A stabiliser moves the whole image along one path, so a resonance is named only if the blur is that:
+
+        - one path for the whole frame: the path fitted on each quadrant alone must agree with the whole frame's,
+          within ``PATH_AGREEMENT_DEG`` in direction (modulo 180 degrees for a centred path, which is its own
+          reverse) and ``PATH_AGREEMENT_SHARE`` in length (a rotation or a lens-dependent smear does not);
+        - a path, not an area: across the path the image moves not at all, so the uniform spread across it that
+          best fits the frames on top of the fitted blur (``across_share``) must stay under ``ACROSS_SHARE_LIMIT`` of
+          the path's length. The 17 samples of the path leave gaps that a fraction of that width fills (0.2-0.35 of
+          the length on camsim's resonances, docs/bench/session83.md); a blur spread over an area (a defocus disc,
+          fitted by a width near its diameter) fits a centred path better than the one-way path without being a
+          motion.
+        """
         if effect != "sinusoidal_motion":
             return []
         whole = np.array([fit.params["dx_ref_px"], fit.params["dy_ref_px"]])
         length = float(np.hypot(*whole))
         reasons = []
+        share = self.across_share(fit, items)
+        if share > ACROSS_SHARE_LIMIT:
+            reasons.append(
+                f"the blur spreads across its path ({length:.1f} px) by {share:.2f} of its length, more than "
+                f"{ACROSS_SHARE_LIMIT:g}: it covers an area, not the path of one motion of the image"
+            )
         for name, path in zip(
             ("top left", "top right", "bottom left", "bottom right"),
             self.quadrant_paths(fit, items),
