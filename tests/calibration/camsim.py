@@ -453,6 +453,19 @@ def projected_image(rng: np.random.Generator, height: int, width: int) -> np.nda
     return img
 
 
+def rebalanced(frame: np.ndarray, reference: np.ndarray, strength: float) -> np.ndarray:
+    """``frame`` (HxWx3 in [0, 1]) after a grey-world white balance settled on ``reference`` re-adapts to it: each
+    channel scaled by (its grey-world gain on ``frame`` / on ``reference``) ** ``strength``."""
+    if not strength:
+        return frame
+
+    def gains(image: np.ndarray) -> np.ndarray:
+        means = image.reshape(-1, 3).mean(0)
+        return means.mean() / means
+
+    return np.clip(frame * (gains(frame) / gains(reference)) ** strength, 0.0, 1.0)
+
+
 def light_projection_pairs(
     rng: np.random.Generator,
     cam: Camera,
@@ -464,6 +477,7 @@ def light_projection_pairs(
     falloff: float = 0.0,
     pattern_record: str = "board",
     reflectance_modulated: bool = True,
+    white_balance: float = 0.0,
 ) -> list[FramePair]:
     """Light projection pairs; the pattern is the projector's frame captured on a white board in the dark
     (``pattern_record="board"``) or the frame the projector was sent (``"emitted"``, what SLAP's tables record as
@@ -477,6 +491,9 @@ def light_projection_pairs(
     overlay with transparency t = digital_alpha * intensity in output space (null). ``falloff``: the projected light
     loses this share at the frame corner (projector lens vignetting), which the recorded pattern does not show (the
     board was captured with a different lens-to-board geometry): an effect the library has no name for.
+    ``white_balance``: the ISP's grey-world white balance, settled on the clean scene, re-adapts to the projected
+    light's colour cast: the attacked frame's channels are scaled by the change of grey-world gains from the clean
+    frame to it, to this power (1: full adaptation): an effect the library has no name for.
     ``reflectance_modulated=False`` is a counterfactual for measuring what the reflectance term changes (benches
     only): every surface returns the projector's light as the scene's mean reflectance would."""
     mix = np.eye(3) + crosstalk * rng.uniform(0.5, 1.5, (3, 3)) * (1 - np.eye(3))
@@ -498,12 +515,12 @@ def light_projection_pairs(
             if falloff:
                 t = t * vignette(cam.height, cam.width, falloff)[..., None]
             blend = (1 - t) * quantised(attacked) + t * pattern_u8 / 255.0
-            attacked_u8 = encode(blend, cam)
+            attacked_u8 = encode(rebalanced(blend, clean, white_balance), cam)
         else:
             returned = refl if reflectance_modulated else refl.mean()
             irradiance = refl * light + returned * intensity * power * projector
             attacked, _ = capture(irradiance, cam, rng, exposure=exposure)
-            attacked_u8 = encode(attacked, cam)
+            attacked_u8 = encode(rebalanced(attacked, clean, white_balance), cam)
         record = "emitted" if pattern_record == "emitted" else "captured"
         pairs.append(
             FramePair(
@@ -739,6 +756,13 @@ def uniform_path(length: float, samples: int = 24) -> np.ndarray:
     return (np.arange(samples) + 0.5) / samples * length
 
 
+def disc_offsets(diameter: float, samples: int = 144) -> np.ndarray:
+    """(dy, dx) positions filling a disc of ``diameter`` px uniformly (a sunflower lattice): a defocus PSF."""
+    radius = np.sqrt((np.arange(samples) + 0.5) / samples) * diameter / 2
+    angle = np.arange(samples) * np.pi * (3 - np.sqrt(5))
+    return np.stack([radius * np.sin(angle), radius * np.cos(angle)], axis=1)
+
+
 def rotation_blur(image: np.ndarray, max_angle_rad: float, samples: int = 24) -> np.ndarray:
     h, w = image.shape[:2]
     yy, xx = np.mgrid[0:h, 0:w].astype(float)
@@ -766,7 +790,9 @@ def ultrasound_blur_pairs(
     space: the null), "sinusoidal" (resonance: x(t) = (d / 2) sin(2 pi f t + phi) with 5-9 non-integer cycles per
     exposure and a random phase, integrated in linear irradiance before the sensor, so the dwell time is
     arcsine-weighted toward both ends of the path), "rotation" (the paper's rotational component, 0 .. theta,
-    theta = intensity * Theta, in output space: an effect the library has no name for)."""
+    theta = intensity * Theta, in output space: an effect the library has no name for), "defocus" (the lens out of
+    focus instead of any motion: a uniform disc of diameter d in linear irradiance, ``disc_offsets``: an effect the
+    library has no name for)."""
     direction = rng.uniform(0, np.pi)
     amplitude = amplitude_px if amplitude_px is not None else rng.uniform(8, 14)
     unit = np.array([np.sin(direction), np.cos(direction)])
@@ -788,6 +814,9 @@ def ultrasound_blur_pairs(
                 path_blur(refl * light, shifts[:, None] * unit), cam, rng, exposure=exposure
             )
             attacked = quantised(attacked)
+        elif path == "defocus":
+            attacked, _ = capture(path_blur(refl * light, disc_offsets(d)), cam, rng, exposure=exposure)
+            attacked = quantised(attacked)
         else:
             attacked, _ = capture(refl * light, cam, rng, exposure=exposure)
             attacked = quantised(attacked)
@@ -796,7 +825,7 @@ def ultrasound_blur_pairs(
             elif path == "rotation":
                 attacked = rotation_blur(attacked, np.deg2rad(intensity * amplitude))
             else:
-                raise ValueError(f"path {path!r}; valid: linear, sinusoidal, rotation")
+                raise ValueError(f"path {path!r}; valid: defocus, linear, rotation, sinusoidal")
         pairs.append(FramePair(encode(clean, cam), encode(attacked, cam), float(intensity)))
     return pairs
 

@@ -4,31 +4,15 @@ calibration named ``sensor_gamma`` (docs/bench/session60.md)."""
 
 from __future__ import annotations
 
-import camsim as cs
 import pytest
 import test_independent_sim as sim
 import torch
 
-from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
-from lerobot_phantom.calibration.core import seeded_split
 from lerobot_phantom.calibration.frame_models.common import TONE_POSITION_EXCESS
 
 
-def drawn_problem(name: str, case_seed: int, folder):
-    """The case's frames at ``case_seed``, read as the calibration CLI reads them, and its fit pairs."""
-    case = sim.CASE_BY_NAME[name]
-    _, rng, camera = sim.case_camera(case, case_seed)
-    cs.write_pairs(folder, case.render(rng, camera))
-    cfg = CalibrateConfig(
-        attack=case.attack, measured=str(folder), out=str(folder / "out"), seed=case_seed % 2**31
-    )
-    problem = build_problem(cfg)
-    fit_items, _ = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
-    return problem, fit_items
-
-
 def test_position_halves_split_each_pairs_sample_at_its_median_distance_from_the_centre(tmp_path):
-    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    problem, items = sim.drawn_problem("projection_null", 7, tmp_path)
     inner, outer = problem.position_halves(items)
     for i, near, far in zip(items, inner, outer, strict=True):
         pair = problem.pairs[int(i)]
@@ -61,7 +45,7 @@ def test_position_halves_split_each_pairs_sample_at_its_median_distance_from_the
 def test_a_gamma_is_the_cameras_only_if_both_position_halves_find_it(
     tmp_path, name, case_seed, effects, named
 ):
-    problem, items = drawn_problem(name, case_seed, tmp_path)
+    problem, items = sim.drawn_problem(name, case_seed, tmp_path)
     fit = problem.fit(frozenset(effects), items)
     assert abs(fit.params["gamma"] - 1.0) > 0.1  # the pooled frame does show a gamma
     reasons = problem.identification_checks("sensor_gamma", fit, items)
@@ -79,7 +63,7 @@ def test_a_gamma_is_the_cameras_only_if_both_position_halves_find_it(
 
 
 def test_a_fit_on_given_pixels_is_the_fit_on_those_pixels_as_the_sample(tmp_path):
-    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    problem, items = sim.drawn_problem("projection_null", 7, tmp_path)
     inner, _ = problem.position_halves(items)
     whole = problem.fit(frozenset(), items)
     on_inner = problem.fit_on_pixels(frozenset(), items, inner)
@@ -100,7 +84,7 @@ def test_a_fit_on_given_pixels_is_the_fit_on_those_pixels_as_the_sample(tmp_path
     ],
 )
 def test_the_verdict_on_given_halves(tmp_path, monkeypatch, whole, halves, reason):
-    problem, items = drawn_problem("projection_null", 7, tmp_path)
+    problem, items = sim.drawn_problem("projection_null", 7, tmp_path)
     reasons = verdict_on_halves(problem, items, monkeypatch, whole, halves)
     if reason is None:
         assert reasons == []
@@ -130,7 +114,7 @@ def test_a_laser_blinding_gamma_holds_near_the_spot_and_away_from_it(
 ):
     """The same verdict for laser blinding, its halves split at the laser spot (``BlindingFrames.centre``): a gamma
     fitted to light the library has no form for (a flare's ghost away from the spot) is not the camera's."""
-    problem, items = drawn_problem("blinding_null", 7, tmp_path)
+    problem, items = sim.drawn_problem("blinding_null", 7, tmp_path)
     for near, far, i in zip(*problem.position_halves(items), items, strict=True):
         pair = problem.pairs[int(i)]
         x_spot, y_spot = problem.centres[int(i)]
@@ -148,3 +132,14 @@ def test_a_laser_blinding_gamma_holds_near_the_spot_and_away_from_it(
         assert reasons == []
     else:
         assert len(reasons) == 1 and reason in reasons[0] and "nearest the laser spot" in reasons[0], reasons
+
+
+def test_a_gamma_below_one_is_no_cameras(tmp_path):
+    """Every camera's encoding compresses light, so a fitted decoding power stops at 1 (``tone.GAMMA_PARAM``), where
+    selection sets it aside as a parameter at its bound: session 82's white balance draw (master seed 4157647104),
+    which named ``sensor_gamma`` at 0.657 beside a blend, fits none below 1."""
+    problem, items = sim.drawn_problem("projection_white_balance_unnamed", 3383599337, tmp_path)
+    (spec,) = [p for p in problem.param_specs(frozenset({"sensor_gamma"})) if p.name == "gamma"]
+    assert spec.low == 1.0
+    fit = problem.fit(frozenset({"sensor_gamma"}), items)
+    assert fit.params["gamma"] == pytest.approx(1.0, abs=1e-6)  # the fit runs to the bound
