@@ -187,10 +187,10 @@ class BlurFrames(FrameProblem):
           reverse) and ``PATH_AGREEMENT_SHARE`` in length (a rotation or a lens-dependent smear does not);
         - a path, not an area: across the path the image moves not at all, so the uniform spread across it that
           best fits the frames on top of the fitted blur (``across_share``) must stay under ``ACROSS_SHARE_LIMIT`` of
-          the path's length. The 17 samples of the path leave gaps that a fraction of that width fills (0.2-0.35 of
-          the length on camsim's resonances, docs/bench/session83.md); a blur spread over an area (a defocus disc,
-          fitted by a width near its diameter) fits a centred path better than the one-way path without being a
-          motion.
+          the path's length. The 17 samples of the path leave gaps that a fraction of that width fills (0.05-0.27
+          of the length on six draws of camsim's resonance); a blur spread over an area fits a centred path better
+          than the one-way path without being a motion (a defocus disc: 0.81-0.87; camsim's rotation: 0.64-1.07;
+          docs/bench/session83/across_share_faa5520.txt).
         """
         if effect != "sinusoidal_motion":
             return []

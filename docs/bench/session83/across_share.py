@@ -1,0 +1,46 @@
+"""How far a blur spreads across its fitted path (``BlurFrames.across_share``, the rule that a resonance is a path):
+per camsim blur case and master seed, the case's frames are rendered as the test renders them, the resonance
+(``sinusoidal_motion``, alone and with ``sensor_gamma``) is fitted on the calibration's fit pairs, and the share of
+the path's length that a uniform spread across it takes is printed.
+
+Usage: ``PYTHONPATH=. python docs/bench/session83/across_share.py CASE[,CASE...] SEED...``
+"""
+
+from __future__ import annotations
+
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from camsim_case_cameras import case_draws
+
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import ACROSS_SHARE_LIMIT
+
+MODELS = (frozenset({"sinusoidal_motion"}), frozenset({"sinusoidal_motion", "sensor_gamma"}))
+
+
+def main() -> None:
+    cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
+    print(f"limit {ACROSS_SHARE_LIMIT}")
+    for name in cases:
+        for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
+            with tempfile.TemporaryDirectory() as folder:
+                problem, items = sim.drawn_problem(name, case_seed, Path(folder))
+                for effects in MODELS:
+                    fit = problem.fit(effects, items)
+                    began = time.perf_counter()
+                    share = problem.across_share(fit, items)
+                    length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
+                    print(
+                        f"{name} master {master} {'+'.join(sorted(effects))}: path {length:.1f} px, across "
+                        f"{share:.3f} of it ({time.perf_counter() - began:.2f} s)",
+                        flush=True,
+                    )
+
+
+if __name__ == "__main__":
+    main()
