@@ -23,6 +23,20 @@ from lerobot_phantom.calibration.frame_models.ultrasound_blur import ACROSS_SHAR
 MODELS = (frozenset({"sinusoidal_motion"}), frozenset({"sinusoidal_motion", "sensor_gamma"}))
 
 
+def print_shares(label: str, problem, items) -> None:
+    """Fit each of ``MODELS`` on ``items`` and print its path's length and the spread across it."""
+    for effects in MODELS:
+        fit = problem.fit(effects, items)
+        began = time.perf_counter()
+        share = problem.across_share(fit, items)
+        length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
+        print(
+            f"{label} {'+'.join(sorted(effects))}: path {length:.1f} px, across {share:.3f} of it "
+            f"({time.perf_counter() - began:.2f} s)",
+            flush=True,
+        )
+
+
 def main() -> None:
     cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
     print(f"limit {ACROSS_SHARE_LIMIT}")
@@ -30,16 +44,7 @@ def main() -> None:
         for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
             with tempfile.TemporaryDirectory() as folder:
                 problem, items = sim.drawn_problem(name, case_seed, Path(folder))
-                for effects in MODELS:
-                    fit = problem.fit(effects, items)
-                    began = time.perf_counter()
-                    share = problem.across_share(fit, items)
-                    length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
-                    print(
-                        f"{name} master {master} {'+'.join(sorted(effects))}: path {length:.1f} px, across "
-                        f"{share:.3f} of it ({time.perf_counter() - began:.2f} s)",
-                        flush=True,
-                    )
+                print_shares(f"{name} master {master}", problem, items)
 
 
 if __name__ == "__main__":
