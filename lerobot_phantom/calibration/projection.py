@@ -384,6 +384,14 @@ class ProjectionTerms:
         """The unattacked colours (N, 3) in [0, 1] that ``items`` recorded with the same camera."""
         raise NotImplementedError
 
+    def white_exceeded(self, fit: Fit, items: np.ndarray) -> tuple[float, float]:
+        """``fit``'s white in grey levels (encoded by its tone curve) and the share of ``items``' clean pixels above
+        it in every channel by more than ``WHITE_EXCEEDED_MARGIN``."""
+        _, encode = tone_curve(fit.effects, fit.params)
+        white = 255.0 * float(encode(torch.tensor(fit.params["white"], dtype=torch.float64)))
+        lowest_channel = 255.0 * self.clean_colours(items).min(dim=1).values
+        return white, float((lowest_channel > white + WHITE_EXCEEDED_MARGIN).double().mean())
+
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """``clipping`` is named the sensor's saturation only if the sensor's own clean frames stay under it: the
         camera that recorded the attacked frames recorded the clean ones, so no more than
@@ -395,10 +403,7 @@ class ProjectionTerms:
         answering the projected cast, camsim's ``white_balance``), not for the sensor."""
         if effect != "clipping":
             return []
-        _, encode = tone_curve(fit.effects, fit.params)
-        white = 255.0 * float(encode(torch.tensor(fit.params["white"], dtype=torch.float64)))
-        lowest_channel = 255.0 * self.clean_colours(items).min(dim=1).values
-        share = float((lowest_channel > white + WHITE_EXCEEDED_MARGIN).double().mean())
+        white, share = self.white_exceeded(fit, items)
         if share <= WHITE_EXCEEDED_SHARE:
             return []
         return [

@@ -34,9 +34,11 @@ def test_a_clip_is_the_sensors_only_if_its_clean_frames_stay_under_it(
     fit = problem.fit(frozenset(effects), items)
     assert fit.params["white"] < 0.95  # both fits do clip below the file's white
     reasons = problem.identification_checks("clipping", fit, items)
+    white, share = problem.white_exceeded(fit, items)
     # neither model has a tone curve: the fitted white is in grey levels as it stands
+    assert white == pytest.approx(255.0 * fit.params["white"])
     lowest_channel = 255.0 * problem.clean_colours(items).min(dim=1).values
-    share = float((lowest_channel > 255.0 * fit.params["white"] + WHITE_EXCEEDED_MARGIN).double().mean())
+    assert share == float((lowest_channel > white + WHITE_EXCEEDED_MARGIN).double().mean())
     # the check's verdict is the stated rule on the share it reports
     assert (reasons == []) == (share <= WHITE_EXCEEDED_SHARE)
     if sensors:
