@@ -153,3 +153,33 @@ def test_the_paper_blur_path_spreads_as_a_constant_speed_path():
     assert abs(path.mean() - 5.0) < 1e-12
     assert abs(path.std() / (10.0 / np.sqrt(12.0)) - 1.0) < 1e-3
     assert path.min() > 0.0 and path.max() < 10.0
+
+
+def test_a_defocus_disc_fills_its_diameter_evenly():
+    # a uniform disc of diameter d: centred, inside radius d / 2, half its points within d / (2 sqrt 2) (half the area)
+    points = cs.disc_offsets(10.0)
+    radius = np.hypot(points[:, 0], points[:, 1])
+    assert np.abs(points.mean(0)).max() < 0.1
+    assert radius.max() <= 5.0
+    assert np.mean(radius <= 5.0 / np.sqrt(2)) == pytest.approx(0.5, abs=0.02)
+
+
+def test_white_balance_takes_back_the_cast_a_frame_gained_over_its_reference():
+    rng = np.random.default_rng(1)
+    reference = rng.uniform(0.2, 0.6, (16, 16, 3))
+    cast = reference * np.array([1.3, 1.0, 0.8])  # the projected light's colour on the whole frame
+    assert np.array_equal(cs.rebalanced(cast, reference, 0.0), cast)
+    assert np.allclose(cs.rebalanced(reference, reference, 1.0), reference)
+
+    def channel_ratios(image):
+        means = image.reshape(-1, 3).mean(0)
+        return means / means[1]
+
+    full, half = cs.rebalanced(cast, reference, 1.0), cs.rebalanced(cast, reference, 0.5)
+    assert np.allclose(
+        channel_ratios(full), channel_ratios(reference)
+    )  # full adaptation: the reference's balance
+    # half adaptation: each channel's cast halved in the log
+    assert np.allclose(
+        channel_ratios(half), channel_ratios(reference) * np.sqrt(np.array([1.3, 1.0, 0.8])), rtol=1e-6
+    )
