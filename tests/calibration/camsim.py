@@ -792,7 +792,9 @@ def ultrasound_blur_pairs(
     arcsine-weighted toward both ends of the path), "rotation" (the paper's rotational component, 0 .. theta,
     theta = intensity * Theta, in output space: an effect the library has no name for), "defocus" (the lens out of
     focus instead of any motion: a uniform disc of diameter d in linear irradiance, ``disc_offsets``: an effect the
-    library has no name for)."""
+    library has no name for), "triangle" (the resonance's centred path swept at constant speed, a triangle wave of
+    as many cycles, in linear irradiance: the dwell time is uniform, not arcsine: an effect the library has no name
+    for)."""
     direction = rng.uniform(0, np.pi)
     amplitude = amplitude_px if amplitude_px is not None else rng.uniform(8, 14)
     unit = np.array([np.sin(direction), np.cos(direction)])
@@ -814,6 +816,13 @@ def ultrasound_blur_pairs(
                 path_blur(refl * light, shifts[:, None] * unit), cam, rng, exposure=exposure
             )
             attacked = quantised(attacked)
+        elif path == "triangle":
+            t = (np.arange(64) + 0.5) / 64
+            shifts = d * (2 * np.abs((cycles * t + rng.uniform(0, 1)) % 1.0 - 0.5) - 0.5)
+            attacked, _ = capture(
+                path_blur(refl * light, shifts[:, None] * unit), cam, rng, exposure=exposure
+            )
+            attacked = quantised(attacked)
         elif path == "defocus":
             attacked, _ = capture(path_blur(refl * light, disc_offsets(d)), cam, rng, exposure=exposure)
             attacked = quantised(attacked)
@@ -825,7 +834,7 @@ def ultrasound_blur_pairs(
             elif path == "rotation":
                 attacked = rotation_blur(attacked, np.deg2rad(intensity * amplitude))
             else:
-                raise ValueError(f"path {path!r}; valid: defocus, linear, rotation, sinusoidal")
+                raise ValueError(f"path {path!r}; valid: defocus, linear, rotation, sinusoidal, triangle")
         pairs.append(FramePair(encode(clean, cam), encode(attacked, cam), float(intensity)))
     return pairs
 

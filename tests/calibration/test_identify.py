@@ -435,15 +435,16 @@ def disc_blur(image: torch.Tensor, diameter: float, samples: int = 64) -> torch.
 
 def blur_pairs(kind: str, seed: int = 0, n_pairs: int = 6) -> BlurFrames:
     """Textured 48x64 frames blurred by one motion of the whole image (a resonance, the library's own sinusoidal
-    path), by a rotation about the centre (every part of the frame moves a different way) or by a defocus disc
-    (no motion: the image spreads over an area)."""
+    path, or a triangle wave: the same centred path swept at constant speed), by a rotation about the centre (every
+    part of the frame moves a different way) or by a defocus disc (no motion: the image spreads over an area)."""
     generator = torch.Generator().manual_seed(seed)
     pairs = []
     for i in range(n_pairs):
         blocks = torch.rand(3, 12, 16, generator=generator, dtype=torch.float64)
         clean = blocks.repeat_interleave(4, 1).repeat_interleave(4, 2).contiguous()
-        if kind == "resonance":
-            offsets = physics.blur_path_offsets("sinusoidal", 17, dtype=torch.float64)
+        if kind in ("resonance", "triangle"):
+            dwell = "sinusoidal" if kind == "resonance" else "uniform"
+            offsets = physics.blur_path_offsets(dwell, 17, dtype=torch.float64)
             attacked = physics.line_blur(clean[None], torch.tensor(6.0), torch.tensor(3.0), offsets)[0]
         elif kind == "rotation":
             attacked = rotation_blur(clean, max_deg=8.0)
@@ -453,8 +454,8 @@ def blur_pairs(kind: str, seed: int = 0, n_pairs: int = 6) -> BlurFrames:
     return BlurFrames(pairs, seed)
 
 
-@pytest.mark.parametrize("kind", ["resonance", "rotation", "defocus"])
-def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame(kind):
+@pytest.mark.parametrize("kind", ["resonance", "triangle", "rotation", "defocus"])
+def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame_that_turns(kind):
     problem = blur_pairs(kind)
     items = np.arange(len(problem.pairs))
     fit = problem.fit(frozenset({"sinusoidal_motion"}), items)
@@ -466,6 +467,9 @@ def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame
         )
         assert reasons == []
         assert problem.across_share(fit, items) < ACROSS_SHARE_LIMIT / 2
+        assert problem.dwell_share(fit, items) > 0.9
+    elif kind == "triangle":  # one motion along one path, but at constant speed
+        assert len(reasons) == 1 and "dwells uniformly along its path" in reasons[0], reasons
     elif (
         kind == "rotation"
     ):  # every part of the frame moves its own way, which pooled spreads over an area too

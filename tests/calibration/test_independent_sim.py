@@ -383,6 +383,15 @@ CASES = [
             rng, cam, N_PAIRS, digital_alpha=rng.uniform(0.3, 0.6), white_balance=rng.uniform(0.5, 1.0)
         ),
     ),
+    # a path swept at constant speed about the rest position (a triangle wave) where a resonance slows to turn at
+    # both ends: the library's centred path is a sinusoid's (docs/bench/session84.md)
+    Case(
+        "blur_triangle_unnamed",
+        "ultrasound_blur",
+        "unexplained",
+        lambda rng, cam: cs.ultrasound_blur_pairs(rng, cam, N_PAIRS, path="triangle"),
+        tolerated=LINEAR_LIGHT,
+    ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
 # the cases CAMSIM_CASES=core runs: every named frame-pair effect of the library, all six nulls and two unnamed

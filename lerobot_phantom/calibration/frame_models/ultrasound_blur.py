@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
+from lerobot_phantom.calibration.core import Effect, Fit, Param, at_bound, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
 from lerobot_phantom.calibration.tone import GAMMA_PARAM
 from lerobot_phantom.transforms import physics
@@ -63,12 +63,17 @@ class BlurFrames(FrameProblem):
         return {"gamma": 1.0} if effect == "sensor_gamma" else {}  # the base blurs the encoded values
 
     def blur(self, effects, params, index: int) -> torch.Tensor:
-        pair = self.pairs[index]
         if "sinusoidal_motion" in effects:
             offsets = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
         else:  # the paper's one-way path: offsets in [0, 1] of the displacement
             offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64) + 0.5
         gamma = params.get("gamma") if "sensor_gamma" in effects else 1.0
+        return self.path_blur(params, index, offsets, gamma)
+
+    def path_blur(self, params, index: int, offsets: torch.Tensor, gamma) -> torch.Tensor:
+        """Pair ``index``'s clean frame averaged, in the light of ``gamma``, over ``offsets`` (shares of the
+        displacement ``params`` gives at the reference scale)."""
+        pair = self.pairs[index]
         x = physics.decode(pair.clean.unsqueeze(0), gamma)
         scale = pair.intensity / pair.to_reference
         dx = torch.as_tensor(params["dx_ref_px"] * scale, dtype=torch.float64)
@@ -179,6 +184,34 @@ class BlurFrames(FrameProblem):
             specs, errors, starts=[{"across_share": 0.8}], jacobian="2-point", max_nfev=30
         )["across_share"]
 
+    def dwell_share(self, fit: Fit, items: np.ndarray) -> float:
+        """Where between a constant-speed sweep (0: uniform dwell) and a sinusoid (1: arcsine dwell) the centred
+        path's samples best fit the attacked frames of ``items``: each sample's position interpolated between the
+        two, the path's displacement refitted with it, every other parameter held at ``fit``'s values."""
+        uniform = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
+        arcsine = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
+        gamma = fit.params.get("gamma", 1.0)
+
+        def errors(p):
+            offsets = (1 - p["dwell_share"]) * uniform + p["dwell_share"] * arcsine
+            return torch.cat(
+                [
+                    (self.path_blur(p, int(i), offsets, gamma) - self.pairs[int(i)].attacked).ravel()
+                    for i in items
+                ]
+            )
+
+        path = {name: fit.params[name] for name in PATH_PARAMS}
+        specs = [Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1), *self.param_specs(frozenset())]
+        return fit_least_squares(
+            specs,
+            errors,
+            warm={"dwell_share": 1.0, **path},
+            starts=[{"dwell_share": 0.0, **path}],
+            jacobian="2-point",
+            max_nfev=30,
+        )["dwell_share"]
+
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """A stabiliser moves the whole image along one path, so a resonance is named only if the blur is that:
 
@@ -190,7 +223,12 @@ class BlurFrames(FrameProblem):
           the path's length. The 17 samples of the path leave gaps that a fraction of that width fills (0.05-0.27
           of the length on six draws of camsim's resonance); a blur spread over an area fits a centred path better
           than the one-way path without being a motion (a defocus disc: 0.81-0.87; camsim's rotation: 0.64-1.07;
-          docs/bench/session83/across_share_faa5520.txt).
+          docs/bench/session83/across_share_faa5520.txt);
+        - a resonance turns: a sinusoid slows to a stop at both ends of its path, so its samples crowd there. Between
+          a constant-speed sweep's uniform dwell (0) and the arcsine (1), the dwell that best fits the frames
+          (``dwell_share``) must not sit at the uniform bound. A resonance of a non-integer number of cycles dwells
+          partly uniformly (camsim's: 0.13-1.00 on 13 draws), a centred triangle wave, a path swept at constant
+          speed, does not turn (0.00-0.08 on 11; docs/bench/session84/dwell_share.txt).
         """
         if effect != "sinusoidal_motion":
             return []
@@ -202,6 +240,13 @@ class BlurFrames(FrameProblem):
             reasons.append(
                 f"the blur spreads across its path ({length:.1f} px) by {share:.2f} of its length, more than "
                 f"{ACROSS_SHARE_LIMIT:g}: it covers an area, not the path of one motion of the image"
+            )
+        dwell = self.dwell_share(fit, items)
+        if at_bound(dwell, 0.0, 1.0) == "low":
+            reasons.append(
+                f"the image dwells uniformly along its path (the best-fitting dwell is {dwell:.3f} of the way from a "
+                "constant-speed sweep to a sinusoid's arcsine): it does not slow to turn at the path's ends as a "
+                "resonance does"
             )
         for name, path in zip(
             ("top left", "top right", "bottom left", "bottom right"),
