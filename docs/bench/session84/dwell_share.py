@@ -1,7 +1,7 @@
 """Where a blur's dwell lies between a constant-speed sweep and a sinusoid (``BlurFrames.dwell_share``, the rule that
 a resonance turns): per camsim blur case and master seed, the case's frames are rendered as the test renders them,
 the resonance (``sinusoidal_motion``, alone and with ``sensor_gamma``) is fitted on the calibration's fit pairs, and
-the dwell share that best fits them (0 uniform, 1 arcsine) is printed with the rule's verdict.
+the dwell share that best fits them (0 uniform, 1 arcsine) is printed with the rule's verdict (``DWELL_SHARE_FLOOR``).
 
 Usage: ``PYTHONPATH=. python docs/bench/session84/dwell_share.py CASE[,CASE...] SEED...``
 """
@@ -18,7 +18,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from camsim_case_cameras import case_draws
 
-from lerobot_phantom.calibration.core import at_bound
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import DWELL_SHARE_FLOOR
 
 MODELS = (frozenset({"sinusoidal_motion"}), frozenset({"sinusoidal_motion", "sensor_gamma"}))
 
@@ -30,7 +30,7 @@ def print_dwell(label: str, problem, items) -> None:
         began = time.perf_counter()
         share = problem.dwell_share(fit, items)
         length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
-        verdict = "uniform: withdrawn" if at_bound(share, 0.0, 1.0) == "low" else "turns"
+        verdict = "withdrawn" if share < DWELL_SHARE_FLOOR else "turns"
         print(
             f"{label} {'+'.join(sorted(effects))}: path {length:.1f} px, dwell {share:.3f} ({verdict}) "
             f"({time.perf_counter() - began:.2f} s)",
@@ -40,6 +40,7 @@ def print_dwell(label: str, problem, items) -> None:
 
 def main() -> None:
     cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
+    print(f"floor {DWELL_SHARE_FLOOR}")
     for name in cases:
         for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
             with tempfile.TemporaryDirectory() as folder:

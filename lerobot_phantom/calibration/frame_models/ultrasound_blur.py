@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 import torch
 
-from lerobot_phantom.calibration.core import Effect, Fit, Param, at_bound, fit_least_squares
+from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
 from lerobot_phantom.calibration.tone import GAMMA_PARAM
 from lerobot_phantom.transforms import physics
@@ -27,6 +27,8 @@ PATH_AGREEMENT_DEG = 20.0  # direction tolerance of a quadrant's path against th
 PATH_AGREEMENT_SHARE = 0.3  # length tolerance, as a share of the whole frame's path length
 # the widest spread across a motion's path, as a share of its length, that the path's own sampling explains
 ACROSS_SHARE_LIMIT = 0.5
+# the least share of the way from a uniform dwell to the arcsine that a resonance's path must fit
+DWELL_SHARE_FLOOR = 0.1
 
 BLUR_EFFECTS = (
     Effect(
@@ -226,9 +228,9 @@ class BlurFrames(FrameProblem):
           docs/bench/session83/across_share_faa5520.txt);
         - a resonance turns: a sinusoid slows to a stop at both ends of its path, so its samples crowd there. Between
           a constant-speed sweep's uniform dwell (0) and the arcsine (1), the dwell that best fits the frames
-          (``dwell_share``) must not sit at the uniform bound. A resonance of a non-integer number of cycles dwells
-          partly uniformly (camsim's: 0.13-1.00 on 13 draws), a centred triangle wave, a path swept at constant
-          speed, does not turn (0.00-0.08 on 11; docs/bench/session84/dwell_share.txt).
+          (``dwell_share``) must reach ``DWELL_SHARE_FLOOR``. A resonance of a non-integer number of cycles fits a
+          partly uniform dwell (camsim's: 0.13-1.00 over 28 fits on 14 draws); a centred triangle wave, the same path
+          swept at constant speed, does not turn (0.00-0.06 over 28 fits; docs/bench/session84/dwell_share.txt).
         """
         if effect != "sinusoidal_motion":
             return []
@@ -242,11 +244,11 @@ class BlurFrames(FrameProblem):
                 f"{ACROSS_SHARE_LIMIT:g}: it covers an area, not the path of one motion of the image"
             )
         dwell = self.dwell_share(fit, items)
-        if at_bound(dwell, 0.0, 1.0) == "low":
+        if dwell < DWELL_SHARE_FLOOR:
             reasons.append(
                 f"the image dwells uniformly along its path (the best-fitting dwell is {dwell:.3f} of the way from a "
-                "constant-speed sweep to a sinusoid's arcsine): it does not slow to turn at the path's ends as a "
-                "resonance does"
+                f"constant-speed sweep to a sinusoid's arcsine, under {DWELL_SHARE_FLOOR:g}): it does not slow to "
+                "turn at the path's ends as a resonance does"
             )
         for name, path in zip(
             ("top left", "top right", "bottom left", "bottom right"),
