@@ -25,8 +25,9 @@ Each of the six camera attacks of the paper (Phantom Menace, Method and Appendix
 * EM colour strip: lines lost on the bus shift the raw Bayer rows by one, so the ISP demosaics them with the wrong
   colour-filter phase: in bands (a second lost line restores the phase) or from one row to the frame's end;
 * EM truncation: a corrupted buffer address drops a band of rows and stitches rows from the frame's end below;
-* ultrasound blur: the image moves along a path during the exposure (linear, resonant sinusoidal whose dwell time is
-  arcsine-distributed, or rotational), averaged in linear irradiance.
+* ultrasound blur: the image moves along a path during the exposure, averaged in linear irradiance (a resonance
+  whose dwell time is arcsine-distributed, or a triangle wave's constant-speed sweep) or in output space (the paper's
+  linear and rotational forms); or the lens is defocused instead (a disc, in linear irradiance).
 
 The paper's own digital forms (alpha blends, the fixed colour map, the fixed Gaussian band) are also here, written
 from Appendix A, to render the *null* cases where the library's base model is the truth.
