@@ -1,4 +1,4 @@
-"""Where session 83's three rules acted in a folder of calibration reports (a camsim matrix or run_camsim_case.py
+"""Where session 83's three rules and session 84's dwell rule acted in a folder of calibration reports (a camsim matrix or run_camsim_case.py
 output): every identification result whose reasons hold a rule's words, and every selection step that set a group
 aside because the gamma sat at its low bound 1.
 
@@ -11,6 +11,7 @@ from pathlib import Path
 RULES = {
     "resonance is a path": "it covers an area, not the path of one motion",
     "clip bounds the clean frames": "the clip is not the sensor's",
+    "resonance turns": "it does not slow to turn at the path's ends",
 }
 
 
