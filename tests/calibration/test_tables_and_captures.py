@@ -202,6 +202,32 @@ def test_a_sixteen_bit_grey_capture_is_read_at_its_own_range(tmp_path, suffix):
         assert float(image.max()) == 1.0 and float(image.min()) < 0.2
 
 
+@pytest.mark.parametrize(("suffix", "alpha"), [(".png", False), (".png", True), (".tif", False)])
+def test_a_sixteen_bit_colour_capture_keeps_every_bit(tmp_path, suffix, alpha):
+    """A 48-bit RGB (or 64-bit RGBA) capture reads as the values it stores, channel by channel, and resized as their
+    area average (Pillow reads it as 8-bit RGB: the right scale, every value's low byte dropped, a dark laser
+    spot's tail 1/256 of the range coarse)."""
+    import cv2
+
+    from lerobot_phantom.calibration.captures import CaptureProblem
+
+    ys, xs = np.mgrid[0:40, 0:56]
+    spot = np.exp(-0.5 * (np.hypot(xs - 30.0, ys - 17.0) / 5.0) ** 2)
+    tint = np.array([1.0, 0.35, 0.12])  # a red laser: the other channels hold its faint light
+    stored = np.round(kit.srgb_encode(0.02 * spot[..., None] * tint + 0.001 * xs[..., None]) * 65535) / 65535
+    planes = (stored * 65535).astype(np.uint16)[..., ::-1]  # OpenCV writes BGR(A)
+    if alpha:
+        planes = np.concatenate([planes, np.full((40, 56, 1), 65535, np.uint16)], axis=2)
+    assert cv2.imwrite(str(tmp_path / f"laser{suffix}"), planes)
+    with Image.open(tmp_path / f"laser{suffix}") as opened:  # what Pillow alone would read
+        assert np.max(np.abs(np.asarray(opened.convert("RGB")) / 255.0 - stored)) > 1e-3
+    halved = stored.reshape(20, 2, 28, 2, 3).mean(axis=(1, 3))
+    for max_side, expected in ((56, stored), (28, halved)):
+        image = CaptureProblem(tmp_path / f"laser{suffix}", max_side=max_side, seed=0).image
+        assert image.shape == (3, *expected.shape[:2])
+        assert np.max(np.abs(image.permute(1, 2, 0).numpy() - expected)) < 1e-6
+
+
 def test_a_capture_of_unstated_range_is_refused_with_the_modes_that_read(tmp_path):
     Image.fromarray(np.full((8, 8), 0.5, np.float32)).save(tmp_path / "laser.tif")
     with pytest.raises(

@@ -15,6 +15,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import cv2
 import numpy as np
 import pandas as pd
 import torch
@@ -93,31 +94,56 @@ SIXTEEN_BIT_GREY_MODES = ("I;16", "I;16B", "I;16L", "I;16N")
 as white, so they are scaled by their own range."""
 
 
+def sixteen_bit_colour(opened: Image.Image) -> bool:
+    """Whether Pillow opened a 16-bit-per-channel colour file (a 48-bit RGB or 64-bit RGBA PNG or TIFF): it reads
+    these as 8-bit RGB(A), the right scale with the low byte of every value dropped."""
+    if opened.mode not in ("RGB", "RGBA") or not opened.tile:
+        return False
+    args = opened.tile[0].args
+    rawmode = args if isinstance(args, str) else args[0] if args else ""
+    return isinstance(rawmode, str) and ";16" in rawmode
+
+
+def sixteen_bit_channels(path: Path, opened: Image.Image) -> list[np.ndarray] | None:
+    """The file's channels in [0, 1] (float32, one grey or red, green, blue) where it stores 16 bits a value, else
+    None. Colour is decoded by OpenCV, which keeps all 16 bits."""
+    if opened.mode in SIXTEEN_BIT_GREY_MODES or (opened.mode == "I" and opened.format == "PNG"):
+        return [np.asarray(opened, dtype=np.float32) / 65535.0]
+    if not sixteen_bit_colour(opened):
+        return None
+    decoded = cv2.imread(str(path), cv2.IMREAD_UNCHANGED)
+    if decoded is None or decoded.dtype != np.uint16 or decoded.ndim != 3:
+        raise ValueError(f"{path}: Pillow reads 16-bit colour that OpenCV does not decode as such")
+    return [decoded[..., channel].astype(np.float32) / 65535.0 for channel in (2, 1, 0)]  # OpenCV's BGR(A)
+
+
 def load_rgb(path: Path, size: tuple[int, int] | None = None, max_side: int | None = None) -> torch.Tensor:
-    """An image file -> float64 (3, H, W) in [0, 1] (alpha dropped; grey repeated in each channel; 16-bit grey
-    scaled by 65535), resized to ``size`` (W, H) or ``max_side`` (area averaging)."""
+    """An image file -> float64 (3, H, W) in [0, 1] (alpha dropped; grey repeated in each channel; 16-bit values,
+    grey or colour, scaled by 65535), resized to ``size`` (W, H) or ``max_side`` (area averaging)."""
     if not path.is_file():
         raise FileNotFoundError(f"image not found: {path}")
     with Image.open(path) as opened:
-        if opened.mode in SIXTEEN_BIT_GREY_MODES or (opened.mode == "I" and opened.format == "PNG"):
-            image = Image.fromarray(np.asarray(opened, dtype=np.float32) / 65535.0)
+        channels = sixteen_bit_channels(path, opened)
+        if channels is not None:
+            images = [Image.fromarray(channel) for channel in channels]
         elif opened.mode in ("I", "F"):
             raise ValueError(
                 f"{path}: a {opened.format} image of Pillow mode {opened.mode!r} (32-bit values) has no stated "
                 "range of grey levels; store the capture as 8-bit or 16-bit PNG or TIFF (readable modes: any "
-                f"8-bit mode, {', '.join(SIXTEEN_BIT_GREY_MODES)})"
+                f"8-bit mode, {', '.join(SIXTEEN_BIT_GREY_MODES)}, 16-bit RGB)"
             )
         else:
-            image = opened.convert("RGB")
-    if size is None and max_side is not None and max(image.size) > max_side:
-        factor = max_side / max(image.size)
-        size = (max(1, round(image.size[0] * factor)), max(1, round(image.size[1] * factor)))
-    if size is not None and image.size != tuple(size):
-        image = image.resize(tuple(size), Image.Resampling.BOX)
-    if image.mode == "F":
-        grey = torch.from_numpy(np.asarray(image, dtype=np.float64))
-        return grey.expand(3, *grey.shape).clone()
-    return torch.from_numpy(np.asarray(image, dtype=np.float64) / 255.0).permute(2, 0, 1).contiguous()
+            images = [opened.convert("RGB")]
+    width, height = images[0].size
+    if size is None and max_side is not None and max(width, height) > max_side:
+        factor = max_side / max(width, height)
+        size = (max(1, round(width * factor)), max(1, round(height * factor)))
+    if size is not None and (width, height) != tuple(size):
+        images = [image.resize(tuple(size), Image.Resampling.BOX) for image in images]
+    if images[0].mode == "RGB":
+        return torch.from_numpy(np.asarray(images[0], dtype=np.float64) / 255.0).permute(2, 0, 1).contiguous()
+    planes = torch.stack([torch.from_numpy(np.asarray(image, dtype=np.float64)) for image in images])
+    return planes.expand(3, *planes.shape[1:]).clone()
 
 
 @dataclass
