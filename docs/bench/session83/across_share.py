@@ -37,14 +37,19 @@ def print_shares(label: str, problem, items) -> None:
         )
 
 
-def main() -> None:
+def each_case_draw(print_draw, heading: str) -> None:
+    """``print_draw(label, problem, fit items)`` for every case and master seed the command line names."""
     cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
-    print(f"limit {ACROSS_SHARE_LIMIT}")
+    print(heading)
     for name in cases:
         for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
             with tempfile.TemporaryDirectory() as folder:
                 problem, items = sim.drawn_problem(name, case_seed, Path(folder))
-                print_shares(f"{name} master {master}", problem, items)
+                print_draw(f"{name} master {master}", problem, items)
+
+
+def main() -> None:
+    each_case_draw(print_shares, f"limit {ACROSS_SHARE_LIMIT}")
 
 
 if __name__ == "__main__":

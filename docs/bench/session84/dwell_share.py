@@ -9,18 +9,15 @@ Usage: ``PYTHONPATH=. python docs/bench/session84/dwell_share.py CASE[,CASE...] 
 from __future__ import annotations
 
 import sys
-import tempfile
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from camsim_case_cameras import case_draws
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "session83"))
+from across_share import MODELS, each_case_draw
 
 from lerobot_phantom.calibration.frame_models.ultrasound_blur import DWELL_SHARE_FLOOR
-
-MODELS = (frozenset({"sinusoidal_motion"}), frozenset({"sinusoidal_motion", "sensor_gamma"}))
 
 
 def print_dwell(label: str, problem, items) -> None:
@@ -39,13 +36,7 @@ def print_dwell(label: str, problem, items) -> None:
 
 
 def main() -> None:
-    cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
-    print(f"floor {DWELL_SHARE_FLOOR}")
-    for name in cases:
-        for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
-            with tempfile.TemporaryDirectory() as folder:
-                problem, items = sim.drawn_problem(name, case_seed, Path(folder))
-                print_dwell(f"{name} master {master}", problem, items)
+    each_case_draw(print_dwell, f"floor {DWELL_SHARE_FLOOR}")
 
 
 if __name__ == "__main__":
