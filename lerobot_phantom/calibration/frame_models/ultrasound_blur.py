@@ -189,27 +189,32 @@ class BlurFrames(FrameProblem):
     def dwell_share(self, fit: Fit, items: np.ndarray) -> float:
         """Where between a constant-speed sweep (0: uniform dwell) and a sinusoid (1: arcsine dwell) the centred
         path's samples best fit the attacked frames of ``items``: each sample's position interpolated between the
-        two, the path's displacement refitted with it, every other parameter held at ``fit``'s values."""
+        two, refitted with the path's displacement and the camera's gamma. The gamma is free whether or not ``fit``
+        names it: the blur averages light, and averaged in the wrong light a resonance's edges can fit a uniform
+        dwell (docs/bench/session84.md)."""
         uniform = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
         arcsine = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
-        gamma = fit.params.get("gamma", 1.0)
 
         def errors(p):
             offsets = (1 - p["dwell_share"]) * uniform + p["dwell_share"] * arcsine
             return torch.cat(
                 [
-                    (self.path_blur(p, int(i), offsets, gamma) - self.pairs[int(i)].attacked).ravel()
+                    (self.path_blur(p, int(i), offsets, p["gamma"]) - self.pairs[int(i)].attacked).ravel()
                     for i in items
                 ]
             )
 
-        path = {name: fit.params[name] for name in PATH_PARAMS}
-        specs = [Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1), *self.param_specs(frozenset())]
+        held = {name: fit.params[name] for name in PATH_PARAMS}
+        held["gamma"] = fit.params.get("gamma", GAMMA_PARAM.init)
+        specs = [
+            Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1),
+            *self.param_specs(frozenset({"sensor_gamma"})),
+        ]
         return fit_least_squares(
             specs,
             errors,
-            warm={"dwell_share": 1.0, **path},
-            starts=[{"dwell_share": 0.0, **path}],
+            warm={"dwell_share": 1.0, **held},
+            starts=[{"dwell_share": 0.0, **held}],
             jacobian="2-point",
             max_nfev=30,
         )["dwell_share"]
