@@ -479,6 +479,19 @@ def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame
     assert problem.identification_checks("sensor_gamma", fit, items) == []
 
 
+def test_a_resonance_averaged_in_light_keeps_its_turning_points_when_the_model_blurs_encoded_values(tmp_path):
+    """camsim's resonance at master seed 4048988818 (case seed 617225774; docs/bench/session84.md), fitted without a
+    gamma: read in the encoded values its dwell fits the uniform bound (0.000) and the resonance was withdrawn; read
+    with the camera's gamma free, as ``dwell_share`` reads it, it turns (0.846)."""
+    import test_independent_sim as sim
+
+    problem, items = sim.drawn_problem("blur_sinusoidal", 617225774, tmp_path)
+    fit = problem.fit(frozenset({"sinusoidal_motion"}), items)
+    assert "gamma" not in fit.params
+    assert problem.dwell_share(fit, items) > 0.5
+    assert problem.identification_checks("sinusoidal_motion", fit, items) == []
+
+
 class HostAndChild(ParentAndChild):
     """As above, with the child's parameter inside its range unless ``child_at_bound``."""
 
