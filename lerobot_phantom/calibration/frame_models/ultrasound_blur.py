@@ -233,9 +233,11 @@ class BlurFrames(FrameProblem):
           docs/bench/session83/across_share_faa5520.txt);
         - a resonance turns: a sinusoid slows to a stop at both ends of its path, so its samples crowd there. Between
           a constant-speed sweep's uniform dwell (0) and the arcsine (1), the dwell that best fits the frames
-          (``dwell_share``) must reach ``DWELL_SHARE_FLOOR``. A resonance of a non-integer number of cycles fits a
-          partly uniform dwell (camsim's: 0.13-1.00 over 28 fits on 14 draws); a centred triangle wave, the same path
-          swept at constant speed, does not turn (0.00-0.06 over 28 fits; docs/bench/session84/dwell_share.txt).
+          (``dwell_share``, the gamma free) must reach ``DWELL_SHARE_FLOOR``. A resonance of a non-integer number of
+          cycles fits a partly uniform dwell. On the 44 draws the rule was shaped on, camsim's resonance fits
+          0.054-1.000 (one draw under it), a centred triangle wave, the same path swept at constant speed,
+          0.000-0.300 (one draw over); on 30 draws held out, 0.223-1.000 and 0.000-0.256 (three triangle draws over):
+          the two overlap (docs/bench/session84/dwell_share_free_gamma_44.txt, dwell_share_free_gamma_heldout30.txt).
         """
         if effect != "sinusoidal_motion":
             return []
