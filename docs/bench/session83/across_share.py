@@ -23,18 +23,29 @@ from lerobot_phantom.calibration.frame_models.ultrasound_blur import ACROSS_SHAR
 MODELS = (frozenset({"sinusoidal_motion"}), frozenset({"sinusoidal_motion", "sensor_gamma"}))
 
 
-def print_shares(label: str, problem, items) -> None:
-    """Fit each of ``MODELS`` on ``items`` and print its path's length and the spread across it."""
+def print_per_model(label: str, problem, items, measure) -> None:
+    """Fit each of ``MODELS`` on ``items`` and print its path's length and what ``measure(problem, fit, items)``
+    says of the fit, timed."""
     for effects in MODELS:
         fit = problem.fit(effects, items)
         began = time.perf_counter()
-        share = problem.across_share(fit, items)
+        said = measure(problem, fit, items)
         length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
         print(
-            f"{label} {'+'.join(sorted(effects))}: path {length:.1f} px, across {share:.3f} of it "
+            f"{label} {'+'.join(sorted(effects))}: path {length:.1f} px, {said} "
             f"({time.perf_counter() - began:.2f} s)",
             flush=True,
         )
+
+
+def print_shares(label: str, problem, items) -> None:
+    """Fit each of ``MODELS`` on ``items`` and print its path's length and the spread across it."""
+    print_per_model(
+        label,
+        problem,
+        items,
+        lambda problem, fit, items: f"across {problem.across_share(fit, items):.3f} of it",
+    )
 
 
 def each_case_draw(print_draw, heading: str) -> None:

@@ -9,30 +9,23 @@ Usage: ``PYTHONPATH=. python docs/bench/session84/dwell_share.py CASE[,CASE...] 
 from __future__ import annotations
 
 import sys
-import time
 from pathlib import Path
 
-import numpy as np
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "session83"))
-from across_share import MODELS, each_case_draw
+from across_share import each_case_draw, print_per_model
 
 from lerobot_phantom.calibration.frame_models.ultrasound_blur import DWELL_SHARE_FLOOR
 
 
+def dwell_verdict(problem, fit, items) -> str:
+    """The dwell share that best fits ``items`` on ``fit``'s path, and the rule's verdict on it."""
+    share = problem.dwell_share(fit, items)
+    return f"dwell {share:.3f} ({'withdrawn' if share < DWELL_SHARE_FLOOR else 'turns'})"
+
+
 def print_dwell(label: str, problem, items) -> None:
     """Fit each of ``MODELS`` on ``items`` and print its path's length, the best-fitting dwell and the verdict."""
-    for effects in MODELS:
-        fit = problem.fit(effects, items)
-        began = time.perf_counter()
-        share = problem.dwell_share(fit, items)
-        length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
-        verdict = "withdrawn" if share < DWELL_SHARE_FLOOR else "turns"
-        print(
-            f"{label} {'+'.join(sorted(effects))}: path {length:.1f} px, dwell {share:.3f} ({verdict}) "
-            f"({time.perf_counter() - began:.2f} s)",
-            flush=True,
-        )
+    print_per_model(label, problem, items, dwell_verdict)
 
 
 def main() -> None:
