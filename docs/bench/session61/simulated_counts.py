@@ -11,15 +11,15 @@ produce it. Before session 61 the calibrated transform drew one count per intens
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
 import numpy as np
 import torch
 
-from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
-from lerobot_phantom.calibration.core import seeded_split
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from report_folder import report_problem
+
 from lerobot_phantom.transforms.registry import make_attack
 
 DRAWS = 4000
@@ -27,16 +27,7 @@ DRAWS = 4000
 
 def frame_counts(root: Path, case: str, seed: str) -> list[tuple[float, int, int]]:
     """(intensity, height, registered count) of each held-out frame."""
-    folder = root / seed / case
-    report = json.loads((folder / "out" / "report.json").read_text())
-    cfg = CalibrateConfig(
-        attack="em_truncation",
-        measured=str(folder / "pairs"),
-        out=str(folder / "out"),
-        seed=report["split"]["seed"],
-    )
-    problem = build_problem(cfg)
-    _, heldout = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+    _, problem, _, heldout = report_problem(root / seed / case, "em_truncation")
     frames = []
     for index in heldout:
         pair = problem.pairs[int(index)]

@@ -7,29 +7,22 @@ Usage: ``PYTHONPATH=. python docs/bench/session83/clip_rule.py FOLDER...``
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 
-from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem
-from lerobot_phantom.calibration.core import Fit, seeded_split
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from report_folder import report_problem
+
+from lerobot_phantom.calibration.core import Fit
 
 
 def main() -> None:
     for folder in map(Path, sys.argv[1:]):
-        report = json.loads((folder / "out" / "report.json").read_text())
+        report, problem, items, _ = report_problem(folder, "light_projection")
         effects = frozenset(report["extended"]["effects"])
         if "clipping" not in effects:
             print(f"{folder}: no clip named")
             continue
-        cfg = CalibrateConfig(
-            attack="light_projection",
-            measured=str(folder / "pairs"),
-            out=str(folder / "unused"),
-            seed=report["split"]["seed"],
-        )
-        problem = build_problem(cfg)
-        items, _ = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
         fit = Fit(effects, report["extended"]["params"])
         white, share = problem.white_exceeded(fit, items)
         reasons = problem.identification_checks("clipping", fit, items)
