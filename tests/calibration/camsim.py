@@ -757,6 +757,14 @@ def uniform_path(length: float, samples: int = 24) -> np.ndarray:
     return (np.arange(samples) + 0.5) / samples * length
 
 
+def triangle_wave_path(length: float, cycles: float, phase: float, samples: int = 64) -> np.ndarray:
+    """Positions, centred on the rest position, of a path swept back and forth at constant speed over ``length``
+    (a triangle wave of ``cycles`` per exposure starting ``phase`` of a cycle in), at ``samples`` equal time steps:
+    every position is visited equally often, where a resonance's sinusoid dwells at both ends."""
+    t = (np.arange(samples) + 0.5) / samples
+    return length * (2 * np.abs((cycles * t + phase) % 1.0 - 0.5) - 0.5)
+
+
 def disc_offsets(diameter: float, samples: int = 144) -> np.ndarray:
     """(dy, dx) positions filling a disc of ``diameter`` px uniformly (a sunflower lattice): a defocus PSF."""
     radius = np.sqrt((np.arange(samples) + 0.5) / samples) * diameter / 2
@@ -818,8 +826,7 @@ def ultrasound_blur_pairs(
             )
             attacked = quantised(attacked)
         elif path == "triangle":
-            t = (np.arange(64) + 0.5) / 64
-            shifts = d * (2 * np.abs((cycles * t + rng.uniform(0, 1)) % 1.0 - 0.5) - 0.5)
+            shifts = triangle_wave_path(d, cycles, rng.uniform(0, 1))
             attacked, _ = capture(
                 path_blur(refl * light, shifts[:, None] * unit), cam, rng, exposure=exposure
             )

@@ -155,6 +155,20 @@ def test_the_paper_blur_path_spreads_as_a_constant_speed_path():
     assert path.min() > 0.0 and path.max() < 10.0
 
 
+def test_the_triangle_wave_sweeps_its_centred_path_at_constant_speed():
+    # whole cycles visit every position of [-d/2, d/2] equally often: mean 0, standard deviation d/sqrt(12), a flat
+    # histogram (a sinusoid's arcsine piles up at both ends: its outer fifths would hold 59% of the time, not 40%)
+    path = cs.triangle_wave_path(10.0, cycles=6.0, phase=0.3, samples=6000)
+    assert path.min() >= -5.0 and path.max() <= 5.0
+    assert abs(path.mean()) < 1e-9
+    assert abs(path.std() / (10.0 / np.sqrt(12.0)) - 1.0) < 1e-3
+    counts, _ = np.histogram(path, bins=5, range=(-5.0, 5.0))
+    assert np.all(np.abs(counts / len(path) - 0.2) < 0.01)
+    # a non-integer number of cycles still stays on the path and near its centre
+    partial = cs.triangle_wave_path(10.0, cycles=5.4, phase=0.8)
+    assert partial.min() >= -5.0 and partial.max() <= 5.0 and abs(partial.mean()) < 0.5
+
+
 def test_a_defocus_disc_fills_its_diameter_evenly():
     # a uniform disc of diameter d: centred, inside radius d / 2, half its points within d / (2 sqrt 2) (half the area)
     points = cs.disc_offsets(10.0)
