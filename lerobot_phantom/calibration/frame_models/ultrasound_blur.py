@@ -13,7 +13,7 @@ import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
-from lerobot_phantom.calibration.tone import GAMMA_PARAM
+from lerobot_phantom.calibration.tone import GAMMA_PARAM, SHOULDER_PARAMS, decode_encode
 from lerobot_phantom.transforms import physics
 
 PATH_PARAMS = ("dx_ref_px", "dy_ref_px")
@@ -72,15 +72,19 @@ class BlurFrames(FrameProblem):
         gamma = params.get("gamma") if "sensor_gamma" in effects else 1.0
         return self.path_blur(params, index, offsets, gamma)
 
-    def path_blur(self, params, index: int, offsets: torch.Tensor, gamma) -> torch.Tensor:
-        """Pair ``index``'s clean frame averaged, in the light of ``gamma``, over ``offsets`` (shares of the
-        displacement ``params`` gives at the reference scale)."""
+    def path_blur(
+        self, params, index: int, offsets: torch.Tensor, gamma, shoulder: bool = False
+    ) -> torch.Tensor:
+        """Pair ``index``'s clean frame averaged over ``offsets`` (shares of the displacement ``params`` gives at the
+        reference scale) in linear light: decoded by the power law ``gamma``, or with ``shoulder`` by the tone curve
+        whose shoulder ``params`` holds under that gamma (calibration/tone.py)."""
         pair = self.pairs[index]
-        x = physics.decode(pair.clean.unsqueeze(0), gamma)
+        decode, encode = decode_encode(params, shoulder, gamma)
+        x = decode(pair.clean.unsqueeze(0))
         scale = pair.intensity / pair.to_reference
         dx = torch.as_tensor(params["dx_ref_px"] * scale, dtype=torch.float64)
         dy = torch.as_tensor(params["dy_ref_px"] * scale, dtype=torch.float64)
-        return physics.encode(physics.line_blur(x, dx, dy, offsets), gamma)[0]
+        return encode(physics.line_blur(x, dx, dy, offsets))[0]
 
     def predict_pair(self, fit: Fit, index: int) -> torch.Tensor:
         with torch.no_grad():
@@ -189,9 +193,11 @@ class BlurFrames(FrameProblem):
     def dwell_share(self, fit: Fit, items: np.ndarray) -> float:
         """Where between a constant-speed sweep (0: uniform dwell) and a sinusoid (1: arcsine dwell) the centred
         path's samples best fit the attacked frames of ``items``: each sample's position interpolated between the
-        two, refitted with the path's displacement and the camera's gamma. The gamma is free whether or not ``fit``
-        names it: the blur averages light, and averaged in the wrong light a resonance's edges can fit a uniform
-        dwell (docs/bench/session84.md)."""
+        two, refitted with the path's displacement and the camera's tone curve, a power law with a highlight
+        shoulder. The tone curve is free whether or not ``fit`` names it: the blur averages light, and averaged in
+        the wrong light a path's ends weigh wrong. A power law alone read a resonance's edges as a uniform dwell
+        (docs/bench/session84.md), and on a filmic camera, whose highlights roll off, a uniform sweep as a partly
+        turning one (0.11-0.30 against 0.00-0.01 with the shoulder; docs/bench/session85.md)."""
         uniform = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
         arcsine = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
 
@@ -199,7 +205,10 @@ class BlurFrames(FrameProblem):
             offsets = (1 - p["dwell_share"]) * uniform + p["dwell_share"] * arcsine
             return torch.cat(
                 [
-                    (self.path_blur(p, int(i), offsets, p["gamma"]) - self.pairs[int(i)].attacked).ravel()
+                    (
+                        self.path_blur(p, int(i), offsets, p["gamma"], shoulder=True)
+                        - self.pairs[int(i)].attacked
+                    ).ravel()
                     for i in items
                 ]
             )
@@ -209,6 +218,7 @@ class BlurFrames(FrameProblem):
         specs = [
             Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1),
             *self.param_specs(frozenset({"sensor_gamma"})),
+            *SHOULDER_PARAMS,
         ]
         return fit_least_squares(
             specs,
