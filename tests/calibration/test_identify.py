@@ -24,7 +24,11 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
-from lerobot_phantom.calibration.frame_models.ultrasound_blur import ACROSS_SHARE_LIMIT, BlurFrames
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import (
+    ACROSS_SHARE_LIMIT,
+    DWELL_SHARE_FLOOR,
+    BlurFrames,
+)
 from lerobot_phantom.calibration.identify import (
     RESUMMED_DRAWS,
     Interval,
@@ -482,14 +486,29 @@ def test_a_blur_is_named_a_resonance_only_if_it_is_one_motion_of_the_whole_frame
 def test_a_resonance_averaged_in_light_keeps_its_turning_points_when_the_model_blurs_encoded_values(tmp_path):
     """camsim's resonance at master seed 4048988818 (case seed 617225774; docs/bench/session84.md), fitted without a
     gamma: read in the encoded values its dwell fits the uniform bound (0.000) and the resonance was withdrawn; read
-    with the camera's gamma free, as ``dwell_share`` reads it, it turns (0.846)."""
+    with the camera's tone curve free, as ``dwell_share`` reads it, it turns (0.846 with a power law, 0.334 with the
+    shoulder of this filmic camera's curve too: docs/bench/session85.md)."""
     import test_independent_sim as sim
 
     problem, items = sim.drawn_problem("blur_sinusoidal", 617225774, tmp_path)
     fit = problem.fit(frozenset({"sinusoidal_motion"}), items)
     assert "gamma" not in fit.params
-    assert problem.dwell_share(fit, items) > 0.5
+    assert problem.dwell_share(fit, items) > 2 * DWELL_SHARE_FLOOR
     assert problem.identification_checks("sinusoidal_motion", fit, items) == []
+
+
+def test_a_uniform_sweep_on_a_filmic_camera_does_not_turn_when_read_in_its_shouldered_light(tmp_path):
+    """camsim's triangle wave (a centred path swept at constant speed) at master seed 2062500564 (case seed
+    3003381006), on a filmic camera whose highlights roll off: read with a power law alone its dwell fitted 0.300 of
+    the way to the arcsine and the resonance was named; read with the tone curve's shoulder free, as ``dwell_share``
+    reads it, the sweep is uniform (docs/bench/session85.md)."""
+    import test_independent_sim as sim
+
+    problem, items = sim.drawn_problem("blur_triangle_unnamed", 3003381006, tmp_path)
+    fit = problem.fit(frozenset({"sinusoidal_motion", "sensor_gamma"}), items)
+    assert problem.dwell_share(fit, items) < DWELL_SHARE_FLOOR / 2
+    reasons = problem.identification_checks("sinusoidal_motion", fit, items)
+    assert any("dwells uniformly along its path" in r for r in reasons), reasons
 
 
 class HostAndChild(ParentAndChild):

@@ -49,14 +49,15 @@ def print_shares(label: str, problem, items) -> None:
 
 
 def each_case_draw(print_draw, heading: str) -> None:
-    """``print_draw(label, problem, fit items)`` for every case and master seed the command line names."""
+    """``print_draw(label, problem, fit items)`` for every case and master seed the command line names (the label
+    names the camera's tone curve)."""
     cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
     print(heading)
     for name in cases:
-        for master, sim, _case, case_seed, _rng, _camera in case_draws(name, seeds):
+        for master, sim, _case, case_seed, _rng, camera in case_draws(name, seeds):
             with tempfile.TemporaryDirectory() as folder:
                 problem, items = sim.drawn_problem(name, case_seed, Path(folder))
-                print_draw(f"{name} master {master}", problem, items)
+                print_draw(f"{name} master {master} ({camera.tone})", problem, items)
 
 
 def main() -> None:
