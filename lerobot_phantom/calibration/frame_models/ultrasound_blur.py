@@ -197,7 +197,8 @@ class BlurFrames(FrameProblem):
         shoulder. The tone curve is free whether or not ``fit`` names it: the blur averages light, and averaged in
         the wrong light a path's ends weigh wrong. A power law alone read a resonance's edges as a uniform dwell
         (docs/bench/session84.md), and on a filmic camera, whose highlights roll off, a uniform sweep as a partly
-        turning one (0.11-0.30 against 0.00-0.01 with the shoulder; docs/bench/session85.md)."""
+        turning one (camsim's triangle wave: up to 0.300 with a power law, 0.000 on every filmic draw with the
+        shoulder; docs/bench/session85.md)."""
         uniform = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
         arcsine = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
 
@@ -243,11 +244,11 @@ class BlurFrames(FrameProblem):
           docs/bench/session83/across_share_faa5520.txt);
         - a resonance turns: a sinusoid slows to a stop at both ends of its path, so its samples crowd there. Between
           a constant-speed sweep's uniform dwell (0) and the arcsine (1), the dwell that best fits the frames
-          (``dwell_share``, the gamma free) must reach ``DWELL_SHARE_FLOOR``. A resonance of a non-integer number of
-          cycles fits a partly uniform dwell. On the 44 draws the rule was shaped on, camsim's resonance fits
-          0.054-1.000 (one draw under it), a centred triangle wave, the same path swept at constant speed,
-          0.000-0.300 (one draw over); on 30 draws held out, 0.223-1.000 and 0.000-0.256 (three triangle draws over):
-          the two overlap (docs/bench/session84/dwell_share_free_gamma_44.txt, dwell_share_free_gamma_heldout30.txt).
+          (``dwell_share``, the tone curve free) must reach ``DWELL_SHARE_FLOOR``. A resonance of a non-integer
+          number of cycles fits a partly uniform dwell. On the 44 draws the floor was set on, camsim's resonance fits
+          0.095-0.982 (one draw under it), a centred triangle wave, the same path swept at constant speed,
+          0.000-0.011; on 30 fresh draws, 0.000-0.910 (one draw under, as with the gamma alone) and 0.000
+          (docs/bench/session85/dwell_share_shoulder_44.txt, dwell_share_shoulder_fresh30.txt).
         """
         if effect != "sinusoidal_motion":
             return []
