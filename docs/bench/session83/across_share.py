@@ -38,7 +38,7 @@ def print_per_model(label: str, problem, items, measure) -> None:
         )
 
 
-def print_shares(label: str, problem, items) -> None:
+def print_shares(label: str, problem, items, _camera) -> None:
     """Fit each of ``MODELS`` on ``items`` and print its path's length and the spread across it."""
     print_per_model(
         label,
@@ -49,15 +49,15 @@ def print_shares(label: str, problem, items) -> None:
 
 
 def each_case_draw(print_draw, heading: str) -> None:
-    """``print_draw(label, problem, fit items)`` for every case and master seed the command line names (the label
-    names the camera's tone curve)."""
+    """``print_draw(label, problem, fit items, camera)`` for every case and master seed the command line names (the
+    label names the camera's tone curve)."""
     cases, seeds = sys.argv[1].split(","), [int(s) for s in sys.argv[2:]]
     print(heading)
     for name in cases:
         for master, sim, _case, case_seed, _rng, camera in case_draws(name, seeds):
             with tempfile.TemporaryDirectory() as folder:
                 problem, items = sim.drawn_problem(name, case_seed, Path(folder))
-                print_draw(f"{name} master {master} ({camera.tone})", problem, items)
+                print_draw(f"{name} master {master} ({camera.tone})", problem, items, camera)
 
 
 def main() -> None:

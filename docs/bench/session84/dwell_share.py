@@ -23,7 +23,7 @@ def dwell_verdict(problem, fit, items) -> str:
     return f"dwell {share:.3f} ({'withdrawn' if share < DWELL_SHARE_FLOOR else 'turns'})"
 
 
-def print_dwell(label: str, problem, items) -> None:
+def print_dwell(label: str, problem, items, _camera) -> None:
     """Fit each of ``MODELS`` on ``items`` and print its path's length, the best-fitting dwell and the verdict."""
     print_per_model(label, problem, items, dwell_verdict)
 

@@ -29,6 +29,8 @@ PATH_AGREEMENT_SHARE = 0.3  # length tolerance, as a share of the whole frame's 
 ACROSS_SHARE_LIMIT = 0.5
 # the least share of the way from a uniform dwell to the arcsine that a resonance's path must fit
 DWELL_SHARE_FLOOR = 0.1
+# the share of the way from a uniform dwell (0) to the arcsine (1) that a path's samples are read at
+DWELL_PARAM = Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1)
 
 BLUR_EFFECTS = (
     Effect(
@@ -217,7 +219,7 @@ class BlurFrames(FrameProblem):
         held = {name: fit.params[name] for name in PATH_PARAMS}
         held["gamma"] = fit.params.get("gamma", GAMMA_PARAM.init)
         specs = [
-            Param("dwell_share", 1.0, 0.0, 1.0, scale=0.1),
+            DWELL_PARAM,
             *self.param_specs(frozenset({"sensor_gamma"})),
             *SHOULDER_PARAMS,
         ]
