@@ -21,8 +21,7 @@ sys.path.insert(1, str(Path(__file__).resolve().parents[3] / "tests" / "calibrat
 import camsim
 from across_share import each_case_draw
 
-from lerobot_phantom.calibration.core import fit_least_squares
-from lerobot_phantom.calibration.frame_models.ultrasound_blur import DWELL_PARAM, PATH_PARAMS
+from lerobot_phantom.calibration.frame_models.ultrasound_blur import PATH_PARAMS, fit_dwell_share
 from lerobot_phantom.transforms import physics
 
 RESONANCE = frozenset({"sinusoidal_motion", "sensor_gamma"})
@@ -54,17 +53,9 @@ def dwell_in_camera_light(problem, fit, items, camera) -> float:
             parts.append((encode(blurred)[0] - pair.attacked).ravel())
         return torch.cat(parts)
 
-    # the package's dwell parameter and path parameters, as it fits them (the tone curve here is camsim's, fixed)
-    specs = [DWELL_PARAM, *problem.param_specs(frozenset())]
+    # fitted with the path as the package fits it; the tone curve here is camsim's, fixed
     held = {name: fit.params[name] for name in PATH_PARAMS}
-    return fit_least_squares(
-        specs,
-        errors,
-        warm={"dwell_share": 1.0, **held},
-        starts=[{"dwell_share": 0.0, **held}],
-        jacobian="2-point",
-        max_nfev=30,
-    )["dwell_share"]
+    return fit_dwell_share(problem.param_specs(frozenset()), errors, held)
 
 
 def print_both(label: str, problem, items, camera) -> None:

@@ -43,6 +43,19 @@ BLUR_EFFECTS = (
 )
 
 
+def fit_dwell_share(specs: list[Param], errors, held: dict[str, float]) -> float:
+    """The dwell share (``DWELL_PARAM``) that, fitted with ``specs``, minimises ``errors``: started from the arcsine
+    and from the uniform dwell, the other parameters at ``held``."""
+    return fit_least_squares(
+        [DWELL_PARAM, *specs],
+        errors,
+        warm={"dwell_share": 1.0, **held},
+        starts=[{"dwell_share": 0.0, **held}],
+        jacobian="2-point",
+        max_nfev=30,
+    )["dwell_share"]
+
+
 class BlurFrames(FrameProblem):
     attack = "ultrasound_blur"
     base_model = "uniform line average from the pixel along a fitted displacement (the paper's ultrasound blur, linear part)"
@@ -218,19 +231,9 @@ class BlurFrames(FrameProblem):
 
         held = {name: fit.params[name] for name in PATH_PARAMS}
         held["gamma"] = fit.params.get("gamma", GAMMA_PARAM.init)
-        specs = [
-            DWELL_PARAM,
-            *self.param_specs(frozenset({"sensor_gamma"})),
-            *SHOULDER_PARAMS,
-        ]
-        return fit_least_squares(
-            specs,
-            errors,
-            warm={"dwell_share": 1.0, **held},
-            starts=[{"dwell_share": 0.0, **held}],
-            jacobian="2-point",
-            max_nfev=30,
-        )["dwell_share"]
+        return fit_dwell_share(
+            [*self.param_specs(frozenset({"sensor_gamma"})), *SHOULDER_PARAMS], errors, held
+        )
 
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
         """A stabiliser moves the whole image along one path, so a resonance is named only if the blur is that:
