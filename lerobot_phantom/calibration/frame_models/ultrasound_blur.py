@@ -3,7 +3,8 @@
 Base (the paper's linear blur, Appendix A): sample ``n`` of the path sits ``n`` steps along the displacement, so the
 path starts at the pixel and runs one way, a uniform average over ``[0, d]``. A resonance instead oscillates about
 the rest position: ``sinusoidal_motion`` is the path ``(d / 2) sin(w t)``, centred, its dwell time arcsine-weighted
-toward both turning points.
+toward both turning points. The blur averages light: ``sensor_gamma`` averages it in the linear light of a power
+law, ``tone_shoulder`` in that of a tone curve with a highlight shoulder (calibration/tone.py), its alternative.
 """
 
 from __future__ import annotations
@@ -13,7 +14,14 @@ import torch
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, fit_least_squares
 from lerobot_phantom.calibration.frame_models.common import SENSOR_GAMMA, FrameProblem, Pair
-from lerobot_phantom.calibration.tone import GAMMA_PARAM, SHOULDER_PARAMS, decode_encode
+from lerobot_phantom.calibration.tone import (
+    GAMMA_PARAM,
+    SHOULDER_PARAMS,
+    TONE_PARAMS,
+    decode_encode,
+    equivalent_power_gamma,
+    implied_gamma_statistic,
+)
 from lerobot_phantom.transforms import physics
 
 PATH_PARAMS = ("dx_ref_px", "dy_ref_px")
@@ -40,6 +48,17 @@ BLUR_EFFECTS = (
         "turning points, an arcsine-weighted blur path instead of a uniform line average",
     ),
     SENSOR_GAMMA,
+    Effect(
+        "tone_shoulder",
+        "the camera's tone curve rolls off towards white (a filmic / log-logistic shoulder, calibration/tone.py): "
+        "the motion averages light in linear irradiance, and a shouldered curve holds more light in a highlight "
+        "than a power law reads from its grey level, so a blurred edge between bright and dark surfaces stays "
+        "brighter than a power law's average predicts",
+        excludes=("sensor_gamma",),
+        # a shouldered curve decodes pixels to linear light as the power law does (tone.py): it is a gamma
+        # encoding too, judged by its equivalent power-law gamma
+        implies=("sensor_gamma",),
+    ),
 )
 
 
@@ -74,18 +93,29 @@ class BlurFrames(FrameProblem):
         ]
         if "sensor_gamma" in effects:
             specs.append(GAMMA_PARAM)
+        if "tone_shoulder" in effects:
+            specs += list(SHOULDER_PARAMS)
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
-        return {"gamma": 1.0} if effect == "sensor_gamma" else {}  # the base blurs the encoded values
+        if effect == "sensor_gamma":  # the base blurs the encoded values
+            return {"gamma": 1.0}
+        if effect == "tone_shoulder":  # a knee at infinite light: the encoded values again (tone.py)
+            return {"shoulder": 0.0}
+        return {}
+
+    def implied_statistic(
+        self, effect: str, implied: str, params: dict[str, float]
+    ) -> tuple[str, float, float]:
+        return implied_gamma_statistic(effect, implied, params)
 
     def blur(self, effects, params, index: int) -> torch.Tensor:
         if "sinusoidal_motion" in effects:
             offsets = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
         else:  # the paper's one-way path: offsets in [0, 1] of the displacement
             offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64) + 0.5
-        gamma = params.get("gamma") if "sensor_gamma" in effects else 1.0
-        return self.path_blur(params, index, offsets, gamma)
+        gamma = params["gamma"] if "sensor_gamma" in effects else 1.0
+        return self.path_blur(params, index, offsets, gamma, shoulder="tone_shoulder" in effects)
 
     def path_blur(
         self, params, index: int, offsets: torch.Tensor, gamma, shoulder: bool = False
@@ -114,7 +144,11 @@ class BlurFrames(FrameProblem):
         # the blur displacement is far from convex (textures alias): start from the best points of PATH_GRID,
         # scored on a few pairs, besides any nested model's fit
         grid = PATH_GRID
-        base = {"gamma": torch.tensor(2.2, dtype=torch.float64)} if "sensor_gamma" in effects else {}
+        base = {
+            p.name: torch.tensor(p.init, dtype=torch.float64)
+            for p in self.param_specs(effects)
+            if p.name not in PATH_PARAMS
+        }
         probe = items[:3]
 
         def probe_cost(params):
@@ -183,12 +217,12 @@ class BlurFrames(FrameProblem):
         attacked frames of ``items`` when added to the fitted blur (in the same light, every other parameter held)."""
         length = float(np.hypot(fit.params["dx_ref_px"], fit.params["dy_ref_px"]))
         across = np.array([-fit.params["dy_ref_px"], fit.params["dx_ref_px"]]) / max(length, 1e-9)
-        gamma = fit.params.get("gamma", 1.0)
+        decode, encode = decode_encode(
+            fit.params, "tone_shoulder" in fit.effects, fit.params.get("gamma", 1.0)
+        )
         offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
         with torch.no_grad():
-            along = {
-                int(i): physics.decode(self.predict_pair(fit, int(i)).unsqueeze(0), gamma) for i in items
-            }
+            along = {int(i): decode(self.predict_pair(fit, int(i)).unsqueeze(0)) for i in items}
 
         def errors(p):
             parts = []
@@ -196,7 +230,7 @@ class BlurFrames(FrameProblem):
                 pair = self.pairs[i]
                 width = p["across_share"] * length * pair.intensity / pair.to_reference
                 spread = physics.line_blur(blurred, width * across[0], width * across[1], offsets)
-                parts.append((physics.encode(spread, gamma)[0] - pair.attacked).ravel())
+                parts.append((encode(spread)[0] - pair.attacked).ravel())
             return torch.cat(parts)
 
         # a disc is fitted by a width near its diameter, a motion's sampling by a fraction of that: start from both
@@ -229,8 +263,9 @@ class BlurFrames(FrameProblem):
                 ]
             )
 
-        held = {name: fit.params[name] for name in PATH_PARAMS}
-        held["gamma"] = fit.params.get("gamma", GAMMA_PARAM.init)
+        # started from the fit's own tone curve (a shoulder's under the display gamma 1 it was fitted with)
+        held = {name: fit.params[name] for name in (*PATH_PARAMS, *TONE_PARAMS) if name in fit.params}
+        held.setdefault("gamma", 1.0 if "tone_shoulder" in fit.effects else GAMMA_PARAM.init)
         return fit_dwell_share(
             [*self.param_specs(frozenset({"sensor_gamma"})), *SHOULDER_PARAMS], errors, held
         )
@@ -296,6 +331,8 @@ class BlurFrames(FrameProblem):
             kwargs["path"] = "sinusoidal"
         if "sensor_gamma" in fit.effects:
             kwargs["gamma"] = fit.params["gamma"]
+        if "tone_shoulder" in fit.effects:  # the transform knows power laws only: the closest one
+            kwargs["gamma"] = equivalent_power_gamma(fit.params)
         return kwargs
 
     def derived(self, fit: Fit) -> dict:
