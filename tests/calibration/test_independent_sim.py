@@ -492,8 +492,8 @@ def case_camera(case: Case, seed: int | None = None) -> tuple[int, np.random.Gen
     return seed, rng, random_camera(rng, **overrides)
 
 
-def drawn_problem(name: str, case_seed: int, folder):
-    """The case's frames at ``case_seed``, read as the calibration CLI reads them, and its fit pairs."""
+def drawn_split(name: str, case_seed: int, folder):
+    """The case's frames at ``case_seed``, read as the calibration CLI reads them, its fit and held-out pairs."""
     case = CASE_BY_NAME[name]
     _, rng, camera = case_camera(case, case_seed)
     cs.write_pairs(folder, case.render(rng, camera))
@@ -501,7 +501,12 @@ def drawn_problem(name: str, case_seed: int, folder):
         attack=case.attack, measured=str(folder), out=str(folder / "out"), seed=case_seed % 2**31
     )
     problem = build_problem(cfg)
-    fit_items, _ = seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+    return problem, *seeded_split(problem.n_items, cfg.heldout, cfg.seed)
+
+
+def drawn_problem(name: str, case_seed: int, folder):
+    """The case's frames at ``case_seed``, read as the calibration CLI reads them, and its fit pairs."""
+    problem, fit_items, _ = drawn_split(name, case_seed, folder)
     return problem, fit_items
 
 
