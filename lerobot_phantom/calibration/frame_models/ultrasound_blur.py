@@ -51,9 +51,9 @@ BLUR_EFFECTS = (
     Effect(
         "tone_shoulder",
         "the camera's tone curve rolls off towards white (a filmic / log-logistic shoulder, calibration/tone.py): "
-        "the motion averages light in linear irradiance, and a shouldered curve holds more light in a highlight "
-        "than a power law reads from its grey level, so a blurred edge between bright and dark surfaces stays "
-        "brighter than a power law's average predicts",
+        "the motion averages light in linear irradiance, and on such a curve a highlight's grey level stands for far "
+        "more light than a power law reads from it, so a blurred edge between bright and dark surfaces averages to "
+        "grey levels no power law predicts",
         excludes=("sensor_gamma",),
         # a shouldered curve decodes pixels to linear light as the power law does (tone.py): it is a gamma
         # encoding too, judged by its equivalent power-law gamma
