@@ -49,6 +49,7 @@ from lerobot_phantom.calibration.tone import (
     implied_gamma_statistic,
     shoulder_decode,
     shoulder_encode,
+    tone_nulls,
 )
 
 TRIPLE_COLUMNS = tuple(f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb")
@@ -188,13 +189,9 @@ def projection_nulls(effect: str) -> dict[str, float]:
         return {n: 0.0 for n in CROSSTALK_NAMES if n[-2] != n[-1]}
     if effect == "clipping":  # saturation at the file's maximum is in every model
         return {"white": 1.0}
-    if effect == "sensor_gamma":
-        return {"gamma": 1.0}
-    if effect == "tone_shoulder":  # a knee at infinite light: the power law (or identity) without it
-        return {"shoulder": 0.0}
     if effect == "light_spread":
         return {"spread_ref_px": 0.0}
-    return {}
+    return tone_nulls(effect)
 
 
 def tone_curve(effects, params: dict):

@@ -82,6 +82,13 @@ def equivalent_power_gamma(params: dict, gamma=None) -> float:
     return float(grid[int(np.argmin(errors))])
 
 
+def tone_nulls(effect: str) -> dict[str, float]:
+    """Where a tone-curve form reduces to a model that composes the encoded values themselves: ``sensor_gamma`` at
+    the power 1, ``tone_shoulder`` with its knee at infinite light (shoulder 0: the power law, the identity under the
+    display gamma 1); {} for any other effect."""
+    return {"sensor_gamma": {"gamma": 1.0}, "tone_shoulder": {"shoulder": 0.0}}.get(effect, {})
+
+
 def implied_gamma_statistic(effect: str, implied: str, params: dict[str, float]) -> tuple[str, float, float]:
     """A shouldered curve's gamma encoding: the power-law gamma closest to it (null 1, linear pixel values)."""
     if (effect, implied) != ("tone_shoulder", "sensor_gamma"):

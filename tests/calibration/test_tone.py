@@ -17,10 +17,12 @@ from lerobot_phantom.calibration.projection import (
 )
 from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
+    decode_encode,
     equivalent_power_gamma,
     implied_gamma_statistic,
     shoulder_decode,
     shoulder_encode,
+    tone_nulls,
 )
 
 CURVES = [
@@ -46,6 +48,20 @@ def test_a_shoulder_of_zero_is_the_power_law():
     curve = shoulder_encode(linear, {"shoulder": 0.0, "shoulder_exponent": 2.7}, 2.2)
     assert torch.allclose(curve, linear.clamp(min=1e-12) ** (1 / 2.2), atol=1e-9)
     assert projection_nulls("tone_shoulder") == {"shoulder": 0.0}
+
+
+@pytest.mark.parametrize("effect", ["sensor_gamma", "tone_shoulder"])
+def test_a_tone_forms_null_value_stores_light_as_it_is(effect):
+    """At ``tone_nulls``' value either form of the curve is the identity (under the display gamma 1 the shoulder is
+    fitted with), which the models without a tone curve compose: the blur's, the stripe's and projection's base."""
+    linear = torch.linspace(0.0, 1.0, 101, dtype=torch.float64)
+    params = {"gamma": 2.2, "shoulder": 5.0, "shoulder_exponent": 2.7, **tone_nulls(effect)}
+    shoulder = effect == "tone_shoulder"
+    decode, encode = decode_encode(params, shoulder, 1.0 if shoulder else params["gamma"])
+    assert torch.allclose(encode(linear), linear.clamp(min=1e-12), atol=1e-9)
+    assert torch.allclose(decode(linear), linear.clamp(min=1e-12), atol=1e-9)
+    assert projection_nulls(effect) == tone_nulls(effect)
+    assert tone_nulls("clipping") == {}
 
 
 def test_a_shoulder_compresses_the_highlights():

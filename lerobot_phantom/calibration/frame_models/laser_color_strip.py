@@ -23,6 +23,7 @@ from lerobot_phantom.calibration.tone import (
     decode_encode,
     equivalent_power_gamma,
     implied_gamma_statistic,
+    tone_nulls,
 )
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.laser_color_strip import band_rows, strip_profile
@@ -116,11 +117,7 @@ class StripFrames(LatentFrameProblem):
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
-        if effect == "sensor_gamma":  # the stripe adds to the encoded values
-            return {"gamma": 1.0}
-        if effect == "tone_shoulder":  # a knee at infinite light: the power law of gamma 1 (tone.py)
-            return {"shoulder": 0.0}
-        return {}
+        return tone_nulls(effect)  # the stripe adds to the encoded values
 
     def implied_statistic(
         self, effect: str, implied: str, params: dict[str, float]

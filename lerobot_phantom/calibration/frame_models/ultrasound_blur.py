@@ -21,6 +21,7 @@ from lerobot_phantom.calibration.tone import (
     decode_encode,
     equivalent_power_gamma,
     implied_gamma_statistic,
+    tone_nulls,
 )
 from lerobot_phantom.transforms import physics
 
@@ -98,11 +99,7 @@ class BlurFrames(FrameProblem):
         return specs
 
     def null_values(self, effect: str) -> dict[str, float]:
-        if effect == "sensor_gamma":  # the base blurs the encoded values
-            return {"gamma": 1.0}
-        if effect == "tone_shoulder":  # a knee at infinite light: the encoded values again (tone.py)
-            return {"shoulder": 0.0}
-        return {}
+        return tone_nulls(effect)  # the base blurs the encoded values
 
     def implied_statistic(
         self, effect: str, implied: str, params: dict[str, float]
