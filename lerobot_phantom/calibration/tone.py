@@ -74,10 +74,12 @@ def shoulder_encode(linear: torch.Tensor, params: dict, gamma=None) -> torch.Ten
 
 def equivalent_power_gamma(params: dict, gamma=None) -> float:
     """The power-law gamma closest to the fitted curve in encoded values over the whole range (least squares on a
-    grid): what a consumer that knows only power laws (the attack transforms) can be given."""
+    grid of 0.005 steps): what a consumer that knows only power laws (the attack transforms) can be given. The grid
+    reaches 10: the shoulders fitted to filmic blurs (camsim's ACES curve on a 4x pre-gain, its knee far below the
+    full well) are closest to gammas of 5.39-6.18, where a grid ending at 5 gave its end (docs/bench/session86.md)."""
     x = torch.linspace(0.0, 1.0, 257, dtype=torch.float64)
     curve = shoulder_encode(x, {k: float(v) for k, v in params.items()}, gamma).numpy()
-    grid = np.linspace(0.3, 5.0, 941)
+    grid = np.linspace(0.3, 10.0, 1941)
     errors = [np.mean((x.numpy() ** (1.0 / g) - curve) ** 2) for g in grid]
     return float(grid[int(np.argmin(errors))])
 

@@ -147,6 +147,11 @@ def test_only_the_declared_implication_has_a_statistic():
 def test_the_transform_gets_the_closest_power_law():
     params = {"shoulder": 0.0, "shoulder_exponent": 1.0}
     assert equivalent_power_gamma(params, 1.8) == pytest.approx(1.8, abs=0.01)
+    # a filmic blur's fitted shoulder (camsim 1168502096, docs/bench/session86/transform_gamma_c28d9a6.txt) is
+    # closest to a gamma above 5
+    assert equivalent_power_gamma({"shoulder": 16.938, "shoulder_exponent": 0.95}) == pytest.approx(
+        6.18, abs=0.01
+    )
     fit = Fit(
         frozenset({"additive_light", "tone_shoulder"}),
         {"strength": 0.5, "shoulder": 40.0, "shoulder_exponent": 1.2},
