@@ -531,6 +531,9 @@ def test_a_filmic_cameras_blur_is_averaged_in_the_light_of_its_shouldered_curve(
     for spec in SHOULDER_PARAMS:
         assert spec.low < shouldered.params[spec.name] < spec.high, (spec, shouldered.params)
     assert heldout_rmse(shouldered) < 0.9 * heldout_rmse(power_law)
+    # the resonance's checks read the shouldered fit in its own light: one path of the whole frame, that turns
+    # (its dwell 0.230 in docs/bench/session86/dwell_profile_26847be.txt)
+    assert problem.identification_checks("sinusoidal_motion", shouldered, fit_items) == []
     # the attack transform knows power laws: it is given the curve's closest one, which compresses light more than
     # sRGB does (camsim's filmic curve, a 4x pre-gain under ACES, stores 12% of the full well at 82% of white)
     assert problem.transform_kwargs(shouldered)["gamma"] > GAMMA_PARAM.init

@@ -1,8 +1,9 @@
 """How well a blur draw's frames measure its dwell: the profile of ``BlurFrames.dwell_share``'s fit. At each fixed
 share (0: a constant-speed sweep's uniform dwell, 1: a sinusoid's arcsine) the path and the shouldered tone curve
-are refitted on the calibration's fit pairs, as the package's read refits them, started from the resonance fitted
-with ``tone_shoulder``; the fit's RMSE is printed per share, beside the package's own read and where the clean
-frames' grey levels lie (a filmic camera stores its scene high on its curve, where contrast is compressed).
+are refitted on the calibration's fit pairs by the package's own residuals (``BlurFrames.dwell_residuals``,
+``dwell_specs``, ``dwell_start``), started from the resonance fitted with ``tone_shoulder``; the fit's RMSE is
+printed per share, beside the package's own read and where the clean frames' grey levels lie (a filmic camera
+stores its scene high on its curve, where contrast is compressed).
 
 Usage: ``PYTHONPATH=. python docs/bench/session86/dwell_profile.py CASE:CASE_SEED...`` (case seeds, as
 ``run_camsim_case.py`` prints them).
@@ -19,9 +20,6 @@ import numpy as np
 import torch
 
 from lerobot_phantom.calibration.core import fit_least_squares
-from lerobot_phantom.calibration.frame_models.ultrasound_blur import PATH_PARAMS
-from lerobot_phantom.calibration.tone import SHOULDER_PARAMS
-from lerobot_phantom.transforms import physics
 
 SHARES = np.linspace(0.0, 1.0, 11)
 RESONANCE = frozenset({"sinusoidal_motion", "tone_shoulder"})
@@ -41,31 +39,19 @@ def profile(name: str, case_seed: int) -> None:
             f"{problem.dwell_share(fit, items):.3f}",
             flush=True,
         )
-        uniform = physics.blur_path_offsets("uniform", problem.taps, dtype=torch.float64)
-        arcsine = physics.blur_path_offsets("sinusoidal", problem.taps, dtype=torch.float64)
-        specs = [*problem.param_specs(frozenset({"sensor_gamma"})), *SHOULDER_PARAMS]
-        start = {
-            k: v for k, v in fit.params.items() if k in (*PATH_PARAMS, *(p.name for p in SHOULDER_PARAMS))
-        }
-        start["gamma"] = 1.0  # the display gamma the shoulder was fitted under
+        specs, start = problem.dwell_specs(), problem.dwell_start(fit)
         rmse = []
         for share in SHARES:
-            offsets = (1 - share) * uniform + share * arcsine
-
-            def errors(p, offsets=offsets):
-                return torch.cat(
-                    [
-                        (
-                            problem.path_blur(p, int(i), offsets, p["gamma"], shoulder=True)
-                            - problem.pairs[int(i)].attacked
-                        ).ravel()
-                        for i in items
-                    ]
-                )
-
-            p = fit_least_squares(specs, errors, warm=start, jacobian="2-point", max_nfev=60)
+            p = fit_least_squares(
+                specs,
+                lambda p, share=float(share): problem.dwell_residuals(p, items, share),
+                warm=start,
+                jacobian="2-point",
+                max_nfev=60,
+            )
             with torch.no_grad():
-                residual = errors({k: torch.tensor(v, dtype=torch.float64) for k, v in p.items()})
+                params = {k: torch.tensor(v, dtype=torch.float64) for k, v in p.items()}
+                residual = problem.dwell_residuals(params, items, float(share))
             rmse.append(255 * float(residual.pow(2).mean().sqrt()))
             print(
                 f"  share {share:.1f}: RMSE {rmse[-1]:.3f}, path {np.hypot(p['dx_ref_px'], p['dy_ref_px']):.1f} ref px",

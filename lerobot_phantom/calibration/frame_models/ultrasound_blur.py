@@ -245,26 +245,38 @@ class BlurFrames(FrameProblem):
         (docs/bench/session84.md), and on a filmic camera, whose highlights roll off, a uniform sweep as a partly
         turning one (camsim's triangle wave: up to 0.300 with a power law, 0.000 on every filmic draw with the
         shoulder; docs/bench/session85.md)."""
+        return fit_dwell_share(
+            self.dwell_specs(),
+            lambda p: self.dwell_residuals(p, items, p["dwell_share"]),
+            self.dwell_start(fit),
+        )
+
+    def dwell_specs(self) -> list[Param]:
+        """The parameters refitted with the dwell share: the path and a power law with a highlight shoulder."""
+        return [*self.param_specs(frozenset({"sensor_gamma"})), *SHOULDER_PARAMS]
+
+    def dwell_start(self, fit: Fit) -> dict[str, float]:
+        """Where the dwell read starts its other parameters: ``fit``'s path and tone curve (a shoulder's under the
+        display gamma 1 it was fitted with)."""
+        start = {name: fit.params[name] for name in (*PATH_PARAMS, *TONE_PARAMS) if name in fit.params}
+        start.setdefault("gamma", 1.0 if "tone_shoulder" in fit.effects else GAMMA_PARAM.init)
+        return start
+
+    def dwell_residuals(self, params, items: np.ndarray, share) -> torch.Tensor:
+        """The clean frames of ``items`` blurred along the centred path whose samples sit ``share`` of the way from
+        a uniform dwell (0) to the arcsine (1), in the shouldered tone curve and path of ``params``
+        (``dwell_specs``), minus their attacked frames."""
         uniform = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64)
         arcsine = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
-
-        def errors(p):
-            offsets = (1 - p["dwell_share"]) * uniform + p["dwell_share"] * arcsine
-            return torch.cat(
-                [
-                    (
-                        self.path_blur(p, int(i), offsets, p["gamma"], shoulder=True)
-                        - self.pairs[int(i)].attacked
-                    ).ravel()
-                    for i in items
-                ]
-            )
-
-        # started from the fit's own tone curve (a shoulder's under the display gamma 1 it was fitted with)
-        held = {name: fit.params[name] for name in (*PATH_PARAMS, *TONE_PARAMS) if name in fit.params}
-        held.setdefault("gamma", 1.0 if "tone_shoulder" in fit.effects else GAMMA_PARAM.init)
-        return fit_dwell_share(
-            [*self.param_specs(frozenset({"sensor_gamma"})), *SHOULDER_PARAMS], errors, held
+        offsets = (1 - share) * uniform + share * arcsine
+        return torch.cat(
+            [
+                (
+                    self.path_blur(params, int(i), offsets, params["gamma"], shoulder=True)
+                    - self.pairs[int(i)].attacked
+                ).ravel()
+                for i in items
+            ]
         )
 
     def identification_checks(self, effect: str, fit: Fit, items: np.ndarray) -> list[str]:
