@@ -80,7 +80,8 @@ def equivalent_power_gamma(params: dict, gamma=None) -> float:
     x = torch.linspace(0.0, 1.0, 257, dtype=torch.float64)
     curve = shoulder_encode(x, {k: float(v) for k, v in params.items()}, gamma).numpy()
     grid = np.linspace(0.3, 10.0, 1941)
-    errors = [np.mean((x.numpy() ** (1.0 / g) - curve) ** 2) for g in grid]
+    # identification calls this once per bootstrap draw: every gamma of the grid in one array
+    errors = np.mean((x.numpy()[None, :] ** (1.0 / grid[:, None]) - curve) ** 2, axis=1)
     return float(grid[int(np.argmin(errors))])
 
 
