@@ -45,10 +45,10 @@ from lerobot_phantom.calibration.structure import NeighbourPairs, ResidualSample
 from lerobot_phantom.calibration.tone import (
     GAMMA_PARAM,
     SHOULDER_PARAMS,
-    equivalent_power_gamma,
     implied_gamma_statistic,
     shoulder_decode,
     shoulder_encode,
+    shoulder_kwargs,
     tone_nulls,
 )
 
@@ -284,9 +284,8 @@ def projection_kwargs(fit: Fit) -> dict:
         "reflectance_floor": p.get("reflectance_floor", 0.0),
         "gamma": p.get("gamma", 1.0),
     }
-    if "tone_shoulder" in effects:
-        # the transform knows power laws only: it gets the one closest to the fitted shoulder curve
-        kwargs["gamma"] = equivalent_power_gamma(p, p.get("gamma"))
+    if "tone_shoulder" in effects:  # the fitted curve itself, under its display gamma
+        kwargs.update(shoulder_kwargs(p, kwargs["gamma"]))
     if "channel_crosstalk" in effects:  # builds on additive light: the matrix carries the light's scale
         kwargs["crosstalk"] = [[p[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)]
     if "projector_gamma" in p:

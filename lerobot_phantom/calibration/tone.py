@@ -33,9 +33,6 @@ import torch
 from lerobot_phantom.calibration.core import Param
 from lerobot_phantom.transforms import physics
 
-# x ** n at x = 0 has an undefined derivative in n (0 * log 0); the darkest modelled light is one part in 1e12
-TINY = 1e-12
-
 SHOULDER_PARAMS = (
     # the knee's half-saturation light E_50 = s ** (-1 / n): s = 0.05 puts it ~20x above white (a barely bent
     # curve), s = 500 a few hundredths of white; beyond either end the curve is a power law or a hard clip
@@ -51,30 +48,28 @@ GAMMA_PARAM = Param("gamma", 2.2, 1.0, 4.0, scale=1.0)
 TONE_PARAMS = ("gamma", *(p.name for p in SHOULDER_PARAMS))
 
 
-def _parts(params: dict, gamma) -> tuple:
-    s = params["shoulder"]
-    n = params["shoulder_exponent"]
-    return s, n, (1.0 if gamma is None else gamma)
+def shoulder_curve(params: dict, gamma=None) -> physics.ShoulderCurve:
+    """The shoulder ``params`` holds (``shoulder``, ``shoulder_exponent``; floats or tensors) under the display power
+    law ``gamma`` (None: 1) as the curve the attacks compose light in (``physics.ShoulderCurve``)."""
+    return physics.ShoulderCurve(
+        params["shoulder"], params["shoulder_exponent"], 1.0 if gamma is None else gamma
+    )
 
 
 def shoulder_decode(encoded: torch.Tensor, params: dict, gamma=None) -> torch.Tensor:
     """Encoded pixel values in [0, 1] -> linear light in [0, 1] (the inverse of :func:`shoulder_encode`)."""
-    s, n, g = _parts(params, gamma)
-    u = encoded.clamp(TINY, 1.0) ** (g * n)
-    return (u / (1.0 + s - s * u)) ** (1.0 / n)
+    return shoulder_curve(params, gamma).decode(encoded)
 
 
 def shoulder_encode(linear: torch.Tensor, params: dict, gamma=None) -> torch.Tensor:
     """Linear light -> encoded pixel values (light beyond the sensor's saturation is clipped first)."""
-    s, n, g = _parts(params, gamma)
-    xn = linear.clamp(TINY, 1.0) ** n
-    u = (1.0 + s) * xn / (1.0 + s * xn)
-    return u ** (1.0 / (n * g))
+    return shoulder_curve(params, gamma).encode(linear)
 
 
 def equivalent_power_gamma(params: dict, gamma=None) -> float:
     """The power-law gamma closest to the fitted curve in encoded values over the whole range (least squares on a
-    grid of 0.005 steps): what a consumer that knows only power laws (the attack transforms) can be given. The grid
+    grid of 0.005 steps): the gamma encoding a shoulder implies, whose interval identification reads (the attack
+    transforms take the shoulder itself, ``shoulder_kwargs``; until session 87 they took this gamma). The grid
     reaches 10: the shoulders fitted to filmic blurs (camsim's ACES curve on a 4x pre-gain, its knee far below the
     full well) are closest to gammas of 5.39-6.18, where a grid ending at 5 gave its end (docs/bench/session86.md)."""
     x = torch.linspace(0.0, 1.0, 257, dtype=torch.float64)
@@ -83,6 +78,16 @@ def equivalent_power_gamma(params: dict, gamma=None) -> float:
     # identification calls this once per bootstrap draw: every gamma of the grid in one array
     errors = np.mean((x.numpy()[None, :] ** (1.0 / grid[:, None]) - curve) ** 2, axis=1)
     return float(grid[int(np.argmin(errors))])
+
+
+def shoulder_kwargs(params: dict, gamma=None) -> dict[str, float | None]:
+    """The attack transforms' options for the shoulder ``params`` holds under the display power law ``gamma``
+    (None: 1): ``gamma``, ``shoulder``, ``shoulder_exponent`` (``physics.tone_options``)."""
+    return {
+        "gamma": None if gamma is None else float(gamma),
+        "shoulder": float(params["shoulder"]),
+        "shoulder_exponent": float(params["shoulder_exponent"]),
+    }
 
 
 def tone_nulls(effect: str) -> dict[str, float]:
@@ -105,8 +110,5 @@ def decode_encode(params: dict, shoulder: bool, gamma):
     """(decode, encode) between pixel values and linear light, clipped at the sensor's full well: the fitted
     shoulder of ``params`` under the display gamma ``gamma`` when ``shoulder``, else ``physics``' power law of
     exponent ``gamma`` (None: sRGB; 1: the encoded values themselves)."""
-    if shoulder:
-        return partial(shoulder_decode, params=params, gamma=gamma), partial(
-            shoulder_encode, params=params, gamma=gamma
-        )
-    return partial(physics.decode, gamma=gamma), partial(physics.encode, gamma=gamma)
+    tone = shoulder_curve(params, gamma) if shoulder else gamma
+    return partial(physics.decode, gamma=tone), partial(physics.encode, gamma=tone)

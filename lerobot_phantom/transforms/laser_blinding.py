@@ -98,6 +98,9 @@ class LaserPhysics:
     glare_scale_ref_px: float = 8.0
     auto_exposure: float = 0.0
     gamma: float | None = None
+    # a tone curve whose highlights roll off (physics.ShoulderCurve) under the display power ``gamma`` (None: 1)
+    shoulder: float | None = None
+    shoulder_exponent: float = 1.0
     # deviation of the log of each sample's laser power factor (the frames' exposures; module docstring)
     exposure_spread: float = 0.0
     # the camera's colour correction matrix (9 numbers, row-major, rows summing to 1) mixing its clipped raw
@@ -115,6 +118,7 @@ class LaserPhysics:
             raise ValueError(
                 "gain, glare_amplitude, auto_exposure and exposure_spread must be >= 0 and glare_scale_ref_px > 0"
             )
+        self.tone  # noqa: B018 -- the shoulder options are checked where they are given
         if self.colour_correction is not None:
             matrix = torch.tensor(self.colour_correction, dtype=torch.float64)
             if matrix.numel() != 9 or not torch.allclose(
@@ -125,6 +129,12 @@ class LaserPhysics:
                     "whose rows sum to 1"
                 )
             object.__setattr__(self, "colour_correction", tuple(float(v) for v in self.colour_correction))
+
+    @property
+    def tone(self) -> physics.Tone:
+        """The tone curve the light is composed in: sRGB (``gamma`` None), the power law ``gamma``, or with
+        ``shoulder`` the shouldered curve under the display power ``gamma`` (None: 1)."""
+        return physics.tone_options(self.gamma, self.shoulder, self.shoulder_exponent, owner="LaserBlinding")
 
 
 def _options(kind: type, given: Any, flat: dict[str, Any]) -> Any:
@@ -471,7 +481,7 @@ class LaserBlinding(CameraAttack):
             halo_exponent=p.glare_exponent,
             halo_scale_px=p.glare_scale_ref_px * max(height, width) / 256.0,
             auto_exposure=p.auto_exposure,
-            gamma=p.gamma,
+            gamma=p.tone,
             colour_correction=None
             if p.colour_correction is None
             else torch.tensor(p.colour_correction, dtype=torch.float64).reshape(3, 3),

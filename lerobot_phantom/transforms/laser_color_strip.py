@@ -28,8 +28,9 @@ saturating add of the rounded increment), so the output is rounded instead of tr
 
 ``model="rolling_shutter"`` (fitted by ``lerobot-phantom-calibrate``) replaces the band by the rows a pulsed laser
 lights through a rolling shutter (``physics.rolling_shutter_row_light``) at a random pulse phase per sample; with
-``gamma`` its light adds in linear irradiance under the power-law tone curve ``x ** gamma``, so dark surfaces gain
-more grey levels than bright ones and the sum saturates at white.
+``gamma`` its light adds in linear irradiance under the power-law tone curve ``x ** gamma`` (with ``shoulder``, a
+tone curve whose highlights roll off, ``physics.ShoulderCurve``), so dark surfaces gain more grey levels than bright
+ones and the sum saturates at white.
 """
 
 from __future__ import annotations
@@ -166,6 +167,8 @@ class LaserColorStrip(CameraAttack):
         integration_offset_s: float = 0.0,
         edge_threshold: float = 0.0,
         gamma: float | None = None,
+        shoulder: float | None = None,
+        shoulder_exponent: float = 1.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
@@ -185,13 +188,15 @@ class LaserColorStrip(CameraAttack):
             raise ValueError(
                 "rolling shutter needs frequency_hz > 0, duty in (0, 1], exposure_s >= 0, row_time_s > 0"
             )
-        # gamma (rolling shutter only): the laser's light adds to the scene's in linear irradiance, the pixels
-        # decoded by the power law x ** gamma and re-encoded after (lerobot-phantom-calibrate's sensor_gamma)
-        if gamma is not None and (model != "rolling_shutter" or not gamma > 0):
+        # gamma / shoulder (rolling shutter only): the laser's light adds to the scene's in linear irradiance, the
+        # pixels decoded by the power law x ** gamma (lerobot-phantom-calibrate's sensor_gamma) or the shouldered
+        # curve (its tone_shoulder) and re-encoded after
+        self.tone = physics.tone_options(gamma, shoulder, shoulder_exponent, owner="LaserColorStrip")
+        if self.tone is not None and (model != "rolling_shutter" or not (gamma is None or gamma > 0)):
             raise ValueError(
-                f"gamma={gamma!r} needs model='rolling_shutter' and gamma > 0 (None: add to the encoded values)"
+                f"gamma={gamma!r}, shoulder={shoulder!r} need model='rolling_shutter' and gamma > 0 (None: add to "
+                "the encoded values)"
             )
-        self.gamma = None if gamma is None else float(gamma)
         self.model = model
         self.rolling_shutter = {
             "frequency_hz": float(frequency_hz),
@@ -273,10 +278,10 @@ class LaserColorStrip(CameraAttack):
         # the paper's peak gain 4 S / pi grey levels, spread over whole rows
         gain = params["strength"].reshape(-1, 1).to(x.device) * (4.0 / math.pi / 255.0)
         added = (gain * params["color_fractions"].reshape(-1, 3).to(x.device))[:, :, None, None]
-        if self.gamma is not None:
-            return physics.encode(physics.decode(x, self.gamma) + added * rows[:, None, :, None], self.gamma)
+        if self.tone is not None:
+            return physics.encode(physics.decode(x, self.tone) + added * rows[:, None, :, None], self.tone)
         return (x + added * rows[:, None, :, None]).clamp_(0.0, 1.0)
 
     def extra_repr(self) -> str:
-        gamma = "" if self.gamma is None else f", gamma={self.gamma:g}"
-        return f"{super().extra_repr()}, color_fractions={self.color_fractions}, model={self.model!r}{gamma}"
+        tone = "" if self.tone is None else f", tone={self.tone!r}"
+        return f"{super().extra_repr()}, color_fractions={self.color_fractions}, model={self.model!r}{tone}"

@@ -167,6 +167,8 @@ class LightProjection(CameraAttack):
         crosstalk: Sequence[Sequence[float]] | None = None,
         white: float = 1.0,
         gamma: float | None = 1.0,
+        shoulder: float | None = None,
+        shoulder_exponent: float = 1.0,
         projector_gamma: float | None = None,
         spread: float = 0.0,
         seed: int | None = None,
@@ -175,8 +177,9 @@ class LightProjection(CameraAttack):
         super().__init__(intensity, seed=seed, generator=generator)
         self.levels = check_levels(levels, "light projection transparency", upper=1.0)
         # model="additive"/"blend" (lerobot-phantom-calibrate): projector light at strength x intensity through
-        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve, the projector's own display
-        # transfer, spread over ``spread`` pixels at the 256-pixel reference, scaled by max(H, W) / 256)
+        # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve -- a power law or one with a
+        # highlight shoulder, physics.ShoulderCurve --, the projector's own display transfer, spread over ``spread``
+        # pixels at the 256-pixel reference, scaled by max(H, W) / 256)
         if model not in ("paper", "additive", "blend"):
             raise ValueError(f"unknown light projection model {model!r}; valid: 'paper', 'additive', 'blend'")
         if spread < 0.0 or (spread > 0.0 and model == "paper"):
@@ -190,7 +193,13 @@ class LightProjection(CameraAttack):
                 "pattern into light in the physical models (model='additive' or 'blend'); None decodes the "
                 "pattern with the camera's gamma"
             )
-        matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float32)
+        if shoulder is not None and model == "paper":
+            raise ValueError(
+                f"shoulder={shoulder!r} bends the tone curve the physical models (model='additive' or 'blend') "
+                "compose light in; the paper's watermark blends the encoded values"
+            )
+        # kept as fitted: the light model casts it to each image's dtype
+        matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float64)
         if matrix is not None and matrix.shape != (3, 3):
             raise ValueError(f"crosstalk must be a 3x3 matrix, got shape {tuple(matrix.shape)}")
         self.model = model
@@ -200,7 +209,9 @@ class LightProjection(CameraAttack):
             "reflectance_floor": float(reflectance_floor),
             "crosstalk": matrix,
             "white": float(white),
-            "gamma": None if gamma is None else float(gamma),
+            "tone": physics.tone_options(
+                None if gamma is None else float(gamma), shoulder, shoulder_exponent, owner="LightProjection"
+            ),
             "projector_gamma": None if projector_gamma is None else float(projector_gamma),
             "spread": float(spread),
         }
@@ -280,24 +291,31 @@ class LightProjection(CameraAttack):
         rgba = self.watermark(height, width, x.device)
         top, left = placement(height, width, rgba.shape[-2], rgba.shape[-1], params["offset"].to(x.device))
         if self.model != "paper":
-            p = self.physical
             projected = composite(
                 torch.zeros_like(x), rgba, torch.ones_like(params["transparency"]), top, left
             )
-            return physics.project_light(
-                x,
-                projected,
-                params["intensity"].to(x.device) * p["strength"],
-                albedo=p["albedo"],
-                reflectance_floor=p["reflectance_floor"],
-                crosstalk=p["crosstalk"],
-                white=p["white"],
-                gamma=p["gamma"],
-                projector_gamma=p["projector_gamma"],
-                spread_px=p["spread"] * max(height, width) / REFERENCE_SIZE,
-                blend=self.model == "blend",
-            )
+            return self.project(x, projected, params["intensity"].to(x.device))
         return composite(x, rgba, params["transparency"], top, left)
+
+    def project(self, x: torch.Tensor, projected: torch.Tensor, intensity: torch.Tensor) -> torch.Tensor:
+        """The physical models' light (``model`` 'additive' or 'blend'): the projector sent ``projected``
+        (``(B, 3, H, W)``, black where it sends nothing) at ``intensity`` per sample, onto the scene ``x``."""
+        if self.model == "paper":
+            raise ValueError("project() is the physical models' light; the paper's watermark is a composite")
+        p = self.physical
+        return physics.project_light(
+            x,
+            projected,
+            intensity * p["strength"],
+            albedo=p["albedo"],
+            reflectance_floor=p["reflectance_floor"],
+            crosstalk=p["crosstalk"],
+            white=p["white"],
+            gamma=p["tone"],
+            projector_gamma=p["projector_gamma"],
+            spread_px=p["spread"] * max(x.shape[-2:]) / REFERENCE_SIZE,
+            blend=self.model == "blend",
+        )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         """The paper's composite on uint8 ``(N, 3, H, W)``: a copy of the frame, blended only under the watermark.

@@ -14,6 +14,7 @@ Images are ``(B, 3, H, W)`` in [0, 1].
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import torch
 import torch.nn.functional as F
@@ -34,17 +35,83 @@ def linear_to_srgb(x: torch.Tensor) -> torch.Tensor:
     return torch.where(x <= 0.0031308, 12.92 * x, 1.055 * x.clamp(min=0.0031308) ** (1.0 / 2.4) - 0.055)
 
 
-def decode(x: torch.Tensor, gamma: float | torch.Tensor | None) -> torch.Tensor:
-    """Encoded pixel values -> linear light: sRGB when ``gamma`` is None, else a pure power law ``x ** gamma``."""
+# x ** n at x = 0 has an undefined derivative in n (0 * log 0): the darkest light a shoulder curve models
+SHOULDER_TINY = 1e-12
+
+
+@dataclass(frozen=True)
+class ShoulderCurve:
+    """A camera tone curve whose highlights roll off instead of clipping (film, "filmic" ISP tone mapping): the
+    normalised log-logistic (Naka-Rushton) response under a display power law,
+
+        u = (1 + s) x**n / (1 + s x**n),     pixel = u ** (1 / (n gamma)),
+
+    ``s = shoulder`` >= 0 its strength (0: the power law ``gamma``), ``n = exponent`` > 0 the knee's sharpness; the
+    sensor's saturation (x = 1) stays the file's white. ``lerobot-phantom-calibrate`` fits it as ``tone_shoulder``
+    (calibration/tone.py holds the physics); the attacks take it wherever they take a ``gamma``. Fields may be
+    tensors (a fit differentiates through them)."""
+
+    shoulder: float | torch.Tensor
+    exponent: float | torch.Tensor = 1.0
+    gamma: float | torch.Tensor = 1.0
+
+    def decode(self, encoded: torch.Tensor) -> torch.Tensor:
+        """Encoded pixel values in [0, 1] -> linear light in [0, 1] (closed form: the curve is invertible)."""
+        s, n = self.shoulder, self.exponent
+        u = encoded.clamp(SHOULDER_TINY, 1.0) ** (self.gamma * n)
+        return (u / (1.0 + s - s * u)) ** (1.0 / n)
+
+    def encode(self, linear: torch.Tensor) -> torch.Tensor:
+        """Linear light -> encoded pixel values (light beyond the sensor's saturation is clipped first)."""
+        s, n = self.shoulder, self.exponent
+        xn = linear.clamp(SHOULDER_TINY, 1.0) ** n
+        return ((1.0 + s) * xn / (1.0 + s * xn)) ** (1.0 / (n * self.gamma))
+
+
+Tone = float | torch.Tensor | ShoulderCurve | None
+
+
+def tone_options(
+    gamma: float | None, shoulder: float | None, shoulder_exponent: float, *, owner: str
+) -> Tone:
+    """An attack's tone options as one curve: ``gamma`` alone, or the shoulder under the display power ``gamma``
+    (None: 1, the pixel values themselves). ``owner`` names the attack in the error."""
+    if shoulder is None:
+        if float(shoulder_exponent) != 1.0:
+            raise ValueError(
+                f"{owner}: shoulder_exponent={shoulder_exponent!r} needs shoulder= (a number >= 0)"
+            )
+        return gamma
+    display = 1.0 if gamma is None else float(gamma)
+    if not (
+        math.isfinite(float(shoulder))
+        and float(shoulder) >= 0.0
+        and float(shoulder_exponent) > 0.0
+        and display > 0.0
+    ):
+        raise ValueError(
+            f"{owner}: shoulder={shoulder!r}, shoulder_exponent={shoulder_exponent!r}, gamma={gamma!r}; valid: a "
+            "finite shoulder >= 0 (0: no shoulder), an exponent > 0 and a display gamma > 0 (None: 1)"
+        )
+    return ShoulderCurve(float(shoulder), float(shoulder_exponent), display)
+
+
+def decode(x: torch.Tensor, gamma: Tone) -> torch.Tensor:
+    """Encoded pixel values -> linear light: sRGB when ``gamma`` is None, a pure power law ``x ** gamma``, or a
+    ``ShoulderCurve``'s inverse."""
     if gamma is None:
         return srgb_to_linear(x)
+    if isinstance(gamma, ShoulderCurve):
+        return gamma.decode(x)
     return x.clamp(min=0.0) ** _as(gamma, x)
 
 
-def encode(x: torch.Tensor, gamma: float | torch.Tensor | None) -> torch.Tensor:
+def encode(x: torch.Tensor, gamma: Tone) -> torch.Tensor:
     """Inverse of ``decode`` (clips to [0, 1] first: a sensor cannot record more than its full well)."""
     if gamma is None:
         return linear_to_srgb(x)
+    if isinstance(gamma, ShoulderCurve):
+        return gamma.encode(x)
     return x.clamp(1e-12, 1.0) ** (1.0 / _as(gamma, x))
 
 
@@ -67,7 +134,7 @@ def inject_linear_light(
     auto_exposure: float | torch.Tensor = 0.0,
     metered_light: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
-    gamma: float | torch.Tensor | None = None,
+    gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Add ``light`` (linear irradiance, broadcastable to ``x``) to the scene in linear light, clip, re-encode.
@@ -198,7 +265,7 @@ def project_light(
     reflectance_floor: float | torch.Tensor = 0.0,
     crosstalk: torch.Tensor | None = None,
     white: float | torch.Tensor = 1.0,
-    gamma: float | torch.Tensor | None = 1.0,
+    gamma: Tone = 1.0,
     projector_gamma: float | torch.Tensor | None = None,
     spread_px: float | torch.Tensor = 0.0,
     blend: bool = False,
@@ -243,7 +310,7 @@ def laser_injection(
     halo_exponent: float = 2.0,
     halo_scale_px: float = 1.0,
     auto_exposure: float = 0.0,
-    gamma: float | None = None,
+    gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """A laser shone into the camera, physically: the recorded ``pattern`` (encoded, ``(B or 1, 3, H, W)``) is

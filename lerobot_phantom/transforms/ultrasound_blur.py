@@ -468,7 +468,11 @@ class UltrasoundBlur(CameraAttack):
     piecewise linear; the paper blurs diagonally, ``dx = dy = d`` (scaled with the image width / height).
     Options: ``displacement_px`` fixes ``d``; ``random_direction=True`` turns the path to a random angle per
     sample (same length ``d * sqrt(2)``); ``rotation_deg`` and ``radial_scale`` add the paper's rotational and
-    radial components, reached at intensity 1 and scaled linearly with the intensity (0 at s = 0).
+    radial components, reached at intensity 1 and scaled linearly with the intensity (0 at s = 0). As
+    ``lerobot-phantom-calibrate`` measures a camera: ``path="sinusoidal"`` centres the path on the pixel and dwells
+    at its ends as a resonating gyroscope does (arcsine weights), and ``gamma`` (a power law) or ``shoulder`` /
+    ``shoulder_exponent`` (a curve whose highlights roll off, ``physics.ShoulderCurve``) average the path in linear
+    light rather than in pixel values.
     """
 
     name: ClassVar[str] = "ultrasound_blur"
@@ -489,22 +493,25 @@ class UltrasoundBlur(CameraAttack):
         radial_scale: float = 0.0,
         path: str = "uniform",
         gamma: float | None = None,
+        shoulder: float | None = None,
+        shoulder_exponent: float = 1.0,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
-        # path="sinusoidal" / gamma (lerobot-phantom-calibrate): a resonating gyroscope's arcsine-weighted blur
-        # path centred on the pixel, optionally averaged in linear light (physics.line_blur)
+        # path="sinusoidal" / gamma / shoulder (lerobot-phantom-calibrate): a resonating gyroscope's
+        # arcsine-weighted blur path centred on the pixel, optionally averaged in linear light decoded by a power
+        # law or a shouldered tone curve (physics.line_blur, physics.ShoulderCurve)
         if path not in physics.BLUR_PATHS:
             raise ValueError(f"unknown blur path {path!r}; valid: {', '.join(physics.BLUR_PATHS)}")
-        if (path != "uniform" or gamma is not None) and (
+        self.tone = physics.tone_options(gamma, shoulder, shoulder_exponent, owner="UltrasoundBlur")
+        if (path != "uniform" or self.tone is not None) and (
             float(rotation_deg) != 0.0 or float(radial_scale) != 0.0
         ):
             raise ValueError(
-                "path='sinusoidal' and gamma= model the linear blur only (rotation_deg = radial_scale = 0)"
+                "path='sinusoidal', gamma= and shoulder= model the linear blur only (rotation_deg = radial_scale = 0)"
             )
         self.path = path
-        self.gamma = None if gamma is None else float(gamma)
         for what, value in (("displacement_px", displacement_px), ("rotation_deg", rotation_deg)):
             if value is not None and not math.isfinite(float(value)):
                 raise ValueError(f"{what} must be finite, got {value!r}")
@@ -543,12 +550,12 @@ class UltrasoundBlur(CameraAttack):
         }
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.path != "uniform" or self.gamma is not None:
+        if self.path != "uniform" or self.tone is not None:
             dx, dy = params["dx"].to(x.device, x.dtype), params["dy"].to(x.device, x.dtype)
             taps = physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
             offsets = physics.blur_path_offsets(self.path, taps, dtype=x.dtype, device=x.device)
-            gamma = 1.0 if self.gamma is None else self.gamma
-            blurred = physics.encode(physics.line_blur(physics.decode(x, gamma), dx, dy, offsets), gamma)
+            tone = 1.0 if self.tone is None else self.tone
+            blurred = physics.encode(physics.line_blur(physics.decode(x, tone), dx, dy, offsets), tone)
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
             return torch.where(still, x, blurred).clamp_(0.0, 1.0)
         return ultrasound_blur_float(
@@ -556,7 +563,7 @@ class UltrasoundBlur(CameraAttack):
         )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.path != "uniform" or self.gamma is not None:
+        if self.path != "uniform" or self.tone is not None:
             return NotImplemented
         return _blur_uint8(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
 

@@ -422,3 +422,21 @@ def assert_kept_values_change_no_prediction(
                 atol=0,
             )
     return steps
+
+
+def blurred_by_the_attack(attack, problem, fit, index: int):
+    """Pair ``index``'s clean frame blurred by the attack transform ``attack`` (``UltrasoundBlur``) along the blur
+    ``fit`` measured, at the pair's intensity: the displacement ``BlurFrames`` fits at the reference scale, in this
+    frame's pixels."""
+    import torch
+
+    pair = problem.pairs[index]
+    scale = pair.intensity / pair.to_reference
+    one = torch.ones(1, dtype=pair.clean.dtype)
+    params = {
+        "dx": one * fit.params["dx_ref_px"] * scale,
+        "dy": one * fit.params["dy_ref_px"] * scale,
+        "theta_deg": 0 * one,
+        "scale": 0 * one,
+    }
+    return attack.apply_params(pair.clean.unsqueeze(0), params)[0]

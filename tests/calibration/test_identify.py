@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import torch
+from calibration_testkit import blurred_by_the_attack
 
 from lerobot_phantom.calibration import core
 from lerobot_phantom.calibration.core import (
@@ -54,8 +55,9 @@ from lerobot_phantom.calibration.identify import (
     unmeasured_params,
 )
 from lerobot_phantom.calibration.report import build_report, write_markdown
-from lerobot_phantom.calibration.tone import GAMMA_PARAM, SHOULDER_PARAMS
+from lerobot_phantom.calibration.tone import GAMMA_PARAM, SHOULDER_PARAMS, equivalent_power_gamma
 from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.ultrasound_blur import UltrasoundBlur
 
 CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
 
@@ -534,9 +536,22 @@ def test_a_filmic_cameras_blur_is_averaged_in_the_light_of_its_shouldered_curve(
     # the resonance's checks read the shouldered fit in its own light: one path of the whole frame, that turns
     # (its dwell 0.230 in docs/bench/session86/dwell_profile_26847be.txt)
     assert problem.identification_checks("sinusoidal_motion", shouldered, fit_items) == []
-    # the attack transform knows power laws: it is given the curve's closest one, which compresses light more than
-    # sRGB does (camsim's filmic curve, a 4x pre-gain under ACES, stores 12% of the full well at 82% of white)
-    assert problem.transform_kwargs(shouldered)["gamma"] > GAMMA_PARAM.init
+    # calibrated.json hands the blur attack the fitted curve itself: at each held-out pair's fitted displacement the
+    # transform predicts what the fit predicts (its own taps along the path: 3.52 grey levels both), closer than the
+    # closest power law it was given before session 87 (3.92; docs/bench/session87/transform_tone_gain_*.txt)
+    kwargs = problem.transform_kwargs(shouldered)
+    power_law = {"path": kwargs["path"], "gamma": equivalent_power_gamma(shouldered.params)}
+
+    def attack_rmse(options):
+        errors = [
+            blurred_by_the_attack(UltrasoundBlur(**options), problem, shouldered, int(i))
+            - problem.pairs[int(i)].attacked
+            for i in heldout
+        ]
+        return float(torch.cat([e.ravel() for e in errors]).pow(2).mean().sqrt())
+
+    assert attack_rmse(kwargs) == pytest.approx(heldout_rmse(shouldered), rel=0.01)
+    assert attack_rmse(kwargs) < 0.95 * attack_rmse(power_law)
 
 
 class HostAndChild(ParentAndChild):

@@ -24,6 +24,7 @@ from lerobot_phantom.calibration.tone import (
     shoulder_encode,
     tone_nulls,
 )
+from lerobot_phantom.transforms.light_projection import LightProjection
 
 CURVES = [
     {"shoulder": 0.0, "shoulder_exponent": 1.0},
@@ -144,7 +145,7 @@ def test_only_the_declared_implication_has_a_statistic():
         implied_gamma_statistic("albedo_modulation", "sensor_gamma", {})
 
 
-def test_the_transform_gets_the_closest_power_law():
+def test_a_shoulder_is_closest_to_a_power_law_of_its_gamma_encoding():
     params = {"shoulder": 0.0, "shoulder_exponent": 1.0}
     assert equivalent_power_gamma(params, 1.8) == pytest.approx(1.8, abs=0.01)
     # a filmic blur's fitted shoulder (camsim 1168502096, docs/bench/session86/transform_gamma_c28d9a6.txt) is
@@ -152,13 +153,41 @@ def test_the_transform_gets_the_closest_power_law():
     assert equivalent_power_gamma({"shoulder": 16.938, "shoulder_exponent": 0.95}) == pytest.approx(
         6.18, abs=0.01
     )
+
+
+def test_the_projection_attack_composes_light_in_the_fitted_shoulder_as_the_fit_does():
+    """calibrated.json hands ``LightProjection`` the fitted curve itself: its light model reproduces the fit's
+    prediction to rounding (with the projector's own gamma, cross-talk and albedo, as on SLAP's stop sign), where
+    the closest power law it was given before session 87 misses by grey levels."""
+    params = {
+        "shoulder": 2.2,
+        "shoulder_exponent": 0.5,
+        "projector_gamma": 1.35,
+        "reflectance_floor": 0.01,
+        **{f"crosstalk_{i}{j}": (0.9 if i == j else 0.1) for i in range(3) for j in range(3)},
+    }
     fit = Fit(
-        frozenset({"additive_light", "tone_shoulder"}),
-        {"strength": 0.5, "shoulder": 40.0, "shoulder_exponent": 1.2},
+        frozenset({"additive_light", "albedo_modulation", "channel_crosstalk", "tone_shoulder"}), params
+    )
+    rng = np.random.default_rng(4)
+    surface, projected = (torch.from_numpy(rng.uniform(0, 1, (300, 3))) for _ in range(2))
+    predicted = projection_predict(
+        surface, projected, torch.ones(300, 1, dtype=torch.float64), fit.effects, params
     )
     kwargs = projection_kwargs(fit)
-    # a strong shoulder lifts the mid-tones like a gamma above 1 (the closest power law is not the identity)
-    assert kwargs["gamma"] > 1.5
+
+    def attack(options):
+        light = LightProjection(**options).project(
+            surface.T.reshape(1, 3, -1, 1),
+            projected.T.reshape(1, 3, -1, 1),
+            torch.ones(1, dtype=torch.float64),
+        )
+        return light.reshape(3, -1).T
+
+    assert torch.allclose(attack(kwargs), predicted, atol=1e-12)
+    power_law = {k: v for k, v in kwargs.items() if not k.startswith("shoulder")}
+    power_law["gamma"] = equivalent_power_gamma(params, kwargs["gamma"])
+    assert 255 * float((attack(power_law) - predicted).abs().max()) > 5.0
 
 
 def test_noise_linearises_with_the_fitted_shoulder():

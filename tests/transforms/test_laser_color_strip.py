@@ -157,4 +157,4 @@ def test_gamma_needs_the_rolling_shutter_model():
         LaserColorStrip(gamma=2.2)
     with pytest.raises(ValueError, match="gamma > 0"):
         LaserColorStrip(model="rolling_shutter", gamma=0.0)
-    assert pickle.loads(pickle.dumps(_rolling_shutter(2.2))).gamma == 2.2
+    assert pickle.loads(pickle.dumps(_rolling_shutter(2.2))).tone == 2.2

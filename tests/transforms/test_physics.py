@@ -522,3 +522,42 @@ def test_a_closing_set_of_whole_stripe_placements_keeps_its_count():
         )
         assert float(drifting.diff().abs().max()) < 1.0, drift
         assert float((lit - drifting).min()) > 80, drift
+
+
+def test_a_shoulder_curve_inverts_keeps_white_and_rolls_off_its_highlights():
+    light = torch.linspace(1e-4, 1.0, 400, dtype=torch.float64)
+    curve = physics.ShoulderCurve(20.0, 1.3, 1.1)
+    assert torch.allclose(physics.decode(physics.encode(light, curve), curve), light, rtol=1e-9, atol=1e-12)
+    assert float(curve.encode(torch.tensor(1.0, dtype=torch.float64))) == pytest.approx(1.0)
+    # no shoulder: the display power law itself
+    assert torch.allclose(physics.ShoulderCurve(0.0, 2.7, 2.2).encode(light), physics.encode(light, 2.2))
+    # at white the curve climbs 1 / (gamma (1 + s)) per unit of light, the power law 1 / gamma: highlights that
+    # would clip roll off (d/dx of ((1 + s) x^n / (1 + s x^n)) ** (1 / (n gamma)) at x = 1)
+    step = torch.tensor([1.0 - 1e-6, 1.0], dtype=torch.float64)
+    slope = float(curve.encode(step).diff()) / 1e-6
+    assert slope == pytest.approx(1.0 / (1.1 * 21.0), rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("options", "valid"),
+    [
+        ({"shoulder": -1.0}, "shoulder >= 0"),
+        ({"shoulder": 2.0, "shoulder_exponent": 0.0}, "exponent > 0"),
+        ({"shoulder": 2.0, "gamma": 0.0}, "display gamma > 0"),
+    ],
+)
+def test_a_shoulder_out_of_its_range_is_refused_with_the_valid_values(options, valid):
+    with pytest.raises(ValueError, match=valid):
+        physics.tone_options(
+            options.get("gamma", 2.2),
+            options["shoulder"],
+            options.get("shoulder_exponent", 1.0),
+            owner="attack",
+        )
+
+
+def test_a_shoulder_exponent_without_a_shoulder_is_refused():
+    with pytest.raises(ValueError, match="needs shoulder="):
+        physics.tone_options(2.2, None, 2.0, owner="attack")
+    assert physics.tone_options(2.2, None, 1.0, owner="attack") == 2.2
+    assert physics.tone_options(None, 3.0, 0.5, owner="attack") == physics.ShoulderCurve(3.0, 0.5, 1.0)

@@ -114,7 +114,7 @@ from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     TONE_PARAMS,
     decode_encode,
-    equivalent_power_gamma,
+    shoulder_kwargs,
 )
 from lerobot_phantom.transforms import physics
 
@@ -970,11 +970,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "colour_correction": correction_matrix(p).reshape(-1).tolist()
             if "colour_correction" in effects
             else None,
-            # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); the
-            # transform knows power laws only, so a fitted shoulder gives it the closest one
-            "gamma": equivalent_power_gamma(p)
-            if "tone_shoulder" in effects
-            else p["gamma"]
-            if "sensor_gamma" in effects
-            else (None if linear else 1.0),
+            # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); a fitted
+            # shoulder under its display gamma (None: 1)
+            "gamma": self.tone(effects, p),
+            **(shoulder_kwargs(p, self.tone(effects, p)) if "tone_shoulder" in effects else {}),
         }

@@ -21,8 +21,8 @@ from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     TONE_PARAMS,
     decode_encode,
-    equivalent_power_gamma,
     implied_gamma_statistic,
+    shoulder_kwargs,
     tone_nulls,
 )
 from lerobot_phantom.transforms import physics
@@ -441,9 +441,8 @@ class StripFrames(LatentFrameProblem):
             "exposure_s": p["exposure_share"],
             "row_time_s": 1.0 / 720,
             "frame_rows": 720,
-            # the transform knows power laws only: a fitted shoulder gives it the closest one
             **({"gamma": p["gamma"]} if "sensor_gamma" in fit.effects else {}),
-            **({"gamma": equivalent_power_gamma(p)} if "tone_shoulder" in fit.effects else {}),
+            **(shoulder_kwargs(p) if "tone_shoulder" in fit.effects else {}),
         }
 
     def derived(self, fit: Fit) -> dict:

@@ -19,8 +19,8 @@ from lerobot_phantom.calibration.tone import (
     SHOULDER_PARAMS,
     TONE_PARAMS,
     decode_encode,
-    equivalent_power_gamma,
     implied_gamma_statistic,
+    shoulder_kwargs,
     tone_nulls,
 )
 from lerobot_phantom.transforms import physics
@@ -340,8 +340,8 @@ class BlurFrames(FrameProblem):
             kwargs["path"] = "sinusoidal"
         if "sensor_gamma" in fit.effects:
             kwargs["gamma"] = fit.params["gamma"]
-        if "tone_shoulder" in fit.effects:  # the transform knows power laws only: the closest one
-            kwargs["gamma"] = equivalent_power_gamma(fit.params)
+        if "tone_shoulder" in fit.effects:
+            kwargs.update(shoulder_kwargs(fit.params))
         return kwargs
 
     def derived(self, fit: Fit) -> dict:
