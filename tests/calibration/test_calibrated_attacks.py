@@ -33,7 +33,10 @@ CALIBRATED = {
         "albedo": True,
         "reflectance_floor": 0.2,
         "crosstalk": [[0.8, 0.1, 0.0], [0.1, 0.7, 0.1], [0.0, 0.2, 0.9]],
+        # the stop sign's form: a shouldered tone curve under no display gamma, the projector's own gamma
         "gamma": 1.0,
+        "shoulder": 2.2,
+        "shoulder_exponent": 0.5,
         "projector_gamma": 2.2,
     },
     "laser_color_strip": {
