@@ -708,6 +708,14 @@ def blur_path_offsets(path: str, taps: int, *, dtype=torch.float32, device=None)
     return 0.5 * torch.sin(math.pi * (u - 0.5))
 
 
+def attack_blur_offsets(path: str, taps: int, *, dtype=torch.float32, device=None) -> torch.Tensor:
+    """Shares of an ultrasound blur's displacement its samples sit at: the paper's constant-speed sweep runs one way,
+    from the pixel to the full displacement (``uniform``: [0, 1], as the paper's path ``n = i / N``); a resonance
+    oscillates about the rest position (``sinusoidal``: centred, :func:`blur_path_offsets`)."""
+    offsets = blur_path_offsets(path, taps, dtype=dtype, device=device)
+    return offsets + 0.5 if path == "uniform" else offsets
+
+
 def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torch.Tensor) -> torch.Tensor:
     """Average of ``x`` shifted by ``offsets * (dx, dy)`` pixels (bilinear, border-replicated), per sample."""
     batch, _, height, width = x.shape

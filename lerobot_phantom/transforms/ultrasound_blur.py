@@ -472,7 +472,8 @@ class UltrasoundBlur(CameraAttack):
     ``lerobot-phantom-calibrate`` measures a camera: ``path="sinusoidal"`` centres the path on the pixel and dwells
     at its ends as a resonating gyroscope does (arcsine weights), and ``gamma`` (a power law) or ``shoulder`` /
     ``shoulder_exponent`` (a curve whose highlights roll off, ``physics.ShoulderCurve``) average the path in linear
-    light rather than in pixel values.
+    light rather than in pixel values; the paper's sweep (``path="uniform"``) runs one way from the pixel in either
+    light (``physics.attack_blur_offsets``).
     """
 
     name: ClassVar[str] = "ultrasound_blur"
@@ -553,7 +554,7 @@ class UltrasoundBlur(CameraAttack):
         if self.path != "uniform" or self.tone is not None:
             dx, dy = params["dx"].to(x.device, x.dtype), params["dy"].to(x.device, x.dtype)
             taps = physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
-            offsets = physics.blur_path_offsets(self.path, taps, dtype=x.dtype, device=x.device)
+            offsets = physics.attack_blur_offsets(self.path, taps, dtype=x.dtype, device=x.device)
             tone = 1.0 if self.tone is None else self.tone
             blurred = physics.encode(physics.line_blur(physics.decode(x, tone), dx, dy, offsets), tone)
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity

@@ -796,7 +796,8 @@ def ultrasound_blur_pairs(
     """Ultrasound blur: the stabiliser moves the image during the exposure.
 
     ``path``: "linear" (the paper's linear component: uniform samples from 0 to d, d = intensity * D, in output
-    space: the null), "sinusoidal" (resonance: x(t) = (d / 2) sin(2 pi f t + phi) with 5-9 non-integer cycles per
+    space: the null), "sweep" (the same one-way constant-speed path, integrated in linear irradiance before the
+    sensor, as a real exposure integrates any motion), "sinusoidal" (resonance: x(t) = (d / 2) sin(2 pi f t + phi) with 5-9 non-integer cycles per
     exposure and a random phase, integrated in linear irradiance before the sensor, so the dwell time is
     arcsine-weighted toward both ends of the path), "rotation" (the paper's rotational component, 0 .. theta,
     theta = intensity * Theta, in output space: an effect the library has no name for), "defocus" (the lens out of
@@ -825,6 +826,11 @@ def ultrasound_blur_pairs(
                 path_blur(refl * light, shifts[:, None] * unit), cam, rng, exposure=exposure
             )
             attacked = quantised(attacked)
+        elif path == "sweep":
+            attacked, _ = capture(
+                path_blur(refl * light, uniform_path(d)[:, None] * unit), cam, rng, exposure=exposure
+            )
+            attacked = quantised(attacked)
         elif path == "triangle":
             shifts = triangle_wave_path(d, cycles, rng.uniform(0, 1))
             attacked, _ = capture(
@@ -842,7 +848,9 @@ def ultrasound_blur_pairs(
             elif path == "rotation":
                 attacked = rotation_blur(attacked, np.deg2rad(intensity * amplitude))
             else:
-                raise ValueError(f"path {path!r}; valid: defocus, linear, rotation, sinusoidal, triangle")
+                raise ValueError(
+                    f"path {path!r}; valid: defocus, linear, rotation, sinusoidal, sweep, triangle"
+                )
         pairs.append(FramePair(encode(clean, cam), encode(attacked, cam), float(intensity)))
     return pairs
 

@@ -554,6 +554,25 @@ def test_a_filmic_cameras_blur_is_averaged_in_the_light_of_its_shouldered_curve(
     assert attack_rmse(kwargs) < 0.95 * attack_rmse(power_law)
 
 
+def test_a_blur_attack_in_linear_light_sweeps_one_way_as_the_fit_does(tmp_path):
+    """camsim's one-way sweep in linear irradiance on a power-law camera (case blur_linear_light, master seed
+    2013028294, case seed 1365449052: calibrated, it names sensor_gamma alone). calibrated.json gives the attack the
+    fitted gamma on the paper's path: the transform must sweep one way from the pixel as the fit does, and so
+    predict the held-out frames as well as the fit (until session 87 it blurred along a centred path)."""
+    import test_independent_sim as sim
+
+    problem, fit_items, heldout = sim.drawn_split("blur_linear_light", 1365449052, tmp_path)
+    fit = problem.fit(frozenset({"sensor_gamma"}), fit_items)
+    attack = UltrasoundBlur(**problem.transform_kwargs(fit))
+    errors = {"fit": [], "attack": []}
+    for i in heldout:
+        attacked = problem.pairs[int(i)].attacked
+        errors["fit"].append(problem.predict_pair(fit, int(i)) - attacked)
+        errors["attack"].append(blurred_by_the_attack(attack, problem, fit, int(i)) - attacked)
+    rmse = {k: float(torch.cat([e.ravel() for e in v]).pow(2).mean().sqrt()) for k, v in errors.items()}
+    assert rmse["attack"] == pytest.approx(rmse["fit"], rel=0.02), rmse
+
+
 class HostAndChild(ParentAndChild):
     """As above, with the child's parameter inside its range unless ``child_at_bound``."""
 

@@ -392,6 +392,16 @@ CASES = [
         lambda rng, cam: cs.ultrasound_blur_pairs(rng, cam, N_PAIRS, path="triangle"),
         tolerated=LINEAR_LIGHT,
     ),
+    Case(
+        # the paper's one-way sweep as an exposure records it, in linear irradiance, on a power-law camera: the
+        # blur's tone curve planted alone (the resonance only tolerates it)
+        "blur_linear_light",
+        "ultrasound_blur",
+        "effect",
+        lambda rng, cam: cs.ultrasound_blur_pairs(rng, cam, N_PAIRS, path="sweep"),
+        planted=frozenset({"sensor_gamma"}),
+        camera={"tone": "power"},
+    ),
 ]
 CASE_BY_NAME = {case.name: case for case in CASES}
 # the cases CAMSIM_CASES=core runs: every named frame-pair effect of the library, all six nulls and two unnamed
@@ -487,7 +497,7 @@ def case_camera(case: Case, seed: int | None = None) -> tuple[int, np.random.Gen
     seed = case_seed(case) if seed is None else seed
     rng = np.random.default_rng(seed)
     overrides = {k: (v(rng) if callable(v) else v) for k, v in case.camera.items()}
-    if case.name == "projection_sensor_gamma":
+    if case.camera.get("tone") == "power":  # a real camera's power law, drawn after the case's own overrides
         overrides.update(_gamma_camera(rng))
     return seed, rng, random_camera(rng, **overrides)
 

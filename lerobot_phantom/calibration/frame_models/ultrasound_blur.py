@@ -107,10 +107,8 @@ class BlurFrames(FrameProblem):
         return implied_gamma_statistic(effect, implied, params)
 
     def blur(self, effects, params, index: int) -> torch.Tensor:
-        if "sinusoidal_motion" in effects:
-            offsets = physics.blur_path_offsets("sinusoidal", self.taps, dtype=torch.float64)
-        else:  # the paper's one-way path: offsets in [0, 1] of the displacement
-            offsets = physics.blur_path_offsets("uniform", self.taps, dtype=torch.float64) + 0.5
+        path = "sinusoidal" if "sinusoidal_motion" in effects else "uniform"
+        offsets = physics.attack_blur_offsets(path, self.taps, dtype=torch.float64)
         gamma = params["gamma"] if "sensor_gamma" in effects else 1.0
         return self.path_blur(params, index, offsets, gamma, shoulder="tone_shoulder" in effects)
 
