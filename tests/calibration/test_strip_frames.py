@@ -10,6 +10,7 @@ import torch
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.laser_color_strip import StripFrames
+from lerobot_phantom.transforms.laser_color_strip import LaserColorStrip
 
 HEIGHT, WIDTH = 48, 32
 STRIPE = {"peak_r": 0.35, "peak_g": 0.08, "peak_b": 0.04, "on_share": 0.08, "exposure_share": 0.05}
@@ -134,3 +135,39 @@ def test_the_pairs_stripes_predicted_together_are_each_pairs_own_to_the_bit(peri
     assert all(
         not torch.equal(predicted, pairs[int(i)].clean) for predicted, i in zip(together, items, strict=True)
     )
+
+
+def test_the_phases_the_model_weighs_are_those_at_which_the_stripe_crosses_the_frame():
+    """Without a period the model sees one pulse: row r integrates over [r + phase, r + phase + exposure] rows and
+    the pulse is on over [0, on], so some row is lit exactly for phases in (-(h - 1) - exposure, on). Every phase the
+    model weighs lights a row, and a row's step beyond either end lights none (until session 87 the span ran from
+    -h to on + exposure: here 55 phases, 3 lighting nothing, and none for a stripe leaving the frame's bottom)."""
+    problem = StripFrames(stripe_pairs(seed=2, period=0.47, n=1), seed=2)
+    phases, _ = problem.phase_costs(STRIPE, 0)
+    light = StripFrames.row_light(STRIPE, HEIGHT, phases)
+    assert bool((light.amax(dim=1) > 0).all())
+    beyond = torch.tensor([float(phases[0]) - 1.0, float(phases[-1]) + 1.0], dtype=torch.float64)
+    assert float(StripFrames.row_light(STRIPE, HEIGHT, beyond).max()) == 0.0
+
+
+@pytest.mark.parametrize("period", [None, 0.47])
+def test_the_calibrated_attack_draws_the_models_stripe_at_every_phase_the_model_weighs(period):
+    """calibrated.json's ``LaserColorStrip`` is the stripe model: at any pulse phase the model scores (without a
+    period, a stripe crossing the frame anywhere, partly out of view at either edge), the attack adds what
+    ``predict_stripe`` predicts, in the fitted shoulder's light. Its pulses come a frame and a stripe's length apart
+    when no period was measured: one pulse a frame (until session 87) lit a second stripe at the frame's other edge
+    where the first left it."""
+    shoulder = {"shoulder": 30.0, "shoulder_exponent": 1.2}
+    params = {**STRIPE, **shoulder, **({} if period is None else {"period_share": period})}
+    effects = {"exposure_overlap", "tone_shoulder"} | ({"stripe_period"} if period else set())
+    problem = StripFrames(stripe_pairs(seed=2, period=0.47, n=2), seed=2)
+    fit = Fit(frozenset(effects), params)
+    attack = LaserColorStrip(**problem.transform_kwargs(fit))
+    pair = problem.pairs[0]
+    phases, _ = problem.phase_costs(params, 0)
+    for phase_rows in phases.tolist():
+        drawn = attack.sample_params(1, HEIGHT, WIDTH, intensity=torch.tensor([pair.intensity]))
+        drawn["phase_s"] = torch.tensor([phase_rows / HEIGHT], dtype=torch.float64)
+        attacked = attack.apply_params(pair.clean.unsqueeze(0), drawn)[0]
+        predicted = problem.predict_stripe(params, 0, phase_rows)
+        assert float((attacked - predicted).abs().max()) < 1e-5, phase_rows

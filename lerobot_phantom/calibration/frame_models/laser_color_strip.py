@@ -227,8 +227,10 @@ class StripFrames(LatentFrameProblem):
         if "period_share" in params:
             span = (0.0, float(params["period_share"]) * height)
         else:
-            # row r sees the pulse when r + phase lies in [-exposure, on]: phases -h .. stripe height cover all
-            span = (-float(height), (float(params["on_share"]) + float(params["exposure_share"])) * height)
+            # row r integrates over [r + phase, r + phase + exposure] (rows) and the pulse is on over [0, on]: some
+            # row of the frame is lit exactly for phases in (-(h - 1) - exposure, on); whole rows from the first
+            exposure_rows = float(params["exposure_share"]) * height
+            span = (math.ceil(-(height - 1) - exposure_rows), float(params["on_share"]) * height)
         phases = torch.arange(span[0], span[1], PHASE_STEP_ROWS, dtype=torch.float64)
         with torch.no_grad():
             light = self.row_light(params, height, phases)  # (P, H)
@@ -421,7 +423,9 @@ class StripFrames(LatentFrameProblem):
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserColorStrip`` options: the colour split of the fitted light; with ``exposure_overlap`` the
         rolling-shutter model on a 720-row frame (frame time 1 s scaled away: only shares of the frame matter),
-        composed in the light ``sensor_gamma``'s power law decodes."""
+        composed in the light ``sensor_gamma``'s power law or the fitted shoulder decodes. At the pulse phase
+        registered on a pair the attack draws what ``predict_stripe`` predicts, and its uniform phase is the model's
+        prior over the phase (``phase_costs``' span)."""
         p = fit.params
         if "exposure_overlap" not in fit.effects:
             total = p["strength_r"] + p["strength_g"] + p["strength_b"]
@@ -429,8 +433,11 @@ class StripFrames(LatentFrameProblem):
             return {"color_fractions": fractions, "levels": [0.0, total / 3, 2 * total / 3, total]}
         peaks = [p[f"peak_{c}"] for c in "rgb"]
         top = max(max(peaks), 1e-12)
-        # one pulse per frame when no period was measured: the stripe lands somewhere in every frame
-        period = p.get("period_share", 1.0)
+        # no period measured: the model sees one pulse at a time (SINGLE_PULSE_PERIOD) and weighs alike every phase
+        # at which its stripe crosses the frame (phase_costs: a frame and a stripe's length, less a row). The
+        # attack's pulses come a frame and a stripe's length apart: no two stripes cross one frame, and a uniform
+        # phase puts the stripe anywhere it can be seen (a row's worth of phases in 720 shows none)
+        period = p.get("period_share", 1.0 + p["on_share"] + p["exposure_share"])
         strength = top * 255.0 * math.pi / 4.0  # the transform's peak gain is 4 S / pi grey levels
         return {
             "model": "rolling_shutter",
