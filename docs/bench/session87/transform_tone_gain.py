@@ -13,9 +13,13 @@ law it was given before.
 - ``CASE:CASE_SEED``: camsim blur draws (tests/calibration/test_independent_sim.py), fitted as the resonance in a
   shouldered curve on the CLI's fit pairs (as the suite's filmic blur test does); ``UltrasoundBlur`` applied to
   each held-out clean frame with the fitted displacement at that frame's intensity.
+- ``CASE:CASE_SEED`` of a laser strip case (``strip_*``): the rolling-shutter stripe in a shouldered curve (with
+  ``stripe_period`` for ``strip_period``) fitted on the fit pairs; ``LaserColorStrip`` applied to each held-out
+  clean frame at its intensity and at the pulse phase registered on that frame (the phase no one knows in advance:
+  the model's figure is the registered one too, ``predict_registered``).
 
 Usage: ``CAMSIM_SEED=0 PYTHONPATH=.:tests/calibration:tests python docs/bench/session87/transform_tone_gain.py
-[--stop-sign CSV] CASE:CASE_SEED...``
+[--stop-sign CSV] CASE:CASE_SEED...`` (blur and laser strip cases)
 """
 
 from __future__ import annotations
@@ -31,10 +35,12 @@ from lerobot_phantom.calibration.cli import CalibrateConfig, build_problem, cali
 from lerobot_phantom.calibration.core import Fit, seeded_split
 from lerobot_phantom.calibration.identify import error_ratio
 from lerobot_phantom.calibration.tone import equivalent_power_gamma
+from lerobot_phantom.transforms.laser_color_strip import LaserColorStrip
 from lerobot_phantom.transforms.light_projection import LightProjection
 from lerobot_phantom.transforms.ultrasound_blur import UltrasoundBlur
 
 RESONANCE = frozenset({"sinusoidal_motion", "tone_shoulder"})
+STRIPE = {"exposure_overlap", "tone_shoulder"}
 
 
 def rmse(errors: list[torch.Tensor]) -> float:
@@ -115,6 +121,40 @@ def blur(name: str, case_seed: int) -> None:
     )
 
 
+def strip(name: str, case_seed: int) -> None:
+    import test_independent_sim as sim
+
+    effects = STRIPE | ({"stripe_period"} if name == "strip_period" else set())
+    with tempfile.TemporaryDirectory() as folder:
+        problem, fit_items, heldout = sim.drawn_split(name, case_seed, Path(folder))
+        camera = sim.case_camera(sim.CASE_BY_NAME[name], case_seed)[2]
+        fit = problem.fit(frozenset(effects), fit_items)
+    kwargs = problem.transform_kwargs(fit)
+    attacks = {
+        "shoulder": LaserColorStrip(**kwargs),
+        "power law": LaserColorStrip(**as_power_law(kwargs, fit.params)),
+    }
+    errors: dict[str, list[torch.Tensor]] = {"model": [], **{k: [] for k in attacks}}
+    for i in heldout:
+        pair = problem.pairs[int(i)]
+        phase_rows = problem.best_phase(fit.params, int(i))
+        errors["model"].append(problem.predict_stripe(fit.params, int(i), phase_rows) - pair.attacked)
+        for what, attack in attacks.items():
+            params = attack.sample_params(
+                1, pair.height, pair.width, intensity=torch.tensor([pair.intensity], dtype=torch.float64)
+            )
+            # the transform's row time is the frame time over its rows (transform_kwargs: 1 / 720 of 720 rows)
+            params["phase_s"] = torch.tensor([phase_rows / pair.height], dtype=torch.float64)
+            errors[what].append(attack.apply_params(pair.clean.unsqueeze(0), params)[0] - pair.attacked)
+    print(
+        f"{name} case seed {case_seed} ({camera.tone}), {len(heldout)} held-out pairs, {sorted(effects)}, shoulder "
+        f"{fit.params['shoulder']:.3f} exponent {fit.params['shoulder_exponent']:.3f} (closest power law "
+        f"{equivalent_power_gamma(fit.params):.2f}): model (registered) {rmse(errors['model']):.2f}, transform "
+        f"with the shoulder {rmse(errors['shoulder']):.2f}, with the power law {rmse(errors['power law']):.2f}",
+        flush=True,
+    )
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--stop-sign", type=Path)
@@ -125,7 +165,7 @@ def main() -> None:
         stop_sign(args.stop_sign)
     for draw in args.draws:
         name, seed = draw.split(":")
-        blur(name, int(seed))
+        (strip if name.startswith("strip_") else blur)(name, int(seed))
 
 
 if __name__ == "__main__":
