@@ -93,64 +93,58 @@ def stop_sign(csv: Path) -> None:
     )
 
 
-def blur(name: str, case_seed: int) -> None:
-    import test_independent_sim as sim
+def blur_attack(attack, problem, fit, index: int) -> torch.Tensor:
     from calibration_testkit import blurred_by_the_attack
 
-    with tempfile.TemporaryDirectory() as folder:
-        problem, fit_items, heldout = sim.drawn_split(name, case_seed, Path(folder))
-        camera = sim.case_camera(sim.CASE_BY_NAME[name], case_seed)[2]
-        fit = problem.fit(RESONANCE, fit_items)
-    kwargs = problem.transform_kwargs(fit)
-    attacks = {
-        "shoulder": UltrasoundBlur(**kwargs),
-        "power law": UltrasoundBlur(**as_power_law(kwargs, fit.params)),
-    }
-    errors: dict[str, list[torch.Tensor]] = {"model": [], **{k: [] for k in attacks}}
-    for i in heldout:
-        pair = problem.pairs[int(i)]
-        errors["model"].append(problem.predict_pair(fit, int(i)) - pair.attacked)
-        for what, attack in attacks.items():
-            errors[what].append(blurred_by_the_attack(attack, problem, fit, int(i)) - pair.attacked)
-    print(
-        f"{name} case seed {case_seed} ({camera.tone}), {len(heldout)} held-out pairs, shoulder "
-        f"{fit.params['shoulder']:.3f} exponent {fit.params['shoulder_exponent']:.3f} (closest power law "
-        f"{equivalent_power_gamma(fit.params):.2f}): model {rmse(errors['model']):.2f}, transform with the "
-        f"shoulder {rmse(errors['shoulder']):.2f}, with the power law {rmse(errors['power law']):.2f}",
-        flush=True,
+    return blurred_by_the_attack(attack, problem, fit, index)
+
+
+def strip_attack(attack, problem, fit, index: int) -> torch.Tensor:
+    pair = problem.pairs[index]
+    params = attack.sample_params(
+        1, pair.height, pair.width, intensity=torch.tensor([pair.intensity], dtype=torch.float64)
     )
+    # at the pulse phase registered on the pair; the transform's row time is the frame time over its rows
+    params["phase_s"] = torch.tensor(
+        [problem.best_phase(fit.params, index) / pair.height], dtype=torch.float64
+    )
+    return attack.apply_params(pair.clean.unsqueeze(0), params)[0]
 
 
-def strip(name: str, case_seed: int) -> None:
+# per camsim attack: the attack transform, the effects fitted (beside the case's own period) and its frame
+DRAWS = {
+    "blur": (UltrasoundBlur, RESONANCE, blur_attack),
+    "strip": (LaserColorStrip, STRIPE, strip_attack),
+}
+
+
+def camsim_draw(name: str, case_seed: int) -> None:
     import test_independent_sim as sim
 
-    effects = STRIPE | ({"stripe_period"} if name == "strip_period" else set())
+    kind = "strip" if name.startswith("strip_") else "blur"
+    attack_class, effects, attacked = DRAWS[kind]
+    effects = frozenset(effects | ({"stripe_period"} if name == "strip_period" else set()))
     with tempfile.TemporaryDirectory() as folder:
         problem, fit_items, heldout = sim.drawn_split(name, case_seed, Path(folder))
         camera = sim.case_camera(sim.CASE_BY_NAME[name], case_seed)[2]
-        fit = problem.fit(frozenset(effects), fit_items)
+        fit = problem.fit(effects, fit_items)
     kwargs = problem.transform_kwargs(fit)
     attacks = {
-        "shoulder": LaserColorStrip(**kwargs),
-        "power law": LaserColorStrip(**as_power_law(kwargs, fit.params)),
+        "shoulder": attack_class(**kwargs),
+        "power law": attack_class(**as_power_law(kwargs, fit.params)),
     }
     errors: dict[str, list[torch.Tensor]] = {"model": [], **{k: [] for k in attacks}}
     for i in heldout:
         pair = problem.pairs[int(i)]
-        phase_rows = problem.best_phase(fit.params, int(i))
-        errors["model"].append(problem.predict_stripe(fit.params, int(i), phase_rows) - pair.attacked)
+        # a stripe's prediction is the registered one (LatentFrameProblem.predict_pair), at the attack's phase
+        errors["model"].append(problem.predict_pair(fit, int(i)) - pair.attacked)
         for what, attack in attacks.items():
-            params = attack.sample_params(
-                1, pair.height, pair.width, intensity=torch.tensor([pair.intensity], dtype=torch.float64)
-            )
-            # the transform's row time is the frame time over its rows (transform_kwargs: 1 / 720 of 720 rows)
-            params["phase_s"] = torch.tensor([phase_rows / pair.height], dtype=torch.float64)
-            errors[what].append(attack.apply_params(pair.clean.unsqueeze(0), params)[0] - pair.attacked)
+            errors[what].append(attacked(attack, problem, fit, int(i)) - pair.attacked)
     print(
         f"{name} case seed {case_seed} ({camera.tone}), {len(heldout)} held-out pairs, {sorted(effects)}, shoulder "
         f"{fit.params['shoulder']:.3f} exponent {fit.params['shoulder_exponent']:.3f} (closest power law "
-        f"{equivalent_power_gamma(fit.params):.2f}): model (registered) {rmse(errors['model']):.2f}, transform "
-        f"with the shoulder {rmse(errors['shoulder']):.2f}, with the power law {rmse(errors['power law']):.2f}",
+        f"{equivalent_power_gamma(fit.params):.2f}): model {rmse(errors['model']):.2f}, transform with the "
+        f"shoulder {rmse(errors['shoulder']):.2f}, with the power law {rmse(errors['power law']):.2f}",
         flush=True,
     )
 
@@ -165,7 +159,7 @@ def main() -> None:
         stop_sign(args.stop_sign)
     for draw in args.draws:
         name, seed = draw.split(":")
-        (strip if name.startswith("strip_") else blur)(name, int(seed))
+        camsim_draw(name, int(seed))
 
 
 if __name__ == "__main__":
