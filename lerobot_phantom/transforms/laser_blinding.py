@@ -267,6 +267,14 @@ class LaserBlinding(CameraAttack):
         if flat:
             valid = [f.name for kind in (LaserSpot, LaserPhysics) for f in dataclasses.fields(kind)]
             raise TypeError(f"LaserBlinding got unknown options {sorted(flat)}; valid: {', '.join(valid)}")
+        if model == "paper" and self.physics != LaserPhysics():
+            changed = [
+                f.name for f in dataclasses.fields(LaserPhysics) if getattr(self.physics, f.name) != f.default
+            ]
+            raise ValueError(
+                f"LaserBlinding options {changed} are the physical model's; pass model='physical' (the paper's "
+                "blend takes alpha levels only)"
+            )
         if pattern is None:  # spot options ask for the spot; the physical model was calibrated with it
             pattern = "spot" if model == "physical" or spot_given else "red"
         text = str(pattern)

@@ -63,6 +63,8 @@ def test_a_shoulder_of_zero_is_the_power_law_and_a_shoulder_changes_the_attack(n
         (LightProjection, {}, "model='additive' or 'blend'"),
         (LaserColorStrip, {}, "rolling_shutter"),
         (UltrasoundBlur, {"rotation_deg": 5.0}, "linear blur only"),
+        # the paper's blend ignored every physical option; now it names them
+        (LaserBlinding, {"gain": 2.0}, r"\['gain', 'shoulder'\] are the physical model's"),
     ],
 )
 def test_a_shoulder_where_the_attack_composes_no_light_is_refused(kind, options, needs):
