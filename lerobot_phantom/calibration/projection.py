@@ -46,8 +46,7 @@ from lerobot_phantom.calibration.tone import (
     GAMMA_PARAM,
     SHOULDER_PARAMS,
     implied_gamma_statistic,
-    shoulder_decode,
-    shoulder_encode,
+    shoulder_curve,
     shoulder_kwargs,
     tone_nulls,
 )
@@ -199,7 +198,8 @@ def tone_curve(effects, params: dict):
     ``sensor_gamma`` power law, or the identity (the paper's composition of encoded values)."""
     gamma = params.get("gamma") if "sensor_gamma" in effects else None
     if "tone_shoulder" in effects:
-        return (lambda v: shoulder_decode(v, params, gamma)), (lambda v: shoulder_encode(v, params, gamma))
+        curve = shoulder_curve(params, gamma)
+        return curve.decode, curve.encode
     if gamma is not None:
         return (lambda v: v.clamp(min=0) ** gamma), (lambda v: v.clamp(min=1e-12) ** (1.0 / gamma))
     return (lambda v: v), (lambda v: v)

@@ -267,10 +267,10 @@ class LaserBlinding(CameraAttack):
         if flat:
             valid = [f.name for kind in (LaserSpot, LaserPhysics) for f in dataclasses.fields(kind)]
             raise TypeError(f"LaserBlinding got unknown options {sorted(flat)}; valid: {', '.join(valid)}")
-        if model == "paper" and self.physics != LaserPhysics():
-            changed = [
-                f.name for f in dataclasses.fields(LaserPhysics) if getattr(self.physics, f.name) != f.default
-            ]
+        changed = [
+            f.name for f in dataclasses.fields(LaserPhysics) if getattr(self.physics, f.name) != f.default
+        ]
+        if model == "paper" and changed:
             raise ValueError(
                 f"LaserBlinding options {changed} are the physical model's; pass model='physical' (the paper's "
                 "blend takes alpha levels only)"
