@@ -19,7 +19,10 @@ paper code's ``dy`` and ``dx`` respectively (its ``x`` is the row); ``theta_deg`
 column axis (counter-clockwise on screen); ``scale`` in [0, 1] pulls the path end towards the centre. Paper
 levels: ``dx = dy = 5 / 10 / 20`` pixels (no rotation, no radial part) at weak / medium / strong on the 256x256
 reference image (``base.REFERENCE_SIZE``); the transform scales ``dx`` with ``W / 256`` and ``dy`` with
-``H / 256`` so every camera resolution sees the same blur.
+``H / 256`` so every camera resolution sees the same blur. A measured blur (``displacement_per_intensity_px``, the
+vector ``lerobot-phantom-calibrate`` fits: pixels at the reference scale of the image's longer side, growing
+linearly with the intensity) is scaled by ``max(H, W) / 256`` on both axes instead: a camera's pixels are square,
+so the stabiliser's motion keeps its direction at every resolution.
 
 Deviations from the paper's code (and why):
 
@@ -57,7 +60,8 @@ from __future__ import annotations
 
 import functools
 import math
-from collections.abc import Callable
+import numbers
+from collections.abc import Callable, Sequence
 from typing import ClassVar
 
 import torch
@@ -94,6 +98,18 @@ def _per_sample(value: float | torch.Tensor, batch: int, what: str) -> list[floa
     if not torch.isfinite(t).all():
         raise ValueError(f"{what} must be finite, got {t.tolist()}")
     return t.tolist()
+
+
+def _measured_displacement(value: Sequence[float] | None) -> tuple[float, float] | None:
+    """``displacement_per_intensity_px`` checked: None, or two finite numbers (a JSON list from calibrated.json)."""
+    if value is None:
+        return None
+    pair = isinstance(value, Sequence) and not isinstance(value, str) and len(value) == 2
+    if not (pair and all(isinstance(v, numbers.Real) and math.isfinite(v) for v in value)):
+        raise ValueError(
+            f"displacement_per_intensity_px must be two finite numbers (dx, dy) in reference pixels, got {value!r}"
+        )
+    return float(value[0]), float(value[1])
 
 
 def _axis_spans(size: int, offset: float) -> list[tuple[int, int, int]]:
@@ -469,11 +485,15 @@ class UltrasoundBlur(CameraAttack):
     Options: ``displacement_px`` fixes ``d``; ``random_direction=True`` turns the path to a random angle per
     sample (same length ``d * sqrt(2)``); ``rotation_deg`` and ``radial_scale`` add the paper's rotational and
     radial components, reached at intensity 1 and scaled linearly with the intensity (0 at s = 0). As
-    ``lerobot-phantom-calibrate`` measures a camera: ``path="sinusoidal"`` centres the path on the pixel and dwells
+    ``lerobot-phantom-calibrate`` measures a camera: ``displacement_per_intensity_px=(dx, dy)`` is the measured
+    blur, horizontal and vertical, at intensity 1 in pixels of the reference scale of the longer image side
+    (``s * (dx, dy) * max(H, W) / 256`` at intensity ``s``; ``random_direction`` keeps its length and turns it),
+    ``path="sinusoidal"`` centres the path on the pixel and dwells
     at its ends as a resonating gyroscope does (arcsine weights), and ``gamma`` (a power law) or ``shoulder`` /
     ``shoulder_exponent`` (a curve whose highlights roll off, ``physics.ShoulderCurve``) average the path in linear
     light rather than in pixel values; the paper's sweep (``path="uniform"``) runs one way from the pixel in either
-    light (``physics.attack_blur_offsets``).
+    light (``physics.attack_blur_offsets``). With any of these the path is sampled continuously, as the calibration
+    fits it (``measured_path``).
     """
 
     name: ClassVar[str] = "ultrasound_blur"
@@ -489,6 +509,7 @@ class UltrasoundBlur(CameraAttack):
         intensity: IntensitySpec = "medium",
         *,
         displacement_px: float | None = None,
+        displacement_per_intensity_px: Sequence[float] | None = None,
         random_direction: bool = False,
         rotation_deg: float = 0.0,
         radial_scale: float = 0.0,
@@ -500,28 +521,42 @@ class UltrasoundBlur(CameraAttack):
         generator: torch.Generator | None = None,
     ) -> None:
         super().__init__(intensity, seed=seed, generator=generator)
-        # path="sinusoidal" / gamma / shoulder (lerobot-phantom-calibrate): a resonating gyroscope's
-        # arcsine-weighted blur path centred on the pixel, optionally averaged in linear light decoded by a power
-        # law or a shouldered tone curve (physics.line_blur, physics.ShoulderCurve)
+        # displacement_per_intensity_px / path="sinusoidal" / gamma / shoulder (lerobot-phantom-calibrate): the
+        # measured blur; a resonating gyroscope's arcsine-weighted path centred on the pixel, optionally averaged in
+        # linear light decoded by a power law or a shouldered tone curve (physics.line_blur, physics.ShoulderCurve)
         if path not in physics.BLUR_PATHS:
             raise ValueError(f"unknown blur path {path!r}; valid: {', '.join(physics.BLUR_PATHS)}")
-        self.tone = physics.tone_options(gamma, shoulder, shoulder_exponent, owner="UltrasoundBlur")
-        if (path != "uniform" or self.tone is not None) and (
-            float(rotation_deg) != 0.0 or float(radial_scale) != 0.0
-        ):
-            raise ValueError(
-                "path='sinusoidal', gamma= and shoulder= model the linear blur only (rotation_deg = radial_scale = 0)"
-            )
         self.path = path
+        self.tone = physics.tone_options(gamma, shoulder, shoulder_exponent, owner="UltrasoundBlur")
         for what, value in (("displacement_px", displacement_px), ("rotation_deg", rotation_deg)):
             if value is not None and not math.isfinite(float(value)):
                 raise ValueError(f"{what} must be finite, got {value!r}")
         if not (0.0 <= float(radial_scale) <= 1.0):
             raise ValueError(f"radial_scale must lie in [0, 1], got {radial_scale!r}")
         self.displacement_px = None if displacement_px is None else float(displacement_px)
+        self.displacement_per_intensity_px = _measured_displacement(displacement_per_intensity_px)
+        if self.displacement_px is not None and self.displacement_per_intensity_px is not None:
+            raise ValueError(
+                "displacement_px (the paper's diagonal, fixed) and displacement_per_intensity_px (a measured blur, "
+                "growing with the intensity) are alternatives: give one"
+            )
+        if self.measured_path and (float(rotation_deg) != 0.0 or float(radial_scale) != 0.0):
+            raise ValueError(
+                "displacement_per_intensity_px=, path='sinusoidal', gamma= and shoulder= model the linear blur only "
+                "(rotation_deg = radial_scale = 0)"
+            )
         self.random_direction = bool(random_direction)
         self.rotation_deg = float(rotation_deg)
         self.radial_scale = float(radial_scale)
+
+    @property
+    def measured_path(self) -> bool:
+        """Whether the blur follows a calibrated camera (a measured displacement, path shape or tone curve): then
+        the path is sampled continuously (``physics.line_blur``, bilinear taps), as the calibration fits it, not at
+        the paper code's whole pixels (its ``int()`` shifts a sub-pixel path by up to a pixel towards the start)."""
+        return (
+            self.path != "uniform" or self.tone is not None or self.displacement_per_intensity_px is not None
+        )
 
     def displacement_for(self, s: torch.Tensor) -> torch.Tensor:
         """Linear displacement per axis, pixels at the 256x256 reference, at intensity ``s`` (per sample)."""
@@ -534,24 +569,31 @@ class UltrasoundBlur(CameraAttack):
         return torch.where((d - whole).abs() < 1e-4, whole, d)
 
     def _sample(self, s, height, width, generator, device):
-        d = self.displacement_for(s).to(torch.float64)
-        d_col, d_row = d, d
+        s64 = s.to(torch.float64)
+        if self.displacement_per_intensity_px is None:
+            d = self.displacement_for(s).to(torch.float64)
+            d_col, d_row = d, d
+            column_scale, row_scale = width / REFERENCE_SIZE, height / REFERENCE_SIZE
+        else:
+            measured_col, measured_row = self.displacement_per_intensity_px
+            d_col, d_row = measured_col * s64, measured_row * s64
+            column_scale = row_scale = max(height, width) / REFERENCE_SIZE
         if self.random_direction:
             if generator is None:
                 raise ValueError("random_direction=True needs a torch.Generator (pass generator= or seed=)")
             angle = torch.rand(s.shape[0], generator=generator, dtype=torch.float64, device=generator.device)
             angle = angle.to(s.device) * (2 * math.pi)
-            d_col, d_row = d * math.sqrt(2) * torch.cos(angle), d * math.sqrt(2) * torch.sin(angle)
-        s64 = s.to(torch.float64)
+            length = torch.hypot(d_col, d_row)
+            d_col, d_row = length * torch.cos(angle), length * torch.sin(angle)
         return {
-            "dx": (d_col * (width / REFERENCE_SIZE)).to(device),
-            "dy": (d_row * (height / REFERENCE_SIZE)).to(device),
+            "dx": (d_col * column_scale).to(device),
+            "dy": (d_row * row_scale).to(device),
             "theta_deg": (self.rotation_deg * s64).to(device),
             "scale": (self.radial_scale * s64).to(device),
         }
 
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.path != "uniform" or self.tone is not None:
+        if self.measured_path:
             dx, dy = params["dx"].to(x.device, x.dtype), params["dy"].to(x.device, x.dtype)
             taps = physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
             offsets = physics.attack_blur_offsets(self.path, taps, dtype=x.dtype, device=x.device)
@@ -564,10 +606,14 @@ class UltrasoundBlur(CameraAttack):
         )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.path != "uniform" or self.tone is not None:
+        if self.measured_path:
             return NotImplemented
         return _blur_uint8(x, params["dx"], params["dy"], params["theta_deg"], params["scale"])
 
     def extra_repr(self) -> str:
         extra = [f"{k}={getattr(self, k)!r}" for k in ("displacement_px", "rotation_deg", "radial_scale")]
+        if (
+            self.displacement_per_intensity_px is not None
+        ):  # absent otherwise: earlier sweeps' records stay valid
+            extra.insert(1, f"displacement_per_intensity_px={self.displacement_per_intensity_px!r}")
         return ", ".join([super().extra_repr(), *extra, f"random_direction={self.random_direction}"])

@@ -424,19 +424,10 @@ def assert_kept_values_change_no_prediction(
     return steps
 
 
-def blurred_by_the_attack(attack, problem, fit, index: int):
-    """Pair ``index``'s clean frame blurred by the attack transform ``attack`` (``UltrasoundBlur``) along the blur
-    ``fit`` measured, at the pair's intensity: the displacement ``BlurFrames`` fits at the reference scale, in this
-    frame's pixels."""
-    import torch
+def blurred_by_the_attack(options: dict, problem, index: int):
+    """Pair ``index``'s clean frame as ``UltrasoundBlur(**options)`` blurs it at the pair's intensity, through the
+    attack's own sampler: what a user of ``calibrated.json`` (its ``kwargs``: ``options``) gets."""
+    from lerobot_phantom.transforms.ultrasound_blur import UltrasoundBlur
 
     pair = problem.pairs[index]
-    scale = pair.intensity / pair.to_reference
-    one = torch.ones(1, dtype=pair.clean.dtype)
-    params = {
-        "dx": one * fit.params["dx_ref_px"] * scale,
-        "dy": one * fit.params["dy_ref_px"] * scale,
-        "theta_deg": 0 * one,
-        "scale": 0 * one,
-    }
-    return attack.apply_params(pair.clean.unsqueeze(0), params)[0]
+    return UltrasoundBlur(pair.intensity, **options)(pair.clean.unsqueeze(0))[0]

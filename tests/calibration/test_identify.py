@@ -57,7 +57,6 @@ from lerobot_phantom.calibration.identify import (
 from lerobot_phantom.calibration.report import build_report, write_markdown
 from lerobot_phantom.calibration.tone import GAMMA_PARAM, SHOULDER_PARAMS, equivalent_power_gamma
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.ultrasound_blur import UltrasoundBlur
 
 CLEAR_GAIN = Interval(1.5, 1.3, 1.8)
 
@@ -540,13 +539,15 @@ def test_a_filmic_cameras_blur_is_averaged_in_the_light_of_its_shouldered_curve(
     # transform predicts what the fit predicts (its own taps along the path: 3.52 grey levels both), closer than the
     # closest power law it was given before session 87 (3.92; docs/bench/session87/transform_tone_gain_*.txt)
     kwargs = problem.transform_kwargs(shouldered)
-    power_law = {"path": kwargs["path"], "gamma": equivalent_power_gamma(shouldered.params)}
+    power_law = {
+        "path": kwargs["path"],
+        "displacement_per_intensity_px": kwargs["displacement_per_intensity_px"],
+        "gamma": equivalent_power_gamma(shouldered.params),
+    }
 
     def attack_rmse(options):
         errors = [
-            blurred_by_the_attack(UltrasoundBlur(**options), problem, shouldered, int(i))
-            - problem.pairs[int(i)].attacked
-            for i in heldout
+            blurred_by_the_attack(options, problem, int(i)) - problem.pairs[int(i)].attacked for i in heldout
         ]
         return float(torch.cat([e.ravel() for e in errors]).pow(2).mean().sqrt())
 
@@ -563,14 +564,37 @@ def test_a_blur_attack_in_linear_light_sweeps_one_way_as_the_fit_does(tmp_path):
 
     problem, fit_items, heldout = sim.drawn_split("blur_linear_light", 1365449052, tmp_path)
     fit = problem.fit(frozenset({"sensor_gamma"}), fit_items)
-    attack = UltrasoundBlur(**problem.transform_kwargs(fit))
+    options = problem.transform_kwargs(fit)
     errors = {"fit": [], "attack": []}
     for i in heldout:
         attacked = problem.pairs[int(i)].attacked
         errors["fit"].append(problem.predict_pair(fit, int(i)) - attacked)
-        errors["attack"].append(blurred_by_the_attack(attack, problem, fit, int(i)) - attacked)
+        errors["attack"].append(blurred_by_the_attack(options, problem, int(i)) - attacked)
     rmse = {k: float(torch.cat([e.ravel() for e in v]).pow(2).mean().sqrt()) for k, v in errors.items()}
     assert rmse["attack"] == pytest.approx(rmse["fit"], rel=0.02), rmse
+
+
+def test_the_calibrated_blur_attack_runs_the_fitted_displacement(tmp_path):
+    """camsim's paper blur (case blur_null, case seed 3973711099: calibrated, the base model alone) on 48x64 frames.
+    calibrated.json hands the attack the fitted displacement: through its own sampler, at each held-out pair's
+    intensity, the attack predicts the held-out frames as the fit does (2.08 grey levels both); without it the
+    attack ran the paper's lengths on its diagonal (21.85; docs/bench/session88/blur_attack_from_calibration_*.txt)."""
+    import test_independent_sim as sim
+
+    problem, fit_items, heldout = sim.drawn_split("blur_null", 3973711099, tmp_path)
+    fit = problem.fit(frozenset(), fit_items)
+    options = problem.transform_kwargs(fit)
+    assert options["displacement_per_intensity_px"] == [fit.params["dx_ref_px"], fit.params["dy_ref_px"]]
+    paper_lengths = {k: v for k, v in options.items() if k != "displacement_per_intensity_px"}
+    errors = {"fit": [], "attack": [], "paper lengths": []}
+    for i in heldout:
+        attacked = problem.pairs[int(i)].attacked
+        errors["fit"].append(problem.predict_pair(fit, int(i)) - attacked)
+        errors["attack"].append(blurred_by_the_attack(options, problem, int(i)) - attacked)
+        errors["paper lengths"].append(blurred_by_the_attack(paper_lengths, problem, int(i)) - attacked)
+    rmse = {k: float(torch.cat([e.ravel() for e in v]).pow(2).mean().sqrt()) for k, v in errors.items()}
+    assert rmse["attack"] == pytest.approx(rmse["fit"], rel=0.02), rmse
+    assert rmse["paper lengths"] > 3 * rmse["attack"], rmse
 
 
 class HostAndChild(ParentAndChild):

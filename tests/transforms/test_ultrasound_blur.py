@@ -310,3 +310,62 @@ def test_the_blur_in_linear_light_sweeps_one_way_as_the_papers_does():
     in_pixel_values = UltrasoundBlur("strong", gamma=1.0)(image)
     interior = (slice(None), slice(0, -24), slice(0, -24))
     assert float((in_pixel_values - paper)[interior].abs().mean()) < 2.0 / 255
+
+
+@pytest.mark.parametrize(("height", "width"), [(480, 640), (640, 480), (48, 64)])
+def test_a_measured_displacement_grows_with_the_intensity_and_keeps_its_direction(height, width):
+    """``displacement_per_intensity_px`` (what lerobot-phantom-calibrate fits): reference pixels of the longer side
+    at intensity 1, scaled alike on both axes, so a measured direction survives a non-square frame (the paper's
+    diagonal is scaled per axis instead)."""
+    longer = max(height, width) / 256
+    for s in (0.0, 0.5, 1.0):
+        params = UltrasoundBlur(s, displacement_per_intensity_px=[8.0, -4.0]).sample_params(2, height, width)
+        torch.testing.assert_close(params["dx"], torch.full((2,), 8.0 * s * longer, dtype=torch.float64))
+        torch.testing.assert_close(params["dy"], torch.full((2,), -4.0 * s * longer, dtype=torch.float64))
+    turned = UltrasoundBlur(1.0, displacement_per_intensity_px=(8.0, -4.0), random_direction=True)
+    params = turned.sample_params(64, height, width, generator=torch.Generator().manual_seed(0))
+    lengths = torch.hypot(params["dx"], params["dy"])
+    torch.testing.assert_close(
+        lengths, torch.full((64,), math.hypot(8.0, -4.0) * longer, dtype=torch.float64)
+    )
+    assert float(torch.atan2(params["dy"], params["dx"]).std()) > 1.0  # turned, not kept
+
+
+def test_a_measured_blur_is_sampled_continuously_as_the_calibration_fits_it():
+    """A measured sub-pixel path is the bilinear line blur along ``[0, d]`` (``physics.line_blur``, the frame model
+    ``lerobot-phantom-calibrate`` fits), not the paper code's whole-pixel samples, which would shift it towards the
+    pixel; uint8 frames take the same float path, rounded once. Zero intensity is the identity."""
+    from lerobot_phantom.transforms import physics
+
+    generator = torch.Generator().manual_seed(3)
+    coarse = torch.rand(2, 3, 8, 10, generator=generator)
+    image = torch.nn.functional.interpolate(coarse, size=(48, 64), mode="nearest")
+    attack = UltrasoundBlur(0.7, displacement_per_intensity_px=(31.0, -22.5))
+    params = attack.sample_params(2, 48, 64)
+    dx, dy = params["dx"].float(), params["dy"].float()
+    offsets = physics.attack_blur_offsets("uniform", physics.blur_taps(float(dx[0]), float(dy[0])))
+    expected = physics.line_blur(image, dx, dy, offsets)
+    torch.testing.assert_close(attack.apply_params(image, params), expected, atol=1e-6, rtol=0)
+    paper = ultrasound_blur(image, dx, dy)  # the same displacement at whole pixels
+    assert float((paper - expected).abs().mean()) > 0.01
+    as_uint8 = (image * 255).round().to(torch.uint8)
+    blurred8 = attack.apply_params(as_uint8, params)
+    assert _max_grey_diff(blurred8, (attack.apply_params(as_uint8 / 255.0, params) * 255).round()) == 0
+    still = UltrasoundBlur(0.0, displacement_per_intensity_px=(31.0, -22.5))
+    assert torch.equal(still(as_uint8), as_uint8)
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "match"),
+    [
+        ({"displacement_per_intensity_px": "12"}, "two finite numbers"),
+        ({"displacement_per_intensity_px": [1.0]}, "two finite numbers"),
+        ({"displacement_per_intensity_px": [1.0, float("nan")]}, "two finite numbers"),
+        ({"displacement_per_intensity_px": [1.0, "a"]}, "two finite numbers"),
+        ({"displacement_per_intensity_px": [1.0, 2.0], "displacement_px": 5.0}, "give one"),
+        ({"displacement_per_intensity_px": [1.0, 2.0], "rotation_deg": 5.0}, "linear blur only"),
+    ],
+)
+def test_a_bad_measured_displacement_is_refused(kwargs, match):
+    with pytest.raises(ValueError, match=match):
+        UltrasoundBlur(**kwargs)

@@ -332,8 +332,9 @@ class BlurFrames(FrameProblem):
         return reasons
 
     def transform_kwargs(self, fit: Fit) -> dict:
-        """``UltrasoundBlur`` options: the blur path (camera physics); its length stays the attack's setting."""
-        kwargs: dict = {}
+        """``UltrasoundBlur`` options: the fitted displacement at intensity 1 (reference pixels of the longer side,
+        as the fit scales it), the path's shape and the light it is averaged in."""
+        kwargs: dict = {"displacement_per_intensity_px": [fit.params[name] for name in PATH_PARAMS]}
         if "sinusoidal_motion" in fit.effects:
             kwargs["path"] = "sinusoidal"
         if "sensor_gamma" in fit.effects:
