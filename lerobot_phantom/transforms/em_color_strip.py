@@ -381,7 +381,9 @@ class EMColorStrip(CameraAttack):
     """EM color strip attack as a torchvision v2 transform.
 
     Intensity -> stripes: identity / 8 (weak) / 12 (medium) / 16 (strong), paper Table 2; see the module docstring
-    for the continuous mapping. ``num_stripes=`` fixes the paper's stripe count whatever the intensity.
+    for the continuous mapping. ``num_stripes=`` fixes the paper's stripe count whatever the intensity. ``gain`` and
+    ``offset`` (a camera's measured colour map, ``physics.em_color_map``; the paper's 2.5 and 50 / 255 by default)
+    colour the mis-decoded rows in either model.
     """
 
     name: ClassVar[str] = "em_color_strip"
@@ -414,7 +416,7 @@ class EMColorStrip(CameraAttack):
             raise ValueError(f"max_fraction must lie in (0, 1], got {max_fraction!r}")
         # demosaic_pattern (a colour-filter tile, lerobot-phantom-calibrate's bayer_demosaic): mis-decoded rows are
         # the demosaic after a lost line with the map's gain and offset, in either model, instead of the map of
-        # each pixel; the paper's bands then use ``gain`` and ``offset`` too
+        # each pixel
         if demosaic_pattern is not None and demosaic_pattern not in physics.BAYER_PATTERNS:
             raise ValueError(
                 f"unknown demosaic_pattern {demosaic_pattern!r}; valid: None, {', '.join(physics.BAYER_PATTERNS)}"
@@ -470,7 +472,7 @@ class EMColorStrip(CameraAttack):
             rows = physics.bayer_flip_mask(
                 height, params["start_fraction"].to(x.device) * height, device=x.device
             )
-        elif self.demosaic_pattern is not None:
+        elif self.demosaic_pattern is not None or not self.paper_colours:
             rows = row_weights_of(x, params)[:, None, :, None]
         else:
             return self._apply_paper(x, params)
@@ -480,8 +482,13 @@ class EMColorStrip(CameraAttack):
         terms, weights = physics.bayer_line_terms(x, self.demosaic_pattern)
         return physics.em_demosaic_rows(terms, weights, x, rows[:, 0, :, 0], gain, offset)
 
+    @property
+    def paper_colours(self) -> bool:
+        """Whether mis-decoded rows take the paper's colour map (its fast in-place kernels, ``_corrupt_``)."""
+        return (self.bayer["gain"], self.bayer["offset"]) == (GREEN_GAIN, GREEN_OFFSET)
+
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        if self.model == "bayer_phase_flip" or self.demosaic_pattern is not None:
+        if self.model == "bayer_phase_flip" or self.demosaic_pattern is not None or not self.paper_colours:
             return NotImplemented
         return self._apply_paper(x, params)
 
@@ -494,5 +501,10 @@ class EMColorStrip(CameraAttack):
         return (
             super().extra_repr()
             + ("" if self.num_stripes is None else f", num_stripes={self.num_stripes}")
+            + (
+                ""
+                if self.paper_colours
+                else f", gain={self.bayer['gain']!r}, offset={self.bayer['offset']!r}"
+            )
             + ("" if self.demosaic_pattern is None else f", demosaic_pattern={self.demosaic_pattern!r}")
         )

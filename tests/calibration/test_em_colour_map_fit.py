@@ -14,6 +14,7 @@ import torch
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.em_color_strip import EMStripFrames
 from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.em_color_strip import EMColorStrip, row_weights_of
 
 
 def bright_flipped_pairs(gain: float, offset: float, seed: int = 7) -> list[Pair]:
@@ -91,3 +92,34 @@ def test_the_placement_search_scores_each_frame_as_the_prediction_it_registers(l
         assert problem.registered_sse(fit, index) == pytest.approx(
             float(((predicted - pair.attacked) ** 2).sum())
         )
+
+
+def test_the_papers_bands_hand_the_attack_their_fitted_colour_map():
+    """Periodic bands (the base model) whose rows show the colour map 1.2, 0.05: the base fit recovers it, and
+    calibrated.json gives it to the attack, whose bands then show it (until session 88 the base handed the attack no
+    options, and the paper's bands ignored a colour map: the paper's 2.5, 50 / 255 whatever was measured)."""
+    rng = np.random.default_rng(11)
+    pairs = []
+    for i in range(6):
+        clean = torch.from_numpy(rng.uniform(0.2, 0.6, (3, 24, 32)))
+        band = physics.em_color_map(clean.unsqueeze(0), 1.2, 0.05)[0]
+        rows = (np.arange(24) + int(rng.integers(0, 8))) % 8 < 4  # a period of 8 rows, its phase per frame
+        attacked = torch.where(torch.from_numpy(rows)[None, :, None], band, clean)
+        pairs.append(Pair(f"pair_{i}", clean, attacked, None, 1.0))
+    problem = EMStripFrames(pairs, seed=0)
+    fit = problem.fit(frozenset(), np.arange(len(pairs)))
+    options = problem.transform_kwargs(fit)
+    assert set(options) == {"gain", "offset"}
+    assert options["gain"] == pytest.approx(1.2, abs=0.02) and options["offset"] == pytest.approx(
+        0.05, abs=0.01
+    )
+    attack = EMColorStrip("strong", **options)
+    clean = pairs[0].clean.unsqueeze(0).float()
+    params = attack.sample_params(1, 24, 32)
+    weights = row_weights_of(clean, params)[0]
+    mis_decoded = weights == 1
+    assert 0 < int(mis_decoded.sum()) < 24
+    expected = physics.em_color_map(clean, options["gain"], options["offset"])[0].clamp(0, 1)
+    torch.testing.assert_close(
+        attack.apply_params(clean, params)[0][:, mis_decoded], expected[:, mis_decoded]
+    )

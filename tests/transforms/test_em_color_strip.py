@@ -288,3 +288,29 @@ def test_a_demosaic_pattern_mis_decodes_the_same_rows_through_the_demosaic_after
     assert as_uint8.dtype == torch.uint8 and _mad(as_uint8, expected * 255) < 1.0
     with pytest.raises(ValueError, match="valid: None, RGGB, GRBG, GBRG, BGGR"):
         EMColorStrip(demosaic_pattern="rggb")
+
+
+@pytest.mark.parametrize("intensity", [(0.1, 1.0), "strong"])
+def test_a_measured_colour_map_colours_the_papers_bands(intensity):
+    """``gain`` / ``offset`` (a camera's colour map, as lerobot-phantom-calibrate fits it) colour the rows the paper's
+    bands mis-decode: the paper's blend of each row by its band weight, towards ``physics.em_color_map`` with the
+    given map (until session 88 the paper's bands ignored them). With the paper's map that blend is the paper's
+    own fast kernel; uint8 frames take the float path, rounded once."""
+    from lerobot_phantom.transforms import physics
+
+    image = torch.rand(3, 3, 24, 32, generator=torch.Generator().manual_seed(5))
+    measured = EMColorStrip(intensity, gain=1.2, offset=0.05)
+    params = measured.sample_params(3, 24, 32, generator=torch.Generator().manual_seed(0))
+    weights = em_color_strip_module.row_weights_of(image, params)[:, None, :, None].float()
+    for gain, offset in ((1.2, 0.05), (2.5, 50 / 255)):
+        attack = EMColorStrip(intensity, gain=gain, offset=offset)
+        blended = torch.lerp(image, physics.em_color_map(image, gain, offset), weights).clamp(0, 1)
+        torch.testing.assert_close(attack.apply_params(image, params), blended, atol=1e-6, rtol=0)
+    assert (
+        float((measured.apply_params(image, params) - EMColorStrip().apply_params(image, params)).abs().max())
+        > 0.1
+    )
+    as_uint8 = (image * 255).round().to(torch.uint8)
+    expected = (measured.apply_params(as_uint8 / 255.0, params) * 255).round().to(torch.uint8)
+    assert torch.equal(measured.apply_params(as_uint8, params), expected)
+    assert "gain=1.2, offset=0.05" in repr(measured) and "gain" not in repr(EMColorStrip())

@@ -280,10 +280,10 @@ class EMStripFrames(LatentFrameProblem):
         return {"colour_filter_tile": fit.extra["pattern"]} if "bayer_demosaic" in fit.effects else {}
 
     def transform_kwargs(self, fit: Fit) -> dict:
-        """``EMColorStrip`` options: the Bayer-flip model with the fitted colour map, with ``bayer_demosaic`` the
-        demosaic's tile (the paper's bands: none, or with ``bayer_demosaic`` the tile and the fitted colour map)."""
+        """``EMColorStrip`` options: the fitted colour map, the Bayer-flip model where it was found, and with
+        ``bayer_demosaic`` the demosaic's tile. The paper's bands keep the attack's stripe count per intensity (the
+        fitted period is not an option: it would leave the intensity nothing to set)."""
         demosaic = {"demosaic_pattern": fit.extra["pattern"]} if "bayer_demosaic" in fit.effects else {}
         colours = {"gain": fit.params["gain"], "offset": fit.params["offset"]}
-        if "bayer_phase_flip" in fit.effects:
-            return {"model": "bayer_phase_flip", **colours, **demosaic}
-        return {**colours, **demosaic} if demosaic else {}
+        model = {"model": "bayer_phase_flip"} if "bayer_phase_flip" in fit.effects else {}
+        return {**model, **colours, **demosaic}
