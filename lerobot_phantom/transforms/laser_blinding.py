@@ -106,6 +106,8 @@ class LaserPhysics:
     # the camera's colour correction matrix (9 numbers, row-major, rows summing to 1) mixing its clipped raw
     # channels; the laser's pattern and colour are then raw light
     colour_correction: tuple[float, ...] | None = None
+    # the tone curve the options give, built (and so checked) once
+    _tone: physics.Tone = dataclasses.field(init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         if (
@@ -118,7 +120,8 @@ class LaserPhysics:
             raise ValueError(
                 "gain, glare_amplitude, auto_exposure and exposure_spread must be >= 0 and glare_scale_ref_px > 0"
             )
-        self.tone  # noqa: B018 -- the shoulder options are checked where they are given
+        tone = physics.tone_options(self.gamma, self.shoulder, self.shoulder_exponent, owner="LaserBlinding")
+        object.__setattr__(self, "_tone", tone)
         if self.colour_correction is not None:
             matrix = torch.tensor(self.colour_correction, dtype=torch.float64)
             if matrix.numel() != 9 or not torch.allclose(
@@ -134,12 +137,17 @@ class LaserPhysics:
     def tone(self) -> physics.Tone:
         """The tone curve the light is composed in: sRGB (``gamma`` None), the power law ``gamma``, or with
         ``shoulder`` the shouldered curve under the display power ``gamma`` (None: 1)."""
-        return physics.tone_options(self.gamma, self.shoulder, self.shoulder_exponent, owner="LaserBlinding")
+        return self._tone
+
+
+def _option_fields(kind: type) -> list[dataclasses.Field]:
+    """The options of a ``LaserSpot``/``LaserPhysics``: its fields a caller gives (not the ones it derives)."""
+    return [f for f in dataclasses.fields(kind) if f.init]
 
 
 def _options(kind: type, given: Any, flat: dict[str, Any]) -> Any:
     """A ``LaserSpot``/``LaserPhysics`` from an instance, a mapping or None, updated by flat keyword options."""
-    names = {f.name for f in dataclasses.fields(kind)}
+    names = {f.name for f in _option_fields(kind)}
     mine = {k: flat.pop(k) for k in list(flat) if k in names}
     if given is None:
         return kind(**mine)
@@ -261,15 +269,13 @@ class LaserBlinding(CameraAttack):
         # the paper's blend returns a fresh tensor in [0, 1]: the base skips its final clamp
         self._apply_in_unit_range = model == "paper"
         flat = dict(options)
-        spot_given = spot is not None or any(f.name in flat for f in dataclasses.fields(LaserSpot))
+        spot_given = spot is not None or any(f.name in flat for f in _option_fields(LaserSpot))
         self.spot = _options(LaserSpot, spot, flat)
         self.physics = _options(LaserPhysics, physics, flat)
         if flat:
-            valid = [f.name for kind in (LaserSpot, LaserPhysics) for f in dataclasses.fields(kind)]
+            valid = [f.name for kind in (LaserSpot, LaserPhysics) for f in _option_fields(kind)]
             raise TypeError(f"LaserBlinding got unknown options {sorted(flat)}; valid: {', '.join(valid)}")
-        changed = [
-            f.name for f in dataclasses.fields(LaserPhysics) if getattr(self.physics, f.name) != f.default
-        ]
+        changed = [f.name for f in _option_fields(LaserPhysics) if getattr(self.physics, f.name) != f.default]
         if model == "paper" and changed:
             raise ValueError(
                 f"LaserBlinding options {changed} are the physical model's; pass model='physical' (the paper's "

@@ -70,3 +70,20 @@ def test_a_shoulder_of_zero_is_the_power_law_and_a_shoulder_changes_the_attack(n
 def test_a_shoulder_where_the_attack_composes_no_light_is_refused(kind, options, needs):
     with pytest.raises(ValueError, match=needs):
         kind(shoulder=4.0, **options)
+
+
+def test_the_laser_physics_builds_its_tone_curve_once_and_a_replaced_copy_its_own():
+    """``LaserPhysics`` checks and builds its tone curve when made (every batch read it again until session 88);
+    a copy with other options gets the curve of those, and the curve is no option of ``LaserBlinding``."""
+    import dataclasses
+
+    from lerobot_phantom.transforms import physics
+    from lerobot_phantom.transforms.laser_blinding import LaserPhysics
+
+    options = LaserPhysics(gamma=1.0, shoulder=3.0, shoulder_exponent=0.5)
+    assert options.tone is options.tone
+    assert options.tone == physics.ShoulderCurve(3.0, 0.5, 1.0)
+    assert pickle.loads(pickle.dumps(options)).tone == options.tone
+    assert dataclasses.replace(options, shoulder=None, shoulder_exponent=1.0).tone == 1.0
+    with pytest.raises(TypeError, match="unknown options"):
+        LaserBlinding(model="physical", _tone=2.2)
