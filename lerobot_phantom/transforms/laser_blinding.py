@@ -24,8 +24,10 @@ pattern is shifted, black filling the uncovered part); ``"random"`` draws it per
 position are random; the pattern is fixed per instance.
 
 ``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of
-blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"`` (what it
-was calibrated with). With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``,
+blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is
+then a capture of the laser alone, read as the calibration reads its captures: its dark level (the dark room and
+the black level, ``physics.dark_level``) is no laser light and is taken out before the light is scaled by the gain,
+and the glare is centred on the capture's spot (``physics.pattern_centre``), moved with it by ``position``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``,
 ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
 (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
 1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
@@ -348,6 +350,21 @@ class LaserBlinding(CameraAttack):
             lambda: resize_pattern(self._user_pattern, height, width).to(device).contiguous(),
         )
 
+    def capture_reading(
+        self, height: int, width: int, device: torch.device
+    ) -> tuple[torch.Tensor, torch.Tensor]:
+        """A capture's (``pattern=PATH``) spot, as an (x, y) pixel offset from the frame's centre where
+        ``position`` puts the pattern's centre, and its dark level ``(3, 1, 1)``, read on the resized capture."""
+
+        def make() -> tuple[torch.Tensor, torch.Tensor]:
+            capture = self._resized_user_pattern(height, width, torch.device("cpu")).double()
+            centre = physics.pattern_centre(capture)
+            offset = (centre[0] - round(0.5 * (width - 1)), centre[1] - round(0.5 * (height - 1)))
+            level = physics.dark_level(capture, centre)
+            return torch.tensor(offset, device=device), level.to(device=device, dtype=torch.float32)
+
+        return self._cached(("capture", height, width, str(device)), make)
+
     def spot_pixel(self, position: torch.Tensor, height: int, width: int) -> torch.Tensor:
         """(x, y) fractions ``(B, 2)`` -> integer (row, col) pixel centres ``(B, 2)``."""
         rows = torch.round(position[:, 1] * (height - 1))
@@ -484,12 +501,17 @@ class LaserBlinding(CameraAttack):
     ) -> torch.Tensor:
         height, width = x.shape[-2:]
         p = self.physics
-        pixels = self.spot_pixel(params["position"].to(x.device), height, width)
+        centre = self.spot_pixel(params["position"].to(x.device), height, width).flip(1).to(x.dtype)
+        dark = None
+        if self._user_pattern is not None:
+            offset, dark = self.capture_reading(height, width, x.device)
+            centre = centre + offset.to(x.dtype)
         return physics.laser_injection(
             x,
             pattern,
             params["intensity"].to(x.device) * p.gain * params.get("exposure", torch.ones(())).to(x.device),
-            centre=pixels.flip(1).to(x.dtype),
+            dark=dark,
+            centre=centre,
             color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
             halo_amplitude=p.glare_amplitude,
             halo_exponent=p.glare_exponent,

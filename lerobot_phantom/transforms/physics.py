@@ -299,6 +299,47 @@ def project_light(
     return encode(total.clamp(min=0.0), gamma)
 
 
+# a capture of the laser alone: where its spot is and the dark room's level in it (the physical laser blinding
+# and lerobot-phantom-calibrate read a capture alike)
+
+
+def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
+    """(x, y) centroid of the brightest part of a laser pattern."""
+    luminance = pattern.mean(0)
+    mask = luminance >= luminance.max() - 0.05 * max(float(luminance.max() - luminance.min()), 1e-6)
+    ys, xs = torch.nonzero(mask, as_tuple=True)
+    return float(xs.double().mean()), float(ys.double().mean())
+
+
+# the share of a capture's pixels, farthest from the spot, whose median is its dark level: the laser's light falls
+# with the distance, and in the outer half it can stand far above the dark room's (the beam's bloom in a capture at the
+# attack's power, on the independent simulator: the outer half's median 0.070 of the full well where the dark room
+# gives 0.0048 at the spot, the farthest tenth's 0.0075; docs/bench/camsim_session24/dark_level_saturation.txt)
+DARK_SHARE = 0.1
+
+
+def dark_region(pattern: torch.Tensor, centre: tuple[float, float]) -> tuple[torch.Tensor, torch.Tensor]:
+    """(flat distances of the capture's pixels from the spot's centre, mask of the ``DARK_SHARE`` farthest)."""
+    _, height, width = pattern.shape
+    ys, xs = torch.meshgrid(
+        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
+    )
+    radius = torch.hypot(xs - centre[0], ys - centre[1]).reshape(-1)
+    return radius, radius >= torch.quantile(radius, 1.0 - DARK_SHARE)
+
+
+def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
+    """(3, 1, 1): per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
+    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
+    _, far = dark_region(pattern, centre)
+    return far_median(pattern, far)
+
+
+def far_median(values: torch.Tensor, far: torch.Tensor) -> torch.Tensor:
+    """(3, 1, 1): each channel's median over the ``far`` pixels of (3, H, W) ``values``."""
+    return values.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
+
+
 def laser_injection(
     x: torch.Tensor,
     pattern: torch.Tensor,
@@ -312,15 +353,21 @@ def laser_injection(
     auto_exposure: float = 0.0,
     gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
+    dark: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """A laser shone into the camera, physically: the recorded ``pattern`` (encoded, ``(B or 1, 3, H, W)``) is
     linear light scaled by ``power`` (per sample), plus an optional power-law glare around ``centre`` (``(B, 2)``
     pixel (x, y)) in the laser's ``color``; the sum adds to the scene in linear light, the auto-exposure meters
     the pattern's light, and the sensor clips before the tone curve (and before ``colour_correction``, a camera's
-    (3, 3) matrix, mixes its raw channels: the pattern and the colour are then raw light)."""
+    (3, 3) matrix, mixes its raw channels: the pattern and the colour are then raw light). ``dark``: the
+    pattern's own dark level (encoded, broadcastable; a capture's :func:`dark_level`), no laser light: taken out
+    before the light is scaled, or the power would brighten the whole frame by it."""
     height, width = x.shape[-2:]
     power = torch.as_tensor(power, dtype=x.dtype, device=x.device).reshape(-1, 1, 1, 1)
-    light = power * decode(pattern.to(x.dtype), gamma)
+    light = decode(pattern.to(x.dtype), gamma)
+    if dark is not None:
+        light = (light - decode(dark.to(x.dtype), gamma)).clamp(min=0.0)
+    light = power * light
     metered = light
     if halo_amplitude > 0.0:
         if centre is None or color is None:

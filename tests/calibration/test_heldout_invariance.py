@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import os
 import shutil
 from pathlib import Path
@@ -63,10 +64,16 @@ def assert_fits_ignore_the_alteration(
             )
         )
 
-    before, after = run(original, "original"), run(altered, "altered")
+    names = ("original", "altered")
+    before, after = (run(path, name) for path, name in zip((original, altered), names, strict=True))
     # selection took an effect (kept or withdrawn), so it had something to leak into
     assert before["selection"]["selected"] or before["selection"]["withdrawn"]
     assert fitted_part(after) == fitted_part(before)
+    # the attack calibrated.json builds is read from the fit items too
+    options = [
+        json.loads((tmp_path / f"out_{name}" / "calibrated.json").read_text())["kwargs"] for name in names
+    ]
+    assert options[0] == options[1]
     assert scores(after) != scores(before)  # the alteration did reach the held-out scores
     return before
 

@@ -327,3 +327,44 @@ def test_colour_correction_is_validated_and_reaches_the_physical_model():
     for bad in ((1.0, 0.0), (1.5, 0, 0, 0, 1, 0, 0, 0, 1)):
         with pytest.raises(ValueError, match="rows sum to 1"):
             LaserPhysics(colour_correction=bad)
+
+
+def _capture_file(tmp_path, height=48, width=64, spot=(44, 14), dark=12):
+    """A capture of the laser alone: a dark room at ``dark`` grey levels and a saturated green spot of radius 3
+    centred at pixel (x, y) = ``spot``, saved as a PNG."""
+    from PIL import Image
+
+    ys, xs = np.mgrid[0:height, 0:width]
+    image = np.full((height, width, 3), dark, dtype=np.uint8)
+    image[np.hypot(xs - spot[0], ys - spot[1]) <= 3] = (40, 255, 40)
+    path = tmp_path / "capture.png"
+    Image.fromarray(image).save(path)
+    return path
+
+
+def test_a_physical_attack_fed_a_capture_takes_out_its_dark_level_and_centres_the_glare_on_its_spot(tmp_path):
+    """``model="physical"`` with a capture as its pattern reads it as lerobot-phantom-calibrate does: the dark room's
+    level is no laser light (scaled by the gain it brightened the whole frame), and the glare is centred on the
+    capture's spot (``physics.pattern_centre``), which ``position`` moves with the capture."""
+    from lerobot_phantom.transforms import physics
+
+    capture = _capture_file(tmp_path)
+    scene = torch.full((1, 3, 48, 64), 0.2)
+    options = {"model": "physical", "gain": 20.0, "gamma": 1.0}
+    far = (slice(None), slice(None), slice(40, 48), slice(0, 8))  # the frame's corner farthest from the spot
+    fed = LaserBlinding(0.5, pattern=str(capture), **options)(scene)
+    torch.testing.assert_close(fed[far], scene[far])
+    # the same capture with the room's level added as laser light: 0.2 + 10 * 12 / 255 on every pixel
+    as_light = physics.laser_injection(scene, fed.new_tensor(12 / 255).expand(1, 3, 48, 64), 10.0, gamma=1.0)
+    assert float(as_light[far].min()) > 0.6
+    glare = {"glare_amplitude": 0.5, "glare_exponent": 1.5, "glare_scale_ref_px": 4.0, "color": (0.0, 1.0, 0.0)}
+    dark_scene = torch.zeros(1, 3, 48, 64)
+    lit = LaserBlinding(0.5, pattern=str(capture), **options, **glare)(dark_scene)[0, 1]
+    # symmetric about the capture's spot at (x, y) = (44, 14), not about the frame's centre
+    torch.testing.assert_close(lit[14, 44 - 10], lit[14, 44 + 10])
+    torch.testing.assert_close(lit[14 - 9, 44], lit[14 + 9, 44])
+    assert float(lit[14, 34]) > 2 * float(lit[40, 10])
+    # position puts the capture's centre (32, 24 here) at (0.25, 0.5): the spot and its glare move by (-16, 0)
+    moved = LaserBlinding(0.5, pattern=str(capture), position=(0.25, 0.5), **options, **glare)(dark_scene)[0, 1]
+    torch.testing.assert_close(moved[14, 28 - 10], moved[14, 28 + 10])
+    torch.testing.assert_close(moved[:, 10:40], lit[:, 26:56])

@@ -117,6 +117,7 @@ from lerobot_phantom.calibration.tone import (
     shoulder_kwargs,
 )
 from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.physics import dark_level, dark_region, far_median, pattern_centre
 
 logger = logging.getLogger(__name__)
 
@@ -234,45 +235,8 @@ def laser_gain(params: dict):
     return 10.0 ** params["log10_gain"]
 
 
-def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
-    """(x, y) centroid of the brightest part of a laser pattern."""
-    luminance = pattern.mean(0)
-    mask = luminance >= luminance.max() - 0.05 * max(float(luminance.max() - luminance.min()), 1e-6)
-    ys, xs = torch.nonzero(mask, as_tuple=True)
-    return float(xs.double().mean()), float(ys.double().mean())
-
-
 # a saturated capture reads a few grey levels below 255 where JPEG rings in its flat white: 248 and above counts
 SATURATED = 247.5 / 255.0
-
-
-# the share of a capture's pixels, farthest from the spot, whose median is its dark level: the laser's light falls
-# with the distance, and in the outer half it can stand far above the dark room's (the beam's bloom in a capture at the
-# attack's power, on the independent simulator: the outer half's median 0.070 of the full well where the dark room
-# gives 0.0048 at the spot, the farthest tenth's 0.0075; docs/bench/camsim_session24/dark_level_saturation.txt)
-DARK_SHARE = 0.1
-
-
-def dark_region(pattern: torch.Tensor, centre: tuple[float, float]) -> tuple[torch.Tensor, torch.Tensor]:
-    """(flat distances of the capture's pixels from the spot's centre, mask of the ``DARK_SHARE`` farthest)."""
-    _, height, width = pattern.shape
-    ys, xs = torch.meshgrid(
-        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
-    )
-    radius = torch.hypot(xs - centre[0], ys - centre[1]).reshape(-1)
-    return radius, radius >= torch.quantile(radius, 1.0 - DARK_SHARE)
-
-
-def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
-    """(3, 1, 1): per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
-    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
-    _, far = dark_region(pattern, centre)
-    return far_median(pattern, far)
-
-
-def far_median(values: torch.Tensor, far: torch.Tensor) -> torch.Tensor:
-    """(3, 1, 1): each channel's median over the ``far`` pixels of (3, H, W) ``values``."""
-    return values.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
 
 
 def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
@@ -456,6 +420,12 @@ GLARE_REFERENCE_PX = 64.0
 # its range (0.3 or 200 px) while the level and exponent fitted the frames as well (camsim halo case,
 # docs/bench/camsim_session24.md). Fixed inside the core, the glare is a power law wherever the frames show it
 GLARE_INNER_SCALE_REF_PX = 1.0
+
+
+def laser_level(params: dict, effects: frozenset[str]):
+    """The laser's light per unit intensity the frame model scales its pattern by: the gain of a linear-light
+    model, the blend's opacity otherwise."""
+    return laser_gain(params) if "linear_light_saturation" in effects else params["alpha"]
 
 
 def halo_amplitude(params: dict):
@@ -798,8 +768,11 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
         if "frame_exposure" in effects:
-            return self.fit_frame_exposure(effects, items, start)
-        return PixelProblem.fit(self, effects, items, start)
+            fit = self.fit_frame_exposure(effects, items, start)
+        else:
+            fit = PixelProblem.fit(self, effects, items, start)
+        fit.extra["items"] = np.asarray(items)  # what transform_kwargs reads the attack's options from
+        return fit
 
     def fit_frame_exposure(self, effects: frozenset[str], items: np.ndarray, start: Fit | None) -> Fit:
         """Least squares on the fit frames' pixel samples with each frame's latent ``u`` registered (the first
@@ -939,18 +912,25 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def divisor_auto_exposure(self, fit: Fit) -> float:
         """The transform's auto-exposure ``1 / (1 + a * mean injected light)`` (``physics.inject_linear_light``)
-        closest, over the fit's frames, to the metered exposure factors (least squares in ``1 / factor - 1``).
-        The core extrapolation has no counterpart in the transform, whose spot pattern is not clipped."""
+        closest, over the fit's frames (none held out), to the metered exposure factors (least squares in
+        ``1 / factor - 1``). The core extrapolation has no counterpart in the transform, whose spot pattern is not
+        clipped."""
         p, effects = fit.params, fit.effects
         decode, _ = self.tone_curve(effects, p)
+        frames = [int(i) for i in np.unique(fit.extra["items"])]
         with torch.no_grad():
-            factor = self.exposure_factor(effects, p, decode)
-            level = laser_gain(p) if "linear_light_saturation" in effects else p["alpha"]
-            f = self.probe_features
-            light = level * f["strength"] * (decode(f["pattern"]) - decode(f["dark"]))
-            metered = light.clamp(min=0.0).mean(1).reshape(len(self.pairs), -1).mean(1)
+            f = self.probe_slots(frames)
+            factor = self.exposure_factor(effects, p, decode, f)
+            light = laser_level(p, effects) * f["strength"] * (decode(f["pattern"]) - decode(f["dark"]))
+            metered = light.clamp(min=0.0).mean(1).reshape(len(frames), -1).mean(1)
             excess = 1.0 / factor.clamp(min=1e-6) - 1.0
         return float(max((metered * excess).sum() / (metered**2).sum().clamp(min=1e-12), 0.0))
+
+    def laser_colour(self, fit: Fit) -> list[float]:
+        """The fit frames' laser colour (linear light, its brightest channel 1): the glare's colour."""
+        frames = np.unique(fit.extra["items"])
+        colour = torch.stack([self.colours[int(i)] for i in frames]).mean(0)
+        return (colour / colour.max().clamp(min=1e-9)).tolist()
 
     def transform_kwargs(self, fit: Fit) -> dict:
         """``LaserBlinding`` options: the paper's alpha levels, or the physical model (``physics.laser_injection``)."""
@@ -958,13 +938,17 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         if not effects:
             alpha = min(p["alpha"], 1.0)
             return {"levels": [0.0, alpha / 3, 2 * alpha / 3, alpha]}
-        linear = "linear_light_saturation" in effects
+        gain = float(laser_level(p, effects))
+        # the transform's glare is light per unit of its laser power (intensity times gain), the frame model's per
+        # unit intensity; at zero gain the attack adds no light at all
+        glare = float(halo_amplitude(p)) / gain if "halo_power_law" in effects and gain > 0 else 0.0
         return {
             "model": "physical",
-            "gain": float(laser_gain(p)) if linear else p["alpha"],
-            "glare_amplitude": float(halo_amplitude(p)) if "halo_power_law" in effects else 0.0,
+            "gain": gain,
+            "glare_amplitude": glare,
             "glare_exponent": p.get("halo_exponent", 2.0),
             "glare_scale_ref_px": GLARE_INNER_SCALE_REF_PX,
+            **({"color": self.laser_colour(fit)} if "halo_power_law" in effects else {}),
             "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
             "exposure_spread": p["exposure_spread"] if "frame_exposure" in effects else 0.0,
             "colour_correction": correction_matrix(p).reshape(-1).tolist()

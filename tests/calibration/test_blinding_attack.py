@@ -1,0 +1,76 @@
+"""The laser blinding attack ``calibrated.json`` builds, against the frame model the calibration fitted: fed the
+camera's own capture of the laser, the attack predicts the held-out frames as the fit does, and its options are
+read from the fit frames alone."""
+
+from __future__ import annotations
+
+import dataclasses
+import os
+
+import numpy as np
+import pytest
+import torch
+
+os.environ.setdefault("HF_HUB_OFFLINE", "1")
+
+from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
+from lerobot_phantom.transforms.laser_blinding import LaserBlinding
+
+
+def heldout_rmse(predictions: list[torch.Tensor], targets: list[torch.Tensor]) -> float:
+    errors = [(p.double() - t).ravel() for p, t in zip(predictions, targets, strict=True)]
+    return float(torch.cat(errors).pow(2).mean().sqrt())
+
+
+def test_the_attack_fed_the_cameras_capture_predicts_the_heldout_frames_as_the_fit_does(tmp_path):
+    """camsim's glare case (case seed 2074608951; calibrated, it selects linear light, its glare, the meter and a
+    tone shoulder). The attack takes the pair's own capture as its pattern: its dark level is no laser light and its
+    glare is centred on its spot, and the glare is light per unit of the attack's power (intensity times gain), not
+    per unit intensity as the fit writes it: 2.58 grey levels against the fit's 2.47; with the capture's dark level
+    scaled as laser light, the glare on the frame's centre and the fit's glare amplitude (until session 88) 23.04
+    (docs/bench/session88/blinding_attack_*.txt)."""
+    import test_independent_sim as sim
+
+    problem, fit_items, heldout = sim.drawn_split("blinding_halo", 2074608951, tmp_path)
+    effects = frozenset({"linear_light_saturation", "halo_power_law", "auto_exposure", "tone_shoulder"})
+    fit = problem.fit(effects, fit_items)
+    options = problem.transform_kwargs(fit)
+    assert (
+        options["glare_amplitude"] * options["gain"] > 5 * options["glare_amplitude"]
+    )  # the gain is well above 1
+    targets = [problem.pairs[int(i)].attacked for i in heldout]
+    fitted = [problem.predict_pair(fit, int(i)) for i in heldout]
+
+    def attacked(i: int, **changes) -> torch.Tensor:
+        pair = problem.pairs[i]
+        attack = LaserBlinding(
+            pair.intensity, pattern=str(tmp_path / f"pattern_{i:03d}.png"), **{**options, **changes}
+        )
+        return attack(pair.clean.unsqueeze(0).float())[0]
+
+    attack = heldout_rmse([attacked(int(i)) for i in heldout], targets)
+    assert attack < 1.15 * heldout_rmse(fitted, targets)
+    per_intensity = {"glare_amplitude": options["glare_amplitude"] * options["gain"]}
+    assert heldout_rmse([attacked(int(i), **per_intensity) for i in heldout], targets) > 3 * attack
+
+
+def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
+    """camsim's auto-exposure case (case seed 1758681884: calibrated, it selects the meter and each frame's own
+    exposure). The options calibrated.json holds (the transform's meter, the glare's colour) must not change when the
+    held-out frames and their captures do: until session 88 the meter's conversion read every pair's frames."""
+    import test_independent_sim as sim
+
+    problem, fit_items, heldout = sim.drawn_split("blinding_auto_exposure", 1758681884, tmp_path)
+    effects = frozenset({"linear_light_saturation", "auto_exposure", "frame_exposure", "halo_power_law"})
+    fit = problem.fit(effects, fit_items)
+    options = problem.transform_kwargs(fit)
+    assert options["auto_exposure"] > 0 and len(options["color"]) == 3
+    pairs = list(problem.pairs)
+    for i in heldout:
+        pair = pairs[int(i)]
+        brighter = (pair.pattern * 1.5).clamp(0, 1)
+        pairs[int(i)] = dataclasses.replace(pair, pattern=brighter.flip(-1), attacked=pair.attacked.flip(-1))
+    altered = BlindingFrames(pairs, seed=problem.seed)
+    assert altered.transform_kwargs(fit) == options
+    every_frame = dataclasses.replace(fit, extra={**fit.extra, "items": np.arange(len(pairs))})
+    assert altered.transform_kwargs(every_frame)["auto_exposure"] != pytest.approx(options["auto_exposure"])
