@@ -357,7 +357,12 @@ def test_a_physical_attack_fed_a_capture_takes_out_its_dark_level_and_centres_th
     # the same capture with the room's level added as laser light: 0.2 + 10 * 12 / 255 on every pixel
     as_light = physics.laser_injection(scene, fed.new_tensor(12 / 255).expand(1, 3, 48, 64), 10.0, gamma=1.0)
     assert float(as_light[far].min()) > 0.6
-    glare = {"glare_amplitude": 0.5, "glare_exponent": 1.5, "glare_scale_ref_px": 4.0, "color": (0.0, 1.0, 0.0)}
+    glare = {
+        "glare_amplitude": 0.5,
+        "glare_exponent": 1.5,
+        "glare_scale_ref_px": 4.0,
+        "color": (0.0, 1.0, 0.0),
+    }
     dark_scene = torch.zeros(1, 3, 48, 64)
     lit = LaserBlinding(0.5, pattern=str(capture), **options, **glare)(dark_scene)[0, 1]
     # symmetric about the capture's spot at (x, y) = (44, 14), not about the frame's centre
@@ -365,6 +370,8 @@ def test_a_physical_attack_fed_a_capture_takes_out_its_dark_level_and_centres_th
     torch.testing.assert_close(lit[14 - 9, 44], lit[14 + 9, 44])
     assert float(lit[14, 34]) > 2 * float(lit[40, 10])
     # position puts the capture's centre (32, 24 here) at (0.25, 0.5): the spot and its glare move by (-16, 0)
-    moved = LaserBlinding(0.5, pattern=str(capture), position=(0.25, 0.5), **options, **glare)(dark_scene)[0, 1]
+    moved = LaserBlinding(0.5, pattern=str(capture), position=(0.25, 0.5), **options, **glare)(dark_scene)[
+        0, 1
+    ]
     torch.testing.assert_close(moved[14, 28 - 10], moved[14, 28 + 10])
     torch.testing.assert_close(moved[:, 10:40], lit[:, 26:56])
