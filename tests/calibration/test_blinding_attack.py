@@ -68,9 +68,13 @@ def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
     pairs = list(problem.pairs)
     for i in heldout:
         pair = pairs[int(i)]
-        brighter = (pair.pattern * 1.5).clamp(0, 1)
-        pairs[int(i)] = dataclasses.replace(pair, pattern=brighter.flip(-1), attacked=pair.attacked.flip(-1))
+        recoloured = pair.pattern * torch.tensor([1.5, 0.5, 1.5], dtype=pair.pattern.dtype).reshape(3, 1, 1)
+        pairs[int(i)] = dataclasses.replace(
+            pair, pattern=recoloured.clamp(0, 1).flip(-1), attacked=pair.attacked.flip(-1)
+        )
     altered = BlindingFrames(pairs, seed=problem.seed)
     assert altered.transform_kwargs(fit) == options
     every_frame = dataclasses.replace(fit, extra={**fit.extra, "items": np.arange(len(pairs))})
-    assert altered.transform_kwargs(every_frame)["auto_exposure"] != pytest.approx(options["auto_exposure"])
+    read_from_every_frame = altered.transform_kwargs(every_frame)
+    assert read_from_every_frame["auto_exposure"] != pytest.approx(options["auto_exposure"])
+    assert read_from_every_frame["color"] != pytest.approx(options["color"])
