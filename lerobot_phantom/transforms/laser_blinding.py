@@ -27,8 +27,9 @@ position are random; the pattern is fixed per instance.
 blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is
 then a capture of the laser alone, read as the calibration reads its captures: its dark level (the dark room and
 the black level, ``physics.dark_level``) is no laser light and is taken out before the light is scaled by the gain,
-and the glare is centred on the capture's spot (``physics.pattern_centre``), moved with it by ``position``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``,
-``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
+and the glare is centred on the capture's spot (``physics.pattern_centre``), moved with it by ``position``. With
+``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``, ``z`` standard normal
+drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
 (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
 1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
 light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well, not
