@@ -11,67 +11,41 @@ docs/bench/session88/blinding_attack_from_calibration.py CASE:CASE_SEED...``
 
 from __future__ import annotations
 
-import json
 import sys
-import tempfile
-from pathlib import Path
 
 import torch
+from calibrated_draws import calibrated_draws
 
 
 def main() -> None:
-    import pandas as pd
-    import test_independent_sim as sim
-
-    from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
-    from lerobot_phantom.calibration.frame_models.laser_blinding import pattern_centre
+    from lerobot_phantom.transforms.physics import pattern_centre
     from lerobot_phantom.transforms.registry import make_attack
 
-    torch.set_num_threads(1)
-    for draw in sys.argv[1:]:
-        name, seed = draw.split(":")
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = Path(tmp)
-            problem, fit_items, heldout = sim.drawn_split(name, int(seed), folder / "pairs")
-            out = folder / "out"
-            report = calibrate(
-                CalibrateConfig(
-                    attack="laser_blinding",
-                    measured=str(folder / "pairs"),
-                    out=str(out),
-                    seed=int(seed) % 2**31,
-                )
+    for draw in calibrated_draws("laser_blinding", sys.argv[1:]):
+        problem, report, kwargs = draw.problem, draw.report, draw.kwargs
+        fit = draw.fit()
+        squared = {"fit": [], "attack": []}
+        near = []
+        for i in draw.heldout:
+            pair = problem.pairs[int(i)]
+            attack = make_attack(
+                "laser_blinding",
+                intensity=pair.intensity,
+                calibration=str(draw.out),
+                pattern=str(draw.folder / "pairs" / f"pattern_{int(i):03d}.png"),  # camsim.write_pairs' names
+                seed=int(i),  # the frame exposure it draws (exposure_spread), reproducibly
             )
-            kwargs = json.loads((out / "calibrated.json").read_text())["kwargs"]
-            fit = problem.fit(
-                frozenset(report["extended"]["effects"]), fit_items
-            )  # the report's (deterministic)
-            table = pd.read_csv(folder / "pairs" / "pairs.csv")
-            squared = {"fit": [], "attack": []}
-            near = []
-            for i in heldout:
-                pair = problem.pairs[int(i)]
-                capture = folder / "pairs" / table.loc[int(i), "pattern"]
-                attack = make_attack(
-                    "laser_blinding",
-                    intensity=pair.intensity,
-                    calibration=str(out),
-                    pattern=str(capture),
-                    seed=int(i),  # the frame exposure it draws (exposure_spread), reproducibly
-                )
-                squared["attack"].append(
-                    (attack(pair.clean.unsqueeze(0).float())[0].double() - pair.attacked) ** 2
-                )
-                squared["fit"].append((problem.predict_pair(fit, int(i)) - pair.attacked) ** 2)
-                cx, cy = pattern_centre(pair.pattern)
-                ys, xs = torch.meshgrid(
-                    torch.arange(pair.height, dtype=torch.float64),
-                    torch.arange(pair.width, dtype=torch.float64),
-                    indexing="ij",
-                )
-                near.append(
-                    (torch.hypot(xs - cx, ys - cy) < max(pair.height, pair.width) / 4).expand(3, -1, -1)
-                )
+            squared["attack"].append(
+                (attack(pair.clean.unsqueeze(0).float())[0].double() - pair.attacked) ** 2
+            )
+            squared["fit"].append((problem.predict_pair(fit, int(i)) - pair.attacked) ** 2)
+            cx, cy = pattern_centre(pair.pattern)
+            ys, xs = torch.meshgrid(
+                torch.arange(pair.height, dtype=torch.float64),
+                torch.arange(pair.width, dtype=torch.float64),
+                indexing="ij",
+            )
+            near.append((torch.hypot(xs - cx, ys - cy) < max(pair.height, pair.width) / 4).expand(3, -1, -1))
         mask = torch.cat([m.ravel() for m in near])
 
         def rmse(values, where=None):
@@ -80,11 +54,11 @@ def main() -> None:
             return 255 * float(flat.mean().sqrt())
 
         print(
-            f"{name} case seed {seed}, frames {tuple(problem.pairs[0].clean.shape)}, {len(heldout)} held-out pairs, "
-            f"selected {report['extended']['effects']}, kwargs {kwargs}: calibration's held-out RMSE "
-            f"{report['extended']['heldout_rmse']:.2f}; fit {rmse(squared['fit']):.2f} (near the spot "
-            f"{rmse(squared['fit'], mask):.2f}, beyond {rmse(squared['fit'], ~mask):.2f}); attack fed the capture "
-            f"{rmse(squared['attack']):.2f} (near {rmse(squared['attack'], mask):.2f}, beyond "
+            f"{draw.name} case seed {draw.seed}, frames {tuple(problem.pairs[0].clean.shape)}, "
+            f"{len(draw.heldout)} held-out pairs, selected {report['extended']['effects']}, kwargs {kwargs}: "
+            f"calibration's held-out RMSE {report['extended']['heldout_rmse']:.2f}; fit {rmse(squared['fit']):.2f} "
+            f"(near the spot {rmse(squared['fit'], mask):.2f}, beyond {rmse(squared['fit'], ~mask):.2f}); attack fed "
+            f"the capture {rmse(squared['attack']):.2f} (near {rmse(squared['attack'], mask):.2f}, beyond "
             f"{rmse(squared['attack'], ~mask):.2f})",
             flush=True,
         )

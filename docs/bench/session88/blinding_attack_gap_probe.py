@@ -18,114 +18,90 @@ PYTHONPATH=.:tests/calibration:tests python docs/bench/session88/blinding_attack
 
 from __future__ import annotations
 
-import json
 import sys
-import tempfile
-from pathlib import Path
 
 import torch
+from calibrated_draws import calibrated_draws
 
 
-def main() -> None:
-    import test_independent_sim as sim
-
-    from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
+def readings(problem, fit, tone, index: int) -> dict[str, tuple[torch.Tensor, torch.Tensor, torch.Tensor]]:
+    """Steps 1-4 (the module docstring): the laser's light per unit power, the glare's centre (x, y) and colour."""
     from lerobot_phantom.calibration.frame_models.laser_blinding import laser_irradiance
     from lerobot_phantom.transforms import physics
     from lerobot_phantom.transforms.laser_blinding import LaserBlinding
 
-    torch.set_num_threads(1)
-    for draw in sys.argv[1:]:
-        name, seed = draw.split(":")
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = Path(tmp)
-            problem, fit_items, heldout = sim.drawn_split(name, int(seed), folder / "pairs")
-            report = calibrate(
-                CalibrateConfig(
-                    attack="laser_blinding",
-                    measured=str(folder / "pairs"),
-                    out=str(folder / "out"),
-                    seed=int(seed) % 2**31,
-                )
+    pair = problem.pairs[index]
+    frame_centre = torch.tensor(
+        [[round(0.5 * (pair.width - 1)), round(0.5 * (pair.height - 1))]], dtype=torch.float64
+    )
+    spot = torch.tensor([problem.centre(index)], dtype=torch.float64)
+    decoded = physics.decode(pair.pattern.unsqueeze(0), tone)
+    dark = physics.decode(problem.dark_fields[index].unsqueeze(0), tone)
+    beam = physics.decode(problem.beams[index].profile.unsqueeze(0), tone)
+    continued = (beam - dark).clamp(min=0.0)
+    if "core_sigma_ref_px" in fit.params:
+        core = (problem.core_depths[index], problem.core_radii[index].reshape(3, 1, 1))
+        continued = laser_irradiance(beam[0], dark[0], *core, fit.params).unsqueeze(0)
+    default_colour = torch.tensor(LaserBlinding(model="physical").color, dtype=torch.float64)
+    colour = problem.colours[index]
+    return {
+        "1": (decoded, frame_centre, default_colour),
+        "2": (decoded, spot, colour),
+        "3": ((decoded - dark).clamp(min=0.0), spot, colour),
+        "4": (continued, spot, colour),
+    }
+
+
+def injected(clean, physics_options, power: float, light, centre, colour) -> torch.Tensor:
+    """The attack's physics (``physics.laser_injection``'s sum, written out) with this light and glare."""
+    from lerobot_phantom.transforms import physics
+
+    p = physics_options
+    laser = power * light
+    total = laser
+    if p.glare_amplitude > 0:
+        height, width = clean.shape[-2:]
+        radius = physics.radial_distance(height, width, centre, dtype=torch.float64)
+        scale = p.glare_scale_ref_px * max(height, width) / 256
+        glare = physics.power_law_halo(radius, p.glare_amplitude, p.glare_exponent, scale)
+        total = laser + power * glare * colour.reshape(1, 3, 1, 1)
+    return physics.inject_linear_light(
+        clean, total, auto_exposure=p.auto_exposure, metered_light=laser, gamma=p.tone
+    )
+
+
+def main() -> None:
+    from lerobot_phantom.transforms.laser_blinding import LaserBlinding
+
+    for draw in calibrated_draws("laser_blinding", sys.argv[1:]):
+        problem, kwargs = draw.problem, draw.kwargs
+        fit = draw.fit()
+        p = LaserBlinding(model="physical", **{k: v for k, v in kwargs.items() if k != "model"}).physics
+        squared: dict[str, list[torch.Tensor]] = {
+            k: [] for k in ("fit", "attack", "attack, no exposure draw", "1", "2", "3", "4")
+        }
+        for i in draw.heldout:
+            i = int(i)
+            pair = problem.pairs[i]
+            clean = pair.clean.unsqueeze(0)
+            squared["fit"].append((problem.predict_pair(fit, i) - pair.attacked) ** 2)
+            capture = str(draw.folder / "pairs" / f"pattern_{i:03d}.png")  # camsim.write_pairs' names
+            user = LaserBlinding(pair.intensity, pattern=capture, seed=i, **kwargs)
+            squared["attack"].append((user(clean.float())[0].double() - pair.attacked) ** 2)
+            steady = LaserBlinding(pair.intensity, pattern=capture, **{**kwargs, "exposure_spread": 0.0})
+            squared["attack, no exposure draw"].append(
+                (steady(clean.float())[0].double() - pair.attacked) ** 2
             )
-            kwargs = json.loads((folder / "out" / "calibrated.json").read_text())["kwargs"]
-            effects = frozenset(report["extended"]["effects"])
-            fit = problem.fit(effects, fit_items)
-            p = LaserBlinding(model="physical", **{k: v for k, v in kwargs.items() if k != "model"}).physics
-            squared: dict[str, list[torch.Tensor]] = {
-                k: [] for k in ("fit", "attack", "attack, no exposure draw", "1", "2", "3", "4")
-            }
-            for i in heldout:
-                i = int(i)
-                pair = problem.pairs[i]
-                clean = pair.clean.unsqueeze(0)
-                squared["fit"].append((problem.predict_pair(fit, i) - pair.attacked) ** 2)
-                capture_file = str(folder / "pairs" / f"pattern_{i:03d}.png")  # camsim.write_pairs' names
-                user = LaserBlinding(pair.intensity, pattern=capture_file, seed=i, **kwargs)
-                squared["attack"].append((user(clean.float())[0].double() - pair.attacked) ** 2)
-                steady = LaserBlinding(
-                    pair.intensity, pattern=capture_file, **{**kwargs, "exposure_spread": 0.0}
-                )
-                squared["attack, no exposure draw"].append(
-                    (steady(clean.float())[0].double() - pair.attacked) ** 2
-                )
-                height, width = pair.height, pair.width
-                power = pair.intensity * p.gain
-                frame_centre = torch.tensor(
-                    [[round(0.5 * (width - 1)), round(0.5 * (height - 1))]], dtype=torch.float64
-                )
-                spot = torch.tensor([problem.centre(i)], dtype=torch.float64)
-                capture = pair.pattern.unsqueeze(0)
-                decoded = physics.decode(capture, p.tone)
-                dark = physics.decode(problem.dark_fields[i].unsqueeze(0), p.tone)
-                beam = physics.decode(problem.beams[i].profile.unsqueeze(0), p.tone)
-                params = {**fit.params}
-                continued = (
-                    laser_irradiance(
-                        beam[0],
-                        dark[0],
-                        problem.core_depths[i],
-                        problem.core_radii[i].reshape(3, 1, 1),
-                        params,
-                    ).unsqueeze(0)
-                    if "core_sigma_ref_px" in params
-                    else (beam - dark).clamp(min=0.0)
-                )
-                default_colour = torch.tensor(LaserBlinding(model="physical").color, dtype=torch.float64)
-                colour = problem.colours[i]
-                steps = {
-                    "1": (decoded, frame_centre, default_colour, 1.0),
-                    "2": (decoded, spot, colour, 1.0),
-                    "3": ((decoded - dark).clamp(min=0.0), spot, colour, 1.0),
-                    "4": (continued, spot, colour, 1.0),
-                }
-                for key, (light, centre, glare_colour, factor) in steps.items():
-                    laser = power * factor * light
-                    total = laser
-                    if p.glare_amplitude > 0:
-                        radius = physics.radial_distance(height, width, centre, dtype=torch.float64)
-                        glare = physics.power_law_halo(
-                            radius,
-                            p.glare_amplitude,
-                            p.glare_exponent,
-                            p.glare_scale_ref_px * max(height, width) / 256,
-                        )
-                        total = laser + power * factor * glare * glare_colour.reshape(1, 3, 1, 1)
-                    out = physics.inject_linear_light(
-                        clean,
-                        total,
-                        auto_exposure=p.auto_exposure,
-                        metered_light=laser,
-                        gamma=p.tone,
-                    )
-                    squared[key].append((out[0] - pair.attacked) ** 2)
+            for key, reading in readings(problem, fit, p.tone, i).items():
+                predicted = injected(clean, p, pair.intensity * p.gain, *reading)
+                squared[key].append((predicted[0] - pair.attacked) ** 2)
 
         def rmse(values):
             return 255 * float(torch.cat([v.ravel() for v in values]).mean().sqrt())
 
         print(
-            f"{name} case seed {seed}, {len(heldout)} held-out pairs, selected {sorted(effects)}: fit "
-            f"{rmse(squared['fit']):.2f}; "
+            f"{draw.name} case seed {draw.seed}, {len(draw.heldout)} held-out pairs, selected "
+            f"{sorted(draw.report['extended']['effects'])}: fit {rmse(squared['fit']):.2f}; "
             + ", ".join(f"{k} {rmse(v):.2f}" for k, v in squared.items() if k != "fit"),
             flush=True,
         )

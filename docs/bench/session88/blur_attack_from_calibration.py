@@ -11,51 +11,32 @@ docs/bench/session88/blur_attack_from_calibration.py CASE:CASE_SEED...``
 
 from __future__ import annotations
 
-import json
 import sys
-import tempfile
-from pathlib import Path
 
 import torch
+from calibrated_draws import calibrated_draws
 
 
 def main() -> None:
-    import test_independent_sim as sim
-
-    from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
     from lerobot_phantom.transforms.registry import make_attack
 
-    torch.set_num_threads(1)
-    for draw in sys.argv[1:]:
-        name, seed = draw.split(":")
-        with tempfile.TemporaryDirectory() as tmp:
-            folder = Path(tmp)
-            problem, _, heldout = sim.drawn_split(name, int(seed), folder / "pairs")
-            out = folder / "out"
-            report = calibrate(
-                CalibrateConfig(
-                    attack="ultrasound_blur",
-                    measured=str(folder / "pairs"),
-                    out=str(out),
-                    seed=int(seed) % 2**31,
-                )
-            )
-            kwargs = json.loads((out / "calibrated.json").read_text())["kwargs"]
-            paper_length = {k: v for k, v in kwargs.items() if k != "displacement_per_intensity_px"}
-            errors: dict[str, list[torch.Tensor]] = {"calibrated.json": [], "without its displacement": []}
-            for i in heldout:
-                pair = problem.pairs[int(i)]
-                clean = pair.clean.unsqueeze(0)
-                calibrated = make_attack("ultrasound_blur", intensity=pair.intensity, calibration=str(out))
-                errors["calibrated.json"].append(calibrated(clean)[0] - pair.attacked)
-                paper = make_attack("ultrasound_blur", intensity=pair.intensity, **paper_length)
-                errors["without its displacement"].append(paper(clean)[0] - pair.attacked)
+    for draw in calibrated_draws("ultrasound_blur", sys.argv[1:]):
+        problem, report, kwargs = draw.problem, draw.report, draw.kwargs
+        paper_length = {k: v for k, v in kwargs.items() if k != "displacement_per_intensity_px"}
+        errors: dict[str, list[torch.Tensor]] = {"calibrated.json": [], "without its displacement": []}
+        for i in draw.heldout:
+            pair = problem.pairs[int(i)]
+            clean = pair.clean.unsqueeze(0)
+            calibrated = make_attack("ultrasound_blur", intensity=pair.intensity, calibration=str(draw.out))
+            errors["calibrated.json"].append(calibrated(clean)[0] - pair.attacked)
+            paper = make_attack("ultrasound_blur", intensity=pair.intensity, **paper_length)
+            errors["without its displacement"].append(paper(clean)[0] - pair.attacked)
         rmse = {
             k: 255 * float(torch.cat([e.ravel() for e in v]).pow(2).mean().sqrt()) for k, v in errors.items()
         }
         shape = tuple(problem.pairs[0].clean.shape)
         print(
-            f"{name} case seed {seed}, frames {shape}, {len(heldout)} held-out pairs, selected "
+            f"{draw.name} case seed {draw.seed}, frames {shape}, {len(draw.heldout)} held-out pairs, selected "
             f"{report['extended']['effects']}, kwargs {kwargs}: calibration's held-out RMSE "
             f"{report['extended']['heldout_rmse']:.2f}, attack from calibrated.json {rmse['calibrated.json']:.2f}, "
             f"without its displacement {rmse['without its displacement']:.2f}",
