@@ -940,8 +940,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             return {"levels": [0.0, alpha / 3, 2 * alpha / 3, alpha]}
         gain = float(laser_level(p, effects))
         # the transform's glare is light per unit of its laser power (intensity times gain), the frame model's per
-        # unit intensity; at zero gain the attack adds no light at all
-        glare = float(halo_amplitude(p)) / gain if "halo_power_law" in effects and gain > 0 else 0.0
+        # unit intensity (the glare builds on linear light, whose gain is at least 10 ** -3)
+        glare = float(halo_amplitude(p)) / gain if "halo_power_law" in effects else 0.0
         return {
             "model": "physical",
             "gain": gain,
