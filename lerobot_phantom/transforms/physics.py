@@ -763,28 +763,76 @@ def attack_blur_offsets(path: str, taps: int, *, dtype=torch.float32, device=Non
     return offsets + 0.5 if path == "uniform" else offsets
 
 
+_LINE_BLUR_CHUNK = 2
+
+
 def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torch.Tensor) -> torch.Tensor:
-    """Average of ``x`` shifted by ``offsets * (dx, dy)`` pixels (bilinear, border-replicated), per sample."""
+    """Average of ``x`` shifted by ``offsets * (dx, dy)`` pixels (bilinear, border-replicated), per sample.
+
+    Each tap is a bilinear sample: four whole-pixel neighbours, weighted. The taps of one path share most of their
+    neighbours (they sit at most half a pixel apart), so the path is a sparse kernel of whole-pixel shifts, about
+    three per pixel of path length, summed over slices of the border-replicated image: one multiply-add per kernel
+    entry instead of a ``grid_sample`` per tap (the same sum to rounding; tests/transforms/test_physics.py keeps
+    the per-tap form as the reference). Samples that share a displacement share their kernel. Differentiable in
+    ``x``; the shifts are read as numbers (the fits difference them numerically).
+    """
     batch, _, height, width = x.shape
-    dx = torch.as_tensor(dx, dtype=x.dtype, device=x.device).reshape(-1).expand(batch)
-    dy = torch.as_tensor(dy, dtype=x.dtype, device=x.device).reshape(-1).expand(batch)
-    ys = torch.linspace(-1.0, 1.0, height, dtype=x.dtype, device=x.device) if height > 1 else x.new_zeros(1)
-    xs = torch.linspace(-1.0, 1.0, width, dtype=x.dtype, device=x.device) if width > 1 else x.new_zeros(1)
-    grid_y, grid_x = torch.meshgrid(ys, xs, indexing="ij")
-    identity = torch.stack([grid_x, grid_y], dim=-1)  # (H, W, 2): grid_sample's (x, y) order
-    scale_x = 2.0 / max(width - 1, 1)
-    scale_y = 2.0 / max(height - 1, 1)
-    # every tap's shift (taps, B, 2) at once; one add per tap then builds its grid (the same sums, bit for bit, as
-    # shifting each coordinate and stacking them, which cost a copy of the grid per tap)
-    taps = offsets.to(x.dtype).reshape(-1, 1)
-    shifts = torch.stack([taps * dx * scale_x, taps * dy * scale_y], dim=-1)
-    out = torch.zeros_like(x)
-    for shift in shifts:
-        grid = identity + shift.reshape(-1, 1, 1, 2)
-        out = out + torch.nn.functional.grid_sample(
-            x, grid, mode="bilinear", padding_mode="border", align_corners=True
-        )
-    return out / len(offsets)
+    shifts = torch.stack(
+        [torch.as_tensor(v, dtype=torch.float64).reshape(-1).expand(batch) for v in (dx, dy)], dim=1
+    )
+    if any(torch.is_tensor(v) and v.requires_grad for v in (dx, dy)):
+        raise ValueError("line_blur is not differentiable in dx, dy: pass them without requires_grad")
+    path = offsets.detach().to(device="cpu", dtype=torch.float64)
+    out = torch.empty_like(x)
+    groups: dict[tuple[float, float], list[int]] = {}
+    for i, key in enumerate(map(tuple, shifts.tolist())):
+        groups.setdefault(key, []).append(i)
+    for (shift_x, shift_y), members in groups.items():
+        rows, cols, weights = _line_kernel(path, shift_x, shift_y)
+        top, left = max(0, -min(rows)), max(0, -min(cols))
+        bottom, right = max(0, max(rows)), max(0, max(cols))
+        padded_width = left + width + right
+        # each pixel's samples are its own position in the padded image moved by row * padded_width + col: on the
+        # flattened image every kernel entry is one contiguous slice, summed over the span from the first pixel
+        # to the last (the padding columns between rows are summed too and dropped)
+        first = top * padded_width + left
+        span = (height - 1) * padded_width + width
+        for i in members:  # one image at a time: its padded copy and running sum stay in cache
+            flat = F.pad(x[i : i + 1], (left, right, top, bottom), mode="replicate").flatten(2)
+            total = flat.new_zeros(*flat.shape[:2], height * padded_width)
+            running = total[:, :, :span]
+            for row, col, weight in zip(rows, cols, weights, strict=True):
+                begin = first + row * padded_width + col
+                running.add_(flat[:, :, begin : begin + span], alpha=weight)
+            out[i].copy_(total.unflatten(2, (height, padded_width))[0, :, :, :width])
+    return out
+
+
+def _line_kernel(
+    path: torch.Tensor, shift_x: float, shift_y: float
+) -> tuple[list[int], list[int], list[float]]:
+    """The whole-pixel shifts ``(rows, cols)`` and weights whose sum is the mean of bilinear samples at
+    ``path * (shift_x, shift_y)``: each tap's four neighbours, merged where taps share one, zero weights dropped."""
+    px, py = path * shift_x, path * shift_y
+    fx, fy = px.floor(), py.floor()
+    wx, wy = px - fx, py - fy
+    cols = torch.cat([fx, fx + 1, fx, fx + 1]).long()
+    rows = torch.cat([fy, fy, fy + 1, fy + 1]).long()
+    weights = torch.cat([(1 - wx) * (1 - wy), wx * (1 - wy), (1 - wx) * wy, wx * wy]) / len(path)
+    keep = weights > 0
+    rows, cols, weights = rows[keep], cols[keep], weights[keep]
+    row0, col0 = int(rows.min()), int(cols.min())
+    span = int(cols.max()) - col0 + 1
+    flat = (rows - row0) * span + (cols - col0)
+    kernel = torch.zeros((int(rows.max()) - row0 + 1) * span, dtype=torch.float64).index_add_(
+        0, flat, weights
+    )
+    entries = kernel.nonzero().flatten()
+    return (
+        (entries // span + row0).tolist(),
+        (entries % span + col0).tolist(),
+        kernel[entries].tolist(),
+    )
 
 
 def blur_taps(dx: float, dy: float) -> int:

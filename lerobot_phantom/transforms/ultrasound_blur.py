@@ -597,10 +597,16 @@ class UltrasoundBlur(CameraAttack):
             dx, dy = params["dx"].to(x.device, x.dtype), params["dy"].to(x.device, x.dtype)
             taps = physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
             offsets = physics.attack_blur_offsets(self.path, taps, dtype=x.dtype, device=x.device)
-            tone = 1.0 if self.tone is None else self.tone
-            blurred = physics.encode(physics.line_blur(physics.decode(x, tone), dx, dy, offsets), tone)
+            if self.tone is None:
+                blurred = physics.line_blur(x, dx, dy, offsets)
+            else:
+                blurred = physics.encode(
+                    physics.line_blur(physics.decode(x, self.tone), dx, dy, offsets), self.tone
+                )
             still = ((dx == 0) & (dy == 0)).reshape(-1, 1, 1, 1)  # s = 0 is exactly the identity
-            return torch.where(still, x, blurred).clamp_(0.0, 1.0)
+            if bool(still.any()):
+                blurred = torch.where(still, x, blurred)
+            return blurred.clamp_(0.0, 1.0)
         return ultrasound_blur_float(
             x, params["dx"], params["dy"], params["theta_deg"], params["scale"], upper=1.0
         )

@@ -205,18 +205,42 @@ def reference_line_blur(x, dx, dy, offsets):
 
 
 @pytest.mark.parametrize("dtype", [torch.float32, torch.float64])
-def test_line_blur_is_the_per_tap_sampling_to_the_bit(dtype):
+def test_line_blur_is_the_per_tap_sampling(dtype):
+    """The sparse whole-pixel kernel sums what the per-tap bilinear sampling sums, to rounding: per-sample and
+    shared shifts, both paths, either sign, paths longer than the image (the border replicated)."""
     generator = torch.Generator().manual_seed(3)
-    x = torch.rand(3, 3, 21, 34, generator=generator, dtype=dtype)
-    dx, dy = (
-        torch.randn(3, generator=generator, dtype=dtype) * 5,
-        torch.randn(3, generator=generator, dtype=dtype),
-    )
-    offsets = physics.blur_path_offsets("sinusoidal", 9, dtype=dtype)
-    for shift_x, shift_y in [(dx, dy), (float(dx[0]), float(dy[0]))]:
-        assert torch.equal(
-            physics.line_blur(x, shift_x, shift_y, offsets), reference_line_blur(x, shift_x, shift_y, offsets)
-        )
+    tolerance = {torch.float32: 2e-6, torch.float64: 1e-12}[dtype]
+    for height, width, reach in [(21, 34, 5.0), (9, 7, 12.0), (2, 40, 3.0)]:
+        x = torch.rand(3, 3, height, width, generator=generator, dtype=dtype)
+        dx = torch.randn(3, generator=generator, dtype=dtype) * reach
+        dy = torch.randn(3, generator=generator, dtype=dtype) * reach / 3
+        for path in physics.BLUR_PATHS:
+            offsets = physics.attack_blur_offsets(
+                path, physics.blur_taps(float(dx.abs().max()), float(dy.abs().max()))
+            )
+            offsets = offsets.to(dtype)
+            for shift_x, shift_y in [(dx, dy), (float(dx[0]), float(dy[0])), (dx[[0, 1, 0]], dy[[0, 1, 0]])]:
+                torch.testing.assert_close(
+                    physics.line_blur(x, shift_x, shift_y, offsets),
+                    reference_line_blur(x, shift_x, shift_y, offsets),
+                    atol=tolerance,
+                    rtol=0.0,
+                )
+
+
+def test_line_blur_differentiates_the_image_not_the_shifts():
+    offsets = physics.attack_blur_offsets("uniform", 7, dtype=torch.float64)
+    image = torch.rand(2, 3, 8, 9, generator=torch.Generator().manual_seed(4), dtype=torch.float64)
+    weights = torch.rand(2, 3, 8, 9, generator=torch.Generator().manual_seed(5), dtype=torch.float64)
+    gradients = []
+    for blur in (physics.line_blur, reference_line_blur):
+        x = image.clone().requires_grad_(True)
+        (blur(x, torch.tensor([3.5, -2.0]), torch.tensor([1.0, 0.5]), offsets) * weights).sum().backward()
+        gradients.append(x.grad)
+    torch.testing.assert_close(*gradients, atol=1e-12, rtol=0.0)
+    shift = torch.tensor(2.0, requires_grad=True)
+    with pytest.raises(ValueError, match="not differentiable in dx, dy"):
+        physics.line_blur(image, shift, 0.0, offsets)
 
 
 def test_em_colour_map_and_masks():
