@@ -25,9 +25,14 @@ position are random; the pattern is fixed per instance.
 
 ``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of
 blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is
-then a capture of the laser alone, read as the calibration reads its captures: its dark level (the dark room and
-the black level, ``physics.dark_level``) is no laser light and is taken out before the light is scaled by the gain,
-and the glare is centred on the capture's spot (``physics.pattern_centre``), moved with it by ``position``. With
+then a capture of the laser alone, read as the calibration reads its captures (``capture.read_capture``): its dark
+level (the dark room and the black level) is no laser light and is taken out before the light is scaled by the
+gain, its noise is smoothed away and its beam continued below the noise floor, its saturated core is continued as
+a Gaussian beam of width ``core_sigma_ref_px``, and the glare is centred on the capture's spot, added back where
+the capture measured the laser (its light holds the glare, less what the dark level took out) and taken as the
+larger of glare and continued beam elsewhere; ``position`` moves the reading with the capture. The auto-exposure is
+the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``, ``k`` the exposure at which its
+clipped mean reads as the clean frame's; ``physics.metered_exposure``), or the divisor ``auto_exposure``. With
 ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``, ``z`` standard normal
 drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
 (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
@@ -52,7 +57,14 @@ from typing import Any, ClassVar
 import torch
 
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.base import CameraAttack, check_image, from_float_rgb, to_float_rgb
+from lerobot_phantom.transforms.base import (
+    REFERENCE_SIZE,
+    CameraAttack,
+    check_image,
+    from_float_rgb,
+    to_float_rgb,
+)
+from lerobot_phantom.transforms.capture import core_continued, read_capture
 from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
     LASER_COLORS,
@@ -99,7 +111,13 @@ class LaserPhysics:
     glare_amplitude: float = 0.0
     glare_exponent: float = 2.0
     glare_scale_ref_px: float = 8.0
+    # the auto-exposure: a divisor of the laser's light (``auto_exposure``), or a meter of the frame's clipped
+    # light whose exposure factor is raised to ``meter_power`` (physics.inject_linear_light); at most one
     auto_exposure: float = 0.0
+    meter_power: float = 0.0
+    # width (reference pixels) of the Gaussian beam a capture's saturated core is continued as (capture.py's
+    # core_continued); None: the core's light held at the full well
+    core_sigma_ref_px: float | None = None
     gamma: float | None = None
     # a tone curve whose highlights roll off (physics.ShoulderCurve) under the display power ``gamma`` (None: 1)
     shoulder: float | None = None
@@ -117,11 +135,18 @@ class LaserPhysics:
             self.gain < 0
             or self.glare_amplitude < 0
             or self.auto_exposure < 0
+            or self.meter_power < 0
             or self.exposure_spread < 0
             or self.glare_scale_ref_px <= 0
+            or (self.core_sigma_ref_px is not None and self.core_sigma_ref_px <= 0)
         ):
             raise ValueError(
-                "gain, glare_amplitude, auto_exposure and exposure_spread must be >= 0 and glare_scale_ref_px > 0"
+                "gain, glare_amplitude, auto_exposure, meter_power and exposure_spread must be >= 0, "
+                "glare_scale_ref_px and core_sigma_ref_px > 0"
+            )
+        if self.auto_exposure > 0 and self.meter_power > 0:
+            raise ValueError(
+                "auto_exposure (a divisor) and meter_power (a clipped-light meter) are two auto-exposures: give one"
             )
         tone = physics.tone_options(self.gamma, self.shoulder, self.shoulder_exponent, owner="LaserBlinding")
         object.__setattr__(self, "_tone", tone)
@@ -218,6 +243,16 @@ def laser_blinding(image: torch.Tensor, alpha: float | torch.Tensor, pattern: to
 def _offset(grey: torch.Tensor, alpha: float) -> torch.Tensor:
     """``alpha * pattern * 255 + 0.5``: the pattern's share of a rounded uint8 blend."""
     return torch.mul(grey, alpha).add_(0.5)
+
+
+def shifted(image: torch.Tensor, rows: int, cols: int) -> torch.Tensor:
+    """``(C, H, W)`` moved down by ``rows`` and right by ``cols`` whole pixels, zero (False) where it uncovers."""
+    height, width = image.shape[-2:]
+    out = torch.zeros_like(image)
+    out[:, max(0, rows) : height + min(0, rows), max(0, cols) : width + min(0, cols)] = image[
+        :, max(0, -rows) : height - max(0, rows), max(0, -cols) : width - max(0, cols)
+    ]
+    return out
 
 
 def _parse_position(position: str | Sequence[float]) -> tuple[float, float] | None:
@@ -351,18 +386,35 @@ class LaserBlinding(CameraAttack):
             lambda: resize_pattern(self._user_pattern, height, width).to(device).contiguous(),
         )
 
-    def capture_reading(
+    def capture_light(
         self, height: int, width: int, device: torch.device
-    ) -> tuple[torch.Tensor, torch.Tensor]:
-        """A capture's (``pattern=PATH``) spot, as an (x, y) pixel offset from the frame's centre where
-        ``position`` puts the pattern's centre, and its dark level ``(3, 1, 1)``, read on the resized capture."""
+    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
+        """A capture (``pattern=PATH``) read as the calibration reads its pairs' (``capture.read_capture``, on the
+        capture resized to the frame): its light per unit power ``(3, H, W)`` in the camera's tone curve (the dark
+        level out, the beam continued below the noise floor, the saturated core continued when
+        ``core_sigma_ref_px`` is set), where it measured the laser ``(H, W)``, its spot as an (x, y) pixel offset
+        from the frame's centre (where ``position`` puts the capture's centre), and the dark level's distance from
+        the spot in pixels."""
 
-        def make() -> tuple[torch.Tensor, torch.Tensor]:
-            capture = self._resized_user_pattern(height, width, torch.device("cpu")).double()
-            centre = physics.pattern_centre(capture)
-            offset = (centre[0] - round(0.5 * (width - 1)), centre[1] - round(0.5 * (height - 1)))
-            level = physics.dark_level(capture, centre)
-            return torch.tensor(offset, device=device), level.to(device=device, dtype=torch.float32)
+        def make() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
+            tone = self.physics.tone
+            reading = read_capture(self._resized_user_pattern(height, width, torch.device("cpu")).double())
+            beam, dark = physics.decode(reading.beam, tone), physics.decode(reading.dark, tone)
+            if self.physics.core_sigma_ref_px is None:
+                light = (beam - dark).clamp(min=0.0)
+            else:
+                light = core_continued(
+                    beam, dark, reading.core_depth, reading.core_radius, self.physics.core_sigma_ref_px
+                )
+            x, y = reading.centre
+            offset = (x - round(0.5 * (width - 1)), y - round(0.5 * (height - 1)))
+            to_pixels = max(height, width) / REFERENCE_SIZE
+            return (
+                light.float().to(device),
+                reading.measured.to(device),
+                torch.tensor(offset, device=device),
+                reading.dark_radius * to_pixels,
+            )
 
         return self._cached(("capture", height, width, str(device)), make)
 
@@ -395,18 +447,9 @@ class LaserBlinding(CameraAttack):
             if self._user_pattern is None:
                 return self._procedural(height, width, (float(row), float(col)), (height, width), device)
             base = self._resized_user_pattern(height, width, device)
-            shifted = torch.zeros_like(base)
-            dy, dx = round(row) - round(0.5 * (height - 1)), round(col) - round(0.5 * (width - 1))
-            src_r, dst_r = (
-                slice(max(0, -dy), min(height, height - dy)),
-                slice(max(0, dy), min(height, height + dy)),
+            return shifted(
+                base, round(row) - round(0.5 * (height - 1)), round(col) - round(0.5 * (width - 1))
             )
-            src_c, dst_c = (
-                slice(max(0, -dx), min(width, width - dx)),
-                slice(max(0, dx), min(width, width + dx)),
-            )
-            shifted[:, dst_r, dst_c] = base[:, src_r, src_c]
-            return shifted
 
         return self._cached(("single", height, width, row, col, str(device)), make)
 
@@ -502,22 +545,36 @@ class LaserBlinding(CameraAttack):
     ) -> torch.Tensor:
         height, width = x.shape[-2:]
         p = self.physics
-        centre = self.spot_pixel(params["position"].to(x.device), height, width).flip(1).to(x.dtype)
-        dark = None
-        if self._user_pattern is not None:
-            offset, dark = self.capture_reading(height, width, x.device)
+        pixels = self.spot_pixel(params["position"].to(x.device), height, width)
+        centre = pixels.flip(1).to(x.dtype)
+        measured, dark_radius_px = None, 0.0
+        if self._user_pattern is None:
+            light = physics.decode(pattern.to(x.dtype), p.tone)
+        else:
+            # the capture's reading, moved as position moves the capture (whole pixels; nothing measured where
+            # the capture does not reach)
+            read, read_measured, offset, dark_radius_px = self.capture_light(height, width, x.device)
             centre = centre + offset.to(x.dtype)
+            moves = (
+                pixels - pixels.new_tensor([round(0.5 * (height - 1)), round(0.5 * (width - 1))])
+            ).tolist()
+            if all(move == moves[0] for move in moves):
+                moves = moves[:1]  # one reading serves the batch
+            light = torch.stack([shifted(read, dy, dx) for dy, dx in moves])
+            measured = torch.stack([shifted(read_measured[None], dy, dx) for dy, dx in moves])
         return physics.laser_injection(
             x,
-            pattern,
+            light,
             params["intensity"].to(x.device) * p.gain * params.get("exposure", torch.ones(())).to(x.device),
-            dark=dark,
             centre=centre,
             color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
             halo_amplitude=p.glare_amplitude,
             halo_exponent=p.glare_exponent,
-            halo_scale_px=p.glare_scale_ref_px * max(height, width) / 256.0,
+            halo_scale_px=p.glare_scale_ref_px * max(height, width) / REFERENCE_SIZE,
+            measured=measured,
+            dark_radius_px=dark_radius_px,
             auto_exposure=p.auto_exposure,
+            meter_power=p.meter_power,
             gamma=p.tone,
             colour_correction=None
             if p.colour_correction is None

@@ -133,6 +133,7 @@ def inject_linear_light(
     *,
     auto_exposure: float | torch.Tensor = 0.0,
     metered_light: torch.Tensor | None = None,
+    meter_power: float = 0.0,
     white: float | torch.Tensor = 1.0,
     gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
@@ -140,21 +141,48 @@ def inject_linear_light(
     """Add ``light`` (linear irradiance, broadcastable to ``x``) to the scene in linear light, clip, re-encode.
 
     ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean(metered_light))`` (default: the injected
-    light), darkening the whole frame; ``white``: linear level at which the sensor saturates; ``gamma``: None =
-    the sRGB tone curve, a number = a power law (1 = compose the encoded values); ``colour_correction``: a (3, 3)
-    matrix the camera mixes its clipped raw channels with (``light`` is then raw light, the scene is taken to the
-    raw channels by its inverse).
+    light), darkening the whole frame; ``meter_power`` a, its alternative: the exposure scales by ``k ** a``, ``k``
+    the exposure at which the frame's clipped mean level equals the scene's (:func:`metered_exposure`);
+    ``white``: linear level at which the sensor saturates; ``gamma``: None = the sRGB tone curve, a number = a
+    power law (1 = compose the encoded values); ``colour_correction``: a (3, 3) matrix the camera mixes its clipped
+    raw channels with (``light`` is then raw light, the scene is taken to the raw channels by its inverse).
     """
+    if meter_power > 0.0 and (metered_light is not None or bool(torch.as_tensor(auto_exposure).ne(0).any())):
+        raise ValueError(
+            "meter_power and auto_exposure (with metered_light) are two auto-exposures: give one"
+        )
     scene = decode(x, gamma)
     if colour_correction is not None:
         scene = mix_channels(torch.linalg.inv(colour_correction.to(torch.float64)), scene)
-    metered = light if metered_light is None else metered_light
-    mean_light = metered.reshape(metered.shape[0], -1).mean(dim=1).reshape(-1, *([1] * (x.ndim - 1)))
-    total = (scene + light) / (1.0 + _as(auto_exposure, scene) * mean_light)
+    if meter_power > 0.0:
+        total = scene + light
+        flat = (-1, *([1] * (x.ndim - 1)))
+        total = total * metered_exposure(total.mean(-3).flatten(-2), scene.mean(-3).flatten(-2)).reshape(
+            flat
+        ) ** (meter_power)
+    else:
+        metered = light if metered_light is None else metered_light
+        mean_light = metered.reshape(metered.shape[0], -1).mean(dim=1).reshape(-1, *([1] * (x.ndim - 1)))
+        total = (scene + light) / (1.0 + _as(auto_exposure, scene) * mean_light)
     total = torch.minimum(total.clamp(min=0.0), _as(white, total))
     if colour_correction is not None:
         total = mix_channels(colour_correction.to(torch.float64), total).clamp(0.0, 1.0)
     return encode(total, gamma)
+
+
+def metered_exposure(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) -> torch.Tensor:
+    """``(n,)``: per frame, the exposure ``k`` at which a meter reading the sensor's clipped light reads the blinded
+    frame as it read the clean one, ``mean(min(k total, 1)) = mean(min(scene, 1))``, over the pixels of ``(n, P)``
+    light (a channel's mean per pixel). The reading is concave and piecewise linear in ``k``: Newton steps from
+    ``k = 1`` (differentiable through the iterations), ``k`` kept in [1e-4, 10]."""
+    target = scene.clamp(max=1.0).mean(1)
+    k = torch.ones(len(total), dtype=total.dtype, device=total.device)
+    for _ in range(steps):
+        lit = (k[:, None] * total < 1.0).to(total.dtype)
+        reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+        slope = (total * lit).mean(1).clamp(min=1e-9)
+        k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+    return k
 
 
 def mix_channels(matrix: torch.Tensor, image: torch.Tensor) -> torch.Tensor:
@@ -299,50 +327,9 @@ def project_light(
     return encode(total.clamp(min=0.0), gamma)
 
 
-# a capture of the laser alone: where its spot is and the dark room's level in it (the physical laser blinding
-# and lerobot-phantom-calibrate read a capture alike)
-
-
-def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
-    """(x, y) centroid of the brightest part of a laser pattern."""
-    luminance = pattern.mean(0)
-    mask = luminance >= luminance.max() - 0.05 * max(float(luminance.max() - luminance.min()), 1e-6)
-    ys, xs = torch.nonzero(mask, as_tuple=True)
-    return float(xs.double().mean()), float(ys.double().mean())
-
-
-# the share of a capture's pixels, farthest from the spot, whose median is its dark level: the laser's light falls
-# with the distance, and in the outer half it can stand far above the dark room's (the beam's bloom in a capture at the
-# attack's power, on the independent simulator: the outer half's median 0.070 of the full well where the dark room
-# gives 0.0048 at the spot, the farthest tenth's 0.0075; docs/bench/camsim_session24/dark_level_saturation.txt)
-DARK_SHARE = 0.1
-
-
-def dark_region(pattern: torch.Tensor, centre: tuple[float, float]) -> tuple[torch.Tensor, torch.Tensor]:
-    """(flat distances of the capture's pixels from the spot's centre, mask of the ``DARK_SHARE`` farthest)."""
-    _, height, width = pattern.shape
-    ys, xs = torch.meshgrid(
-        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
-    )
-    radius = torch.hypot(xs - centre[0], ys - centre[1]).reshape(-1)
-    return radius, radius >= torch.quantile(radius, 1.0 - DARK_SHARE)
-
-
-def dark_level(pattern: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor:
-    """(3, 1, 1): per-channel median (encoded) of the capture's pixels farthest from the spot (``DARK_SHARE``): the dark
-    room's light and the black level (a median commutes with any monotone tone curve, so it decodes exactly)."""
-    _, far = dark_region(pattern, centre)
-    return far_median(pattern, far)
-
-
-def far_median(values: torch.Tensor, far: torch.Tensor) -> torch.Tensor:
-    """(3, 1, 1): each channel's median over the ``far`` pixels of (3, H, W) ``values``."""
-    return values.reshape(3, -1)[:, far].median(dim=1).values.reshape(3, 1, 1)
-
-
 def laser_injection(
     x: torch.Tensor,
-    pattern: torch.Tensor,
+    light: torch.Tensor,
     power: torch.Tensor,
     *,
     centre: torch.Tensor | None = None,
@@ -350,36 +337,48 @@ def laser_injection(
     halo_amplitude: float = 0.0,
     halo_exponent: float = 2.0,
     halo_scale_px: float = 1.0,
+    measured: torch.Tensor | None = None,
+    dark_radius_px: float = 0.0,
     auto_exposure: float = 0.0,
+    meter_power: float = 0.0,
     gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
-    dark: torch.Tensor | None = None,
 ) -> torch.Tensor:
-    """A laser shone into the camera, physically: the recorded ``pattern`` (encoded, ``(B or 1, 3, H, W)``) is
-    linear light scaled by ``power`` (per sample), plus an optional power-law glare around ``centre`` (``(B, 2)``
-    pixel (x, y)) in the laser's ``color``; the sum adds to the scene in linear light, the auto-exposure meters
-    the pattern's light, and the sensor clips before the tone curve (and before ``colour_correction``, a camera's
-    (3, 3) matrix, mixes its raw channels: the pattern and the colour are then raw light). ``dark``: the
-    pattern's own dark level (encoded, broadcastable; a capture's :func:`dark_level`), no laser light: taken out
-    before the light is scaled, or the power would brighten the whole frame by it."""
+    """A laser shone into the camera, physically: ``light``, the laser's linear light per unit power (``(B or 1,
+    3, H, W)``, in the tone curve ``gamma`` decodes: a recorded pattern decoded, a capture's reading from
+    ``capture.py``), scaled by ``power`` (per sample), plus an optional power-law glare around ``centre`` (``(B,
+    2)`` pixel (x, y)) in the laser's ``color``; the sum adds to the scene in linear light, the auto-exposure
+    (``auto_exposure``: a divisor metering the laser's light without its glare; ``meter_power``: a meter of the
+    frame's clipped light, :func:`inject_linear_light`) reacts, and the sensor clips before the tone curve (and
+    before ``colour_correction``, a camera's (3, 3) matrix, mixes its raw channels: ``light`` and the colour are
+    then raw light). ``measured`` (broadcastable ``(H, W)`` bool): where ``light`` is a capture's measurement of
+    the laser, which holds the glare already, scaled with the beam, less the glare its dark level took out (the
+    glare at ``dark_radius_px`` from the spot, added back there); elsewhere the capture's continued beam and the
+    glare estimate one light, and the larger counts (the calibration's frame model composes alike). Without it the
+    glare adds everywhere (a procedural pattern holds none)."""
     height, width = x.shape[-2:]
     power = torch.as_tensor(power, dtype=x.dtype, device=x.device).reshape(-1, 1, 1, 1)
-    light = decode(pattern.to(x.dtype), gamma)
-    if dark is not None:
-        light = (light - decode(dark.to(x.dtype), gamma)).clamp(min=0.0)
-    light = power * light
+    light = power * light.to(x.dtype)
     metered = light
     if halo_amplitude > 0.0:
         if centre is None or color is None:
             raise ValueError("a halo needs the spot centre and the laser colour")
         radius = radial_distance(height, width, centre, dtype=x.dtype, device=x.device)
-        glare = power_law_halo(radius, halo_amplitude, halo_exponent, halo_scale_px)
-        light = light + power * glare * color.to(x.dtype).reshape(1, 3, 1, 1)
+        shade = power * color.to(x.dtype).reshape(1, 3, 1, 1)
+        if measured is None:
+            light = light + shade * power_law_halo(radius, halo_amplitude, halo_exponent, halo_scale_px)
+        else:
+            far = radius.new_tensor(dark_radius_px)
+            glare = shade * power_law_halo(
+                torch.where(measured, far, radius), halo_amplitude, halo_exponent, halo_scale_px
+            )
+            light = torch.where(measured, light + glare, torch.maximum(light, glare))
     return inject_linear_light(
         x,
         light,
         auto_exposure=auto_exposure,
-        metered_light=metered,
+        metered_light=metered if meter_power == 0.0 else None,
+        meter_power=meter_power,
         gamma=gamma,
         colour_correction=colour_correction,
     )

@@ -19,8 +19,6 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     MIN_METER_REACTION,
     MIN_MIXED_SHARE,
     BlindingFrames,
-    dark_level,
-    dark_level_radius,
     exposure_nodes,
     faint_channels_at_zero,
     halo_amplitude,
@@ -29,6 +27,7 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
 from lerobot_phantom.calibration.identify import at_bound, unmeasured_params
 from lerobot_phantom.calibration.tone import TONE_PARAMS
 from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.capture import dark_level, dark_level_radius
 
 
 @pytest.mark.parametrize(("level", "exponent"), [(0.02, 2.0), (0.7, 4.5), (3.0, 8.0)])

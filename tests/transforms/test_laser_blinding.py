@@ -375,3 +375,54 @@ def test_a_physical_attack_fed_a_capture_takes_out_its_dark_level_and_centres_th
     ]
     torch.testing.assert_close(moved[14, 28 - 10], moved[14, 28 + 10])
     torch.testing.assert_close(moved[:, 10:40], lit[:, 26:56])
+
+
+def test_a_captures_noise_is_not_scaled_into_the_frame_as_laser_light(tmp_path):
+    """The capture's pixel noise about its dark level is read as noise, not light (``capture.beam_profile``): at a
+    gain of 40 the frame far from the spot stays as even as the scene, where the capture as stored (its dark level
+    out) would have scaled every noisy pixel above the level into tens of grey levels of speckle."""
+    from PIL import Image
+
+    from lerobot_phantom.transforms import physics
+
+    rng = np.random.default_rng(3)
+    path = _capture_file(tmp_path)
+    image = np.asarray(Image.open(path)).astype(np.int16)
+    noisy = np.clip(image + rng.normal(0.0, 2.0, image.shape).round(), 0, 255).astype(np.uint8)
+    Image.fromarray(noisy).save(path)
+    scene = torch.full((1, 3, 48, 64), 0.2)
+    options = {"model": "physical", "gain": 40.0, "gamma": 1.0}
+    far = (0, slice(None), slice(36, 48), slice(0, 16))
+    fed = LaserBlinding(1.0, pattern=str(path), **options)(scene)
+    assert float(fed[far].std()) < 2 / 255
+    stored = torch.from_numpy(noisy).permute(2, 0, 1).float()[None] / 255
+    as_stored = physics.laser_injection(scene, (stored - 12 / 255).clamp(min=0.0), 40.0, gamma=1.0)
+    assert float(as_stored[far].std()) > 10 / 255
+
+
+def test_a_captures_saturated_core_is_continued_at_the_calibrated_width(tmp_path):
+    """A capture saturated in its core recorded at least the full well there: at a laser a fifth of the capture's
+    power the core held at the full well turns grey, continued as a Gaussian beam (``core_sigma_ref_px``) its
+    centre stays white, the more so the narrower the beam."""
+    capture = _capture_file(tmp_path)
+    scene = torch.zeros(1, 3, 48, 64)
+    options = {"model": "physical", "gain": 0.2, "gamma": 1.0}
+    held = LaserBlinding(1.0, pattern=str(capture), **options)(scene)[0, 1, 14, 44]
+    wide = LaserBlinding(1.0, pattern=str(capture), core_sigma_ref_px=30.0, **options)(scene)[0, 1, 14, 44]
+    narrow = LaserBlinding(1.0, pattern=str(capture), core_sigma_ref_px=3.0, **options)(scene)[0, 1, 14, 44]
+    assert 0.15 < float(held) < 0.2  # the full well less the dark level, times the power ratio
+    assert float(held) < float(wide) < float(narrow) and float(narrow) == 1.0
+    with pytest.raises(ValueError, match="core_sigma_ref_px > 0"):
+        LaserPhysics(core_sigma_ref_px=0.0)
+
+
+def test_the_meter_darkens_the_frame_by_its_power_and_excludes_the_divisor():
+    scene = torch.full((1, 3, 32, 32), 0.4)
+    params = LaserBlinding("strong", model="physical", gain=5.0).sample_params(1, 32, 32)
+    plain = LaserBlinding("strong", model="physical", gain=5.0).apply_params(scene, params)
+    half = LaserBlinding("strong", model="physical", gain=5.0, meter_power=0.5).apply_params(scene, params)
+    full = LaserBlinding("strong", model="physical", gain=5.0, meter_power=1.0).apply_params(scene, params)
+    corner = (0, slice(None), 0, 0)
+    assert float(full[corner].mean()) < float(half[corner].mean()) < float(plain[corner].mean())
+    with pytest.raises(ValueError, match="two auto-exposures"):
+        LaserPhysics(auto_exposure=1.0, meter_power=1.0)

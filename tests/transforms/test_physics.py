@@ -59,7 +59,7 @@ def test_a_colour_correction_mixes_the_raw_channels_after_they_clip():
     assert torch.allclose(plain[:, 1:], scene[:, 1:])
 
 
-def test_laser_injection_adds_pattern_light_and_glare():
+def test_laser_injection_adds_the_lasers_light_and_glare():
     scene = torch.full((2, 3, 16, 16), 0.3)
     pattern = torch.zeros(1, 3, 16, 16)
     pattern[:, :, 7:9, 7:9] = 1.0
@@ -80,6 +80,51 @@ def test_laser_injection_adds_pattern_light_and_glare():
     assert glare[0, 1, 0, 0] > on[0, 1, 0, 0] + 0.05 and glare[0, 0, 0, 0] == pytest.approx(0.3, abs=1e-5)
     dimmed = physics.laser_injection(scene, pattern, torch.tensor([1.0, 1.0]), auto_exposure=50.0)
     assert (dimmed[:, :, 0, 0] < 0.25).all()
+
+
+def test_a_captures_glare_is_added_back_where_it_measured_the_laser_and_the_larger_counts_elsewhere():
+    """``measured``: the capture's light holds the glare already, less the share its dark level took out (the glare
+    at ``dark_radius_px``); where it measured nothing, its continued beam and the glare estimate one light."""
+    scene = torch.zeros(1, 3, 9, 9, dtype=torch.float64)
+    light = torch.zeros(1, 3, 9, 9, dtype=torch.float64)
+    light[:, :, 3:6, 3:6] = 0.2
+    light[:, :, 0, 0] = 0.05  # a continued beam far out, brighter than the glare there
+    measured = torch.zeros(9, 9, dtype=torch.bool)
+    measured[3:6, 3:6] = True
+    centre = torch.tensor([[4.0, 4.0]], dtype=torch.float64)
+    colour = torch.tensor([1.0, 0.5, 0.0], dtype=torch.float64)
+    options = {"halo_amplitude": 0.1, "halo_exponent": 2.0, "halo_scale_px": 1.0, "gamma": 1.0}
+    out = physics.laser_injection(
+        scene, light, 1.0, centre=centre, color=colour, measured=measured, dark_radius_px=6.0, **options
+    )
+    radius = physics.radial_distance(9, 9, centre, dtype=torch.float64)
+    glare = physics.power_law_halo(radius, 0.1, 2.0, 1.0) * colour.reshape(1, 3, 1, 1)
+    at_dark_radius = 0.1 * (1 + 6.0) ** -2.0 * colour.reshape(1, 3, 1, 1)
+    torch.testing.assert_close(out[:, :, 4, 4], (0.2 + at_dark_radius)[:, :, 0, 0])
+    torch.testing.assert_close(out[:, :, 0, 0], torch.maximum(light, glare)[:, :, 0, 0])
+    torch.testing.assert_close(out[:, :, 8, 8], glare[:, :, 8, 8])
+    everywhere = physics.laser_injection(scene, light, 1.0, centre=centre, color=colour, **options)
+    torch.testing.assert_close(everywhere, (light + glare).clamp(max=1.0))
+
+
+def test_the_meter_exposes_the_blinded_frame_to_read_as_the_clean_one():
+    """``metered_exposure``: the clipped mean of the blinded light at ``k`` equals the clean frame's; with
+    ``meter_power`` the frame's exposure scales by ``k ** a`` (a = 1: the meter's reading restored)."""
+    generator = torch.Generator().manual_seed(8)
+    scene = torch.rand(3, 3, 20, 20, generator=generator, dtype=torch.float64) * 0.6
+    light = torch.zeros_like(scene)
+    light[:, :, 5:12, 5:12] = torch.tensor([0.5, 3.0, 40.0], dtype=torch.float64).reshape(3, 1, 1, 1)
+    total = (scene + light).mean(1).flatten(1)
+    k = physics.metered_exposure(total, scene.mean(1).flatten(1))
+    assert (k < 1).all() and k[0] > k[1] > k[2]
+    reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+    torch.testing.assert_close(reading, scene.mean(1).flatten(1).clamp(max=1.0).mean(1), atol=1e-9, rtol=0)
+    metered = physics.inject_linear_light(scene, light, meter_power=1.0, gamma=1.0)
+    torch.testing.assert_close(metered, ((scene + light) * k.reshape(-1, 1, 1, 1)).clamp(0.0, 1.0))
+    half = physics.inject_linear_light(scene, light, meter_power=0.5, gamma=1.0)
+    torch.testing.assert_close(half, ((scene + light) * k.sqrt().reshape(-1, 1, 1, 1)).clamp(0.0, 1.0))
+    with pytest.raises(ValueError, match="two auto-exposures"):
+        physics.inject_linear_light(scene, light, meter_power=1.0, auto_exposure=2.0)
 
 
 def test_halo_is_power_law_and_saturation_radius_solves_profile():

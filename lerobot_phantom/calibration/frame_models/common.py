@@ -33,9 +33,8 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.noise import NoiseSample, NoiseSources, noise_sample, tone_curve, unclipped
 from lerobot_phantom.calibration.structure import LAG, NeighbourPairs, ResidualSample, line_terms
+from lerobot_phantom.transforms.base import REFERENCE_SIZE
 from lerobot_phantom.transforms.physics import gaussian_spread
-
-REFERENCE_SIZE = 256
 
 
 class ParameterMemo:

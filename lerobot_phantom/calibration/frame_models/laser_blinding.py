@@ -20,7 +20,7 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   shrinks, and a model holding the core at the full well would paint it grey instead;
 * the capture's noise is not laser light either, and the beam goes on below the capture's noise floor: the
   capture is read as a smoothed beam profile, continued below its floor with the fall-off of its edge, and its
-  fainter channels are read as the laser's channel times the laser's colour (:func:`beam_profile`). A capture
+  fainter channels are read as the laser's channel times the laser's colour (``capture.beam_profile``). A capture
   exposed for the beam's profile is tens of times weaker than the attack, and that ratio would otherwise multiply
   its noise into the frames and drop the beam's faint outskirts, which the ``halo_power_law`` then stood in for
   with its exponent at the bound (measured on the independent simulator).
@@ -29,7 +29,7 @@ as laser irradiance instead, which needs three corrections any capture of a lase
 at ``GLARE_REFERENCE_PX`` from the spot (where the frames show it) and its exponent; its inner scale lies inside
 the clipped core (``GLARE_INNER_SCALE_REF_PX``). The capture holds the glare too, at its own power: where it
 measured the laser's light, its beam already carries the glare (scaled with it by the gain) less the share its dark
-level took out (the glare at :func:`dark_level_radius`), so the halo adds back only that share there; below its
+level took out (the glare at ``capture.dark_level_radius``), so the halo adds back only that share there; below its
 noise floor the glare is the larger of the halo and the beam's continued edge. Added everywhere (until session 24),
 it counted the measured glare twice and missed the dark level's share, and fits answered with a glare whose exponent
 ran to its bound (independent simulator's halo case, docs/bench/camsim_session24.md). ``tone_shoulder``
@@ -91,12 +91,9 @@ matrix; selection then still has to take the term.
 
 from __future__ import annotations
 
-import logging
-from typing import NamedTuple
-
 import numpy as np
 import torch
-from scipy import ndimage, stats
+from scipy import stats
 
 from lerobot_phantom.calibration.core import Effect, Fit, Param, Problem, fit_least_squares, further_starts
 from lerobot_phantom.calibration.frame_models.common import (
@@ -117,9 +114,15 @@ from lerobot_phantom.calibration.tone import (
     shoulder_kwargs,
 )
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.physics import dark_level, dark_region, far_median, pattern_centre
-
-logger = logging.getLogger(__name__)
+from lerobot_phantom.transforms.capture import (
+    BeamReading,
+    core_continued,
+    dark_level,
+    dark_region,
+    far_median,
+    pattern_centre,
+    read_capture,
+)
 
 # a feature decoded under the tone curve, kept at the fitted point and at a step of each tone parameter for each
 # feature tensor a prediction decodes (scene, beam, dark and pattern; the meter's probes likewise): a
@@ -235,12 +238,8 @@ def laser_gain(params: dict):
     return 10.0 ** params["log10_gain"]
 
 
-# a saturated capture reads a few grey levels below 255 where JPEG rings in its flat white: 248 and above counts
-SATURATED = 247.5 / 255.0
-
-
 def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
-    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): a quadratic surface per channel
+    """(3, H, W) linear light (sRGB, as ``capture.beam_profile`` reads a capture): a quadratic surface per channel
     fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
     towards the corners), a capture's noise from pixel to pixel."""
     light = physics.srgb_to_linear(dark_frame)
@@ -256,10 +255,10 @@ def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
 
 
 def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
-    """(3, H, W) encoded: the capture's dark level at every pixel, :func:`dark_level` where it is read. With the
+    """(3, H, W) encoded: the capture's dark level at every pixel, ``capture.dark_level`` where it is read. With the
     pair's dark frame, the room's light departs from its level as the frame's :func:`dark_surface` departs from its
     own median there: the capture, that departure taken out, is read as a capture of a uniform room (its median
-    holding the glare at :func:`dark_level_radius`, which the halo adds back), and the departure put back.
+    holding the glare at ``capture.dark_level_radius``, which the halo adds back), and the departure put back.
     Subtracted whole (the surface, no glare added back), the dark frame leaves the capture's faint glare a few
     noise deviations above it, which the beam then reads pixel by pixel, noise and all, times the gain, where the
     halo had modelled it: on camsim's glare case the halo was named on fewer draws (docs/bench/session80.md)."""
@@ -271,146 +270,6 @@ def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
     # read in linear light: the median commutes with the tone curve, so this is dark_level of the flattened capture
     level = far_median((physics.srgb_to_linear(pair.pattern) - departure).clamp(0.0, 1.0), far)
     return physics.linear_to_srgb((level + departure).clamp(min=0.0))
-
-
-def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> float:
-    """Capture pixels from the spot at which :func:`dark_level` reads the laser's glare: glare falls with the
-    distance, so the median over the farthest pixels holds its value at their median distance, and subtracting the
-    dark level takes that much glare out of every pixel of the capture."""
-    radius, far = dark_region(pattern, centre)
-    return float(radius[far].median())
-
-
-# the capture's noise is estimated, and removed, on the scale of a few pixels: a beam profile is smooth there
-BEAM_SMOOTHING_PX = 1.0
-# a value counts as laser light when it stands this many noise deviations above the capture's dark level
-NOISE_FLOOR_SIGMAS = 3.0
-# the beam's edge whose fall-off is continued below the noise floor: measured light between these many floors
-# (from twice the floor: pixels just above it are the ones noise lifted there, a fall-off read from them is too flat)
-EDGE_FLOORS = (2.0, 16.0)
-# fewest edge pixels a fall-off is fitted to (a line through log light vs r^2 from fewer is noise)
-MIN_EDGE_PIXELS = 6
-
-
-class BeamReading(NamedTuple):
-    # (3, H, W) encoded values: the beam without the capture's noise, continued below its floor
-    profile: torch.Tensor
-    # (H, W) bool: where the laser's own channel stands above the capture's noise floor
-    measured: torch.Tensor
-
-
-def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float, float]) -> BeamReading:
-    """The laser's beam profile as the capture measured it, without the capture's noise (encoded values), and
-    where the capture measured it.
-
-    The capture records the beam plus its own dark noise (photon noise of the dark room's light, read noise, 8-bit
-    steps, compression). Only the beam grows with the laser's power: read as laser light and scaled by the power
-    ratio between the frames and the capture (tens, for a beam-profile exposure), the noise would be amplified
-    into the frames too. So the capture is smoothed over ``BEAM_SMOOTHING_PX`` (a beam profile varies slowly on
-    that scale, pixel noise does not), and values within ``NOISE_FLOOR_SIGMAS`` noise deviations of the dark level
-    ``dark`` (encoded: one level per channel, (3, 1, 1), or a field, (3, H, W), :func:`dark_field`; the noise is the
-    robust spread of the capture about its smoothed self in the outer half, plus the 8-bit step) are not read as
-    measured light. The beam does not end at that floor: at the power ratio, its light below the floor lights
-    the frames far around the spot. There it is continued with the fall-off of its measured edge (light
-    ``EDGE_FLOORS`` floors above the dark level): in the laser's own channel (the one holding the most light), a
-    Gaussian in the distance from the spot, ``exp(a - r^2 / (2 s^2))``, fitted in linear light (sRGB) and capped
-    at the floor.
-
-    A laser is narrowband, so every part of its light (beam, bloom, glare) reaches the other two channels in one
-    fixed ratio, the laser's colour. Wherever the laser's channel is unsaturated, they are its beam times that
-    ratio: the slope of one on the other through the origin, where both measure the beam unsaturated (the
-    brightest, most precisely measured light leads it). Their own readings hold more than the laser's light
-    there: demosaicing and colour compression bleed the laser channel's steep edge into them, which the frames,
-    where that channel clips, do not repeat at the power ratio; and they sink below their floors far nearer the
-    spot. Read on their own (session 16 and before), a red laser's blue channel held 2-11 times its colour share
-    10-25 px from the spot, and its faint edge, continued on its own, held the floor over the whole frame: tens of
-    grey levels of light of the wrong colour at the power ratio, which the fit answered with a low gain and a
-    glare for the spot (camsim halo case, docs/bench/camsim_session17.md). A power-law glare
-    beyond the continued beam is the halo's to model."""
-    _, height, width = pattern.shape
-    smooth = torch.from_numpy(
-        ndimage.gaussian_filter(
-            pattern.numpy(), sigma=(0, BEAM_SMOOTHING_PX, BEAM_SMOOTHING_PX), mode="nearest"
-        )
-    )
-    ys, xs = torch.meshgrid(
-        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
-    )
-    radius = torch.hypot(xs - centre[0], ys - centre[1])
-    flat_radius = radius.reshape(-1)
-    # pixel noise: the robust spread of the capture about its smoothed self in the outer half (a smooth beam
-    # there, whether faint or bright, leaves only the noise)
-    detail = (pattern - smooth).reshape(3, -1)[:, flat_radius >= flat_radius.median()]
-    spread = torch.from_numpy(stats.median_abs_deviation(detail.numpy(), axis=1, scale="normal"))
-    noise = torch.sqrt(spread**2 + 1.0 / (12.0 * 255.0**2))
-    dark_linear = physics.srgb_to_linear(dark)
-    light = physics.srgb_to_linear(smooth) - dark_linear
-    floor = physics.srgb_to_linear(dark + NOISE_FLOOR_SIGMAS * noise.reshape(3, 1, 1)) - dark_linear
-    measured = light > floor
-    beam = torch.where(measured, light, torch.zeros_like(light))
-    laser = int(light.clamp(min=0.0).sum(dim=(1, 2)).argmax())
-    unsaturated = smooth < SATURATED
-    low, high = EDGE_FLOORS[0] * floor[laser], EDGE_FLOORS[1] * floor[laser]
-    edge = (light[laser] > low) & (light[laser] < high) & unsaturated[laser]
-    slope, offset = 0.0, 0.0
-    if int(edge.sum()) >= MIN_EDGE_PIXELS:
-        slope, offset = np.polyfit((radius[edge] ** 2).numpy(), torch.log(light[laser][edge]).numpy(), 1)
-    if slope < 0.0:
-        tail = torch.minimum(torch.exp(offset + slope * radius**2), floor[laser])
-        beam[laser] = torch.where(measured[laser], beam[laser], tail)
-    else:
-        logger.warning(
-            "laser capture channel %d (the laser's): %d pixels on the beam's edge (at least %d needed), falling off "
-            "with distance from the spot at a slope of %.3g (negative needed), so the beam is not continued below "
-            "the noise floor; the frames see no laser light there",
-            laser,
-            int(edge.sum()),
-            MIN_EDGE_PIXELS,
-            slope,
-        )
-    for c in range(3):
-        if c == laser:
-            continue
-        # the colour ratio, read where both channels measure the beam unsaturated
-        both = measured[c] & measured[laser] & unsaturated[c] & unsaturated[laser]
-        if int(both.sum()) < MIN_EDGE_PIXELS:
-            logger.warning(
-                "laser capture channel %d: %d pixels measure the beam unsaturated where the laser's own channel "
-                "(%d) does too (fewer than %d), so it is not read in the laser's colour: its light below the noise "
-                "floor is not continued, and the frames see none there",
-                c,
-                int(both.sum()),
-                laser,
-                MIN_EDGE_PIXELS,
-            )
-            continue
-        ratio = (light[c][both] * light[laser][both]).sum() / (light[laser][both] ** 2).sum()
-        beam[c] = torch.where(unsaturated[laser], ratio * beam[laser], beam[c])
-    return BeamReading(physics.linear_to_srgb(beam + dark_linear), measured[laser])
-
-
-def saturated_depth(pattern: torch.Tensor) -> torch.Tensor:
-    """(3, H, W): per channel, the distance (working pixels) from each saturated pixel of the capture to the
-    nearest unsaturated one (0 outside the saturated area)."""
-    # holes left by compression noise are closed: a saturated area has no unsaturated islands
-    clipped = [ndimage.binary_fill_holes(c) for c in (pattern >= SATURATED).numpy()]
-    return torch.from_numpy(
-        np.stack([ndimage.distance_transform_edt(c) if c.any() else np.zeros(c.shape) for c in clipped])
-    )
-
-
-def laser_irradiance(
-    pattern: torch.Tensor,
-    dark: torch.Tensor,
-    core_depth: torch.Tensor,
-    core_radius: torch.Tensor,
-    params: dict,
-) -> torch.Tensor:
-    """Laser light per unit power from the decoded capture: its dark level removed, its saturated core
-    extrapolated (module docstring)."""
-    depth = torch.minimum(core_depth, core_radius)
-    rise = (2.0 * core_radius * depth - depth**2) / (2.0 * params["core_sigma_ref_px"] ** 2)
-    return (pattern - dark).clamp(min=0.0) * torch.exp(rise.clamp(max=50.0))
 
 
 # reference pixels from the spot at which the glare's level is fitted: a quarter of the reference frame's side
@@ -461,21 +320,15 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             )
         super().__init__(pairs, seed)
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
-        self.centres = [pattern_centre(p.pattern) for p in pairs]
-        self.dark_fields = [dark_field(p, c) for p, c in zip(pairs, self.centres, strict=True)]
-        self.dark_radii = [
-            dark_level_radius(p.pattern, c) * p.to_reference for p, c in zip(pairs, self.centres, strict=True)
-        ]
-        self.beams = [
-            beam_profile(p.pattern, d, c)
-            for p, d, c in zip(pairs, self.dark_fields, self.centres, strict=True)
-        ]
-        self.core_depths = [saturated_depth(p.pattern) * p.to_reference for p in pairs]
-        # equivalent radius (reference pixels) of each channel's saturated area
-        self.core_radii = [
-            torch.sqrt((d > 0).sum(dim=(1, 2)).double() / torch.pi) * p.to_reference
-            for p, d in zip(pairs, self.core_depths, strict=True)
-        ]
+        # each capture read as the physical attack reads one (capture.read_capture), its dark frame's field
+        # standing for the one level the attack reads
+        readings = [read_capture(p.pattern, dark_field(p, pattern_centre(p.pattern))) for p in pairs]
+        self.centres = [r.centre for r in readings]
+        self.dark_fields = [r.dark for r in readings]
+        self.dark_radii = [r.dark_radius for r in readings]
+        self.beams = [BeamReading(r.beam, r.measured) for r in readings]
+        self.core_depths = [r.core_depth for r in readings]
+        self.core_radii = [r.core_radius for r in readings]  # a channel's saturated area as a disc's radius
         # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
         probe_rng = np.random.default_rng(seed + 7)
         self.probes = [
@@ -676,12 +529,12 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         scene = decode(f["scene"])
         s = f["strength"]
         if "linear_light_saturation" in effects:
-            laser = laser_irradiance(
+            laser = core_continued(
                 decode(f["beam"]),
                 decode(f["dark"]),
                 f["core_depth"],
                 f["core_radius"],
-                params,
+                params["core_sigma_ref_px"],
             )
             light, scene_weight = s * f["exposure"] * laser_gain(params) * laser, 1.0
         else:
@@ -711,12 +564,12 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         colour = self.raw_laser_colour(params)
         channel = slice(self.laser_channel, self.laser_channel + 1)
         stored_share = (correction_matrix(params) @ colour)[self.laser_channel].clamp(min=1e-6)
-        beam = laser_irradiance(
+        beam = core_continued(
             decode(f["beam"])[:, channel],
             decode(f["dark"])[:, channel],
             f["core_depth"][:, channel],
             f["core_radius"][:, channel],
-            params,
+            params["core_sigma_ref_px"],
         )
         s = f["strength"]
         light = s * f["exposure"] * laser_gain(params) * beam * (colour / stored_share)
@@ -732,20 +585,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         return self.scene_light(effects, params, f, decode) + light
 
     def exposure_factor(self, effects, params, decode, probes: dict | None = None) -> torch.Tensor:
-        """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one (Newton
-        steps on the concave, piecewise-linear meter reading; differentiable through the iterations). ``probes``:
+        """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one
+        (``physics.metered_exposure``, the attack's meter; here on a sample of the frame's pixels). ``probes``:
         the meter's pixels, ``METER_PROBES`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
-        n = len(total)
-        target = self.scene_light(effects, params, f, decode).mean(1).clamp(max=1.0).reshape(n, -1).mean(1)
-        k = torch.ones(n, dtype=total.dtype)
-        for _ in range(12):
-            lit = (k[:, None] * total < 1.0).to(total.dtype)
-            reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
-            slope = (total * lit).mean(1).clamp(min=1e-9)
-            k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
-        return k ** params["auto_exposure"]
+        scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
+        return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
     def predict_features(self, effects, params, f, probes: dict | None = None):
         """Encoded prediction at the features ``f``; ``f["pair"]`` indexes the frames of ``probes`` (the meter's
@@ -910,22 +756,6 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             return LatentFrameProblem.expected_squared_errors(self, fit, items)
         return Problem.item_squared_errors(self, fit, items)
 
-    def divisor_auto_exposure(self, fit: Fit) -> float:
-        """The transform's auto-exposure ``1 / (1 + a * mean injected light)`` (``physics.inject_linear_light``)
-        closest, over the fit's frames (none held out), to the metered exposure factors (least squares in
-        ``1 / factor - 1``). The core extrapolation has no counterpart in the transform, whose spot pattern is not
-        clipped."""
-        p, effects = fit.params, fit.effects
-        decode, _ = self.tone_curve(effects, p)
-        frames = [int(i) for i in np.unique(fit.extra["items"])]
-        with torch.no_grad():
-            f = self.probe_slots(frames)
-            factor = self.exposure_factor(effects, p, decode, f)
-            light = laser_level(p, effects) * f["strength"] * (decode(f["pattern"]) - decode(f["dark"]))
-            metered = light.clamp(min=0.0).mean(1).reshape(len(frames), -1).mean(1)
-            excess = 1.0 / factor.clamp(min=1e-6) - 1.0
-        return float(max((metered * excess).sum() / (metered**2).sum().clamp(min=1e-12), 0.0))
-
     def laser_colour(self, fit: Fit) -> list[float]:
         """The fit frames' laser colour (linear light, its brightest channel 1): the glare's colour."""
         frames = np.unique(fit.extra["items"])
@@ -933,7 +763,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         return (colour / colour.max().clamp(min=1e-9)).tolist()
 
     def transform_kwargs(self, fit: Fit) -> dict:
-        """``LaserBlinding`` options: the paper's alpha levels, or the physical model (``physics.laser_injection``)."""
+        """``LaserBlinding`` options: the paper's alpha levels, or the physical model (``physics.laser_injection``).
+
+        Fed a capture, the physical attack reads it with this model's functions (``capture.read_capture``), continues
+        its core at the fitted width and meters with this model's meter, so on a new scene it predicts as the fit
+        does, but for three differences: it meters every pixel where the fit meters a sample; it reads one dark
+        level where a pair's dark frame gives the fit a field; and under ``colour_correction`` it takes the
+        capture's stored channels as raw light where the fit reads the laser's channel in its fitted raw colour."""
         p, effects = fit.params, fit.effects
         if not effects:
             alpha = min(p["alpha"], 1.0)
@@ -949,7 +785,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "glare_exponent": p.get("halo_exponent", 2.0),
             "glare_scale_ref_px": GLARE_INNER_SCALE_REF_PX,
             **({"color": self.laser_colour(fit)} if "halo_power_law" in effects else {}),
-            "auto_exposure": self.divisor_auto_exposure(fit) if "auto_exposure" in effects else 0.0,
+            # the frame model's meter and continued core: the attack reads a capture as the fit read its pairs'
+            "meter_power": float(p["auto_exposure"]) if "auto_exposure" in effects else 0.0,
+            **({"core_sigma_ref_px": float(p["core_sigma_ref_px"])} if "core_sigma_ref_px" in p else {}),
             "exposure_spread": p["exposure_spread"] if "frame_exposure" in effects else 0.0,
             "colour_correction": correction_matrix(p).reshape(-1).tolist()
             if "colour_correction" in effects

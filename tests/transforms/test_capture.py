@@ -1,8 +1,10 @@
-"""The laser's beam profile read from a noisy capture (``frame_models.laser_blinding.beam_profile``).
+"""Reading a capture of the laser alone (``transforms/capture.py``), as the physical laser blinding and the
+calibration read it.
 
 A capture of the laser alone holds the beam plus the capture's own dark noise. Scaled by the power ratio between
 the blinded frames and the capture, the noise must not be scaled with it, and the beam's light below the capture's
-noise floor must not be lost (at tens of times the capture's power it lights the frame far around the spot).
+noise floor must not be lost (at tens of times the capture's power it lights the frame far around the spot). The
+image operations are torch's own, held to scipy's (the calibration's until session 89) to rounding.
 """
 
 from __future__ import annotations
@@ -14,8 +16,8 @@ import pytest
 import torch
 from PIL import Image
 
-from lerobot_phantom.calibration.frame_models.laser_blinding import beam_profile, dark_level, pattern_centre
 from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.capture import beam_profile, dark_level, pattern_centre
 
 HEIGHT, WIDTH = 48, 64
 CENTRE = (30.0, 22.0)  # (x, y)
@@ -126,3 +128,37 @@ def test_every_channel_carries_the_laser_colour():
                 c,
                 low,
             )
+
+
+def test_the_image_operations_are_scipys_to_rounding():
+    """Gaussian filter (borders replicated), median absolute deviation, line fit, hole filling and distance
+    transform against scipy's and numpy's, on random images, sample sizes of both parities and blobs with holes."""
+    from scipy import ndimage, stats
+
+    from lerobot_phantom.transforms import capture as read
+
+    generator = torch.Generator().manual_seed(11)
+    for trial in range(12):
+        height, width = (int(v) for v in torch.randint(6, 50, (2,), generator=generator))
+        image = torch.rand(3, height, width, generator=generator, dtype=torch.float64)
+        scipy_smooth = ndimage.gaussian_filter(image.numpy(), sigma=(0, 1.0, 1.0), mode="nearest")
+        torch.testing.assert_close(
+            read.gaussian_smooth(image, 1.0), torch.from_numpy(scipy_smooth), atol=1e-14, rtol=0
+        )
+        values = torch.randn(3, 20 + trial, generator=generator, dtype=torch.float64)
+        spread = stats.median_abs_deviation(values.numpy(), axis=1, scale="normal")
+        torch.testing.assert_close(read.robust_spread(values), torch.from_numpy(spread), atol=1e-14, rtol=0)
+        x = torch.rand(40, generator=generator, dtype=torch.float64) * 100
+        y = -0.03 * x + torch.randn(40, generator=generator, dtype=torch.float64)
+        assert read.line_fit(x, y) == pytest.approx(tuple(np.polyfit(x.numpy(), y.numpy(), 1)), rel=1e-10)
+        ys, xs = torch.meshgrid(torch.arange(height), torch.arange(width), indexing="ij")
+        disc = (ys - height / 2) ** 2 + (xs - width / 3) ** 2 < (min(height, width) / 3) ** 2
+        blob = (disc & (torch.rand(height, width, generator=generator) > 0.1)) | (
+            torch.rand(height, width, generator=generator) > 0.97
+        )
+        filled = read.fill_holes(blob)
+        assert torch.equal(filled, torch.from_numpy(ndimage.binary_fill_holes(blob.numpy())))
+        distances = torch.from_numpy(ndimage.distance_transform_edt(filled.numpy()))
+        torch.testing.assert_close(read.distance_to_background(filled), distances, atol=1e-12, rtol=0)
+    with pytest.raises(ValueError, match="whole frame"):
+        read.distance_to_background(torch.ones(4, 4, dtype=torch.bool))
