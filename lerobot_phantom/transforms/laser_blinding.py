@@ -490,11 +490,10 @@ class LaserBlinding(CameraAttack):
 
     # -- application ----------------------------------------------------------------------------------------------
     def _apply(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
-        height, width = x.shape[-2:]
-        pattern = self.patterns_for(params["position"], height, width, x.device)
         if self.model == "physical":
-            return self._apply_physical(x, params, pattern)
-        return blend(x, params["alpha"], pattern)
+            return self._apply_physical(x, params)
+        height, width = x.shape[-2:]
+        return blend(x, params["alpha"], self.patterns_for(params["position"], height, width, x.device))
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         """The paper's blend on uint8 ``(N, 3, H, W)`` without a batch-sized float copy.
@@ -540,15 +539,14 @@ class LaserBlinding(CameraAttack):
             out[chunk].copy_(as_int16[:size])
         return out
 
-    def _apply_physical(
-        self, x: torch.Tensor, params: dict[str, torch.Tensor], pattern: torch.Tensor
-    ) -> torch.Tensor:
+    def _apply_physical(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:
         height, width = x.shape[-2:]
         p = self.physics
         pixels = self.spot_pixel(params["position"].to(x.device), height, width)
         centre = pixels.flip(1).to(x.dtype)
         measured, dark_radius_px = None, 0.0
         if self._user_pattern is None:
+            pattern = self.patterns_for(params["position"], height, width, x.device)
             light = physics.decode(pattern.to(x.dtype), p.tone)
         else:
             # the capture's reading, moved as position moves the capture (whole pixels; nothing measured where
