@@ -762,9 +762,6 @@ def attack_blur_offsets(path: str, taps: int, *, dtype=torch.float32, device=Non
     return offsets + 0.5 if path == "uniform" else offsets
 
 
-_LINE_BLUR_CHUNK = 2
-
-
 def line_blur(x: torch.Tensor, dx: torch.Tensor, dy: torch.Tensor, offsets: torch.Tensor) -> torch.Tensor:
     """Average of ``x`` shifted by ``offsets * (dx, dy)`` pixels (bilinear, border-replicated), per sample.
 
