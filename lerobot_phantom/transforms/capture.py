@@ -133,25 +133,25 @@ def fill_holes(mask: torch.Tensor) -> torch.Tensor:
         reached = grown
 
 
-def distance_to_background(mask: torch.Tensor, chunk: int = 4096) -> torch.Tensor:
+def distance_to_background(mask: torch.Tensor, pairs: int = 1 << 18) -> torch.Tensor:
     """(H, W) float64: each ``mask`` pixel's Euclidean distance to the nearest pixel outside it (0 outside).
 
     The nearest outside pixel always borders the mask (a step from it towards the pixel comes nearer), so only
-    those are searched; squared distances of whole pixels are exact in float64, so is their square root."""
+    those are searched, in blocks of at most ``pairs`` (mask pixel, border pixel) pairs; squared distances of whole
+    pixels are exact in float64, so is their square root."""
     if bool(mask.all()):
         raise ValueError("a mask covering the whole frame has no pixel outside it to measure a distance to")
     out = torch.zeros(mask.shape, dtype=torch.float64)
     if not bool(mask.any()):
         return out
-    padded = F.pad(mask[None, None].double(), (1, 1, 1, 1)).squeeze()
-    beside = F.max_pool2d(padded[None, None], 3, stride=1).squeeze() > 0  # a mask pixel within the 3x3 around
+    padded = F.pad(mask[None, None].double(), (1, 1, 1, 1))
+    beside = F.max_pool2d(padded, 3, stride=1)[0, 0] > 0  # a mask pixel within the 3x3 around
     edge = torch.nonzero(beside & ~mask).double()
     inside = torch.nonzero(mask)
-    points = inside.double()
     nearest = torch.cat(
         [
-            ((part[:, None, :] - edge[None, :, :]) ** 2).sum(-1).amin(1)
-            for part in points.split(max(1, chunk * 64 // max(len(edge), 1)))
+            ((block[:, None, :] - edge[None, :, :]) ** 2).sum(-1).amin(1)
+            for block in inside.double().split(max(1, pairs // len(edge)))
         ]
     )
     out[inside[:, 0], inside[:, 1]] = nearest.sqrt()

@@ -162,3 +162,8 @@ def test_the_image_operations_are_scipys_to_rounding():
         torch.testing.assert_close(read.distance_to_background(filled), distances, atol=1e-12, rtol=0)
     with pytest.raises(ValueError, match="whole frame"):
         read.distance_to_background(torch.ones(4, 4, dtype=torch.bool))
+    row = torch.tensor([[False, True, True, True, False, True]])  # one row, and blocks of one pair
+    torch.testing.assert_close(
+        read.distance_to_background(row, pairs=1),
+        torch.from_numpy(ndimage.distance_transform_edt(row.numpy())),
+    )
