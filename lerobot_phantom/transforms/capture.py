@@ -8,8 +8,8 @@ exposure, so each of these would be scaled with it: the dark level is taken out,
 noise and continued below the noise floor (:func:`beam_profile`), and the saturated core is continued as a Gaussian
 beam (:func:`saturated_depth`, :func:`core_continued`). Module docstring of
 ``calibration/frame_models/laser_blinding.py`` for what each reading fixed on the independent simulator. Pure
-torch (the image operations the calibration once took from scipy are written here: a Gaussian filter, medians, a
-line fit, hole filling and a distance transform).
+torch (the image operations the calibration once took from scipy are written here: medians, a line fit, hole
+filling and a distance transform; the Gaussian filter is ``physics.gaussian_spread``).
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ import torch
 import torch.nn.functional as F
 
 from lerobot_phantom.transforms.base import REFERENCE_SIZE
-from lerobot_phantom.transforms.physics import linear_to_srgb, srgb_to_linear
+from lerobot_phantom.transforms.physics import gaussian_spread, linear_to_srgb, srgb_to_linear
 
 logger = logging.getLogger(__name__)
 
@@ -74,19 +74,6 @@ def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> flo
 
 
 # -- image operations --------------------------------------------------------------------------------------------
-
-
-def gaussian_smooth(image: torch.Tensor, sigma: float) -> torch.Tensor:
-    """(C, H, W) smoothed over rows then columns by a Gaussian of ``sigma`` pixels cut at four deviations, borders
-    replicated (``scipy.ndimage.gaussian_filter``'s defaults with ``mode="nearest"``, to rounding)."""
-    radius = int(4.0 * sigma + 0.5)
-    taps = torch.arange(-radius, radius + 1, dtype=image.dtype)
-    kernel = torch.exp(-0.5 * taps**2 / sigma**2)
-    kernel = kernel / kernel.sum()
-    out = image.unsqueeze(1)  # (C, 1, H, W): every channel a batch item
-    out = F.conv2d(F.pad(out, (0, 0, radius, radius), mode="replicate"), kernel.reshape(1, 1, -1, 1))
-    out = F.conv2d(F.pad(out, (radius, radius, 0, 0), mode="replicate"), kernel.reshape(1, 1, 1, -1))
-    return out.squeeze(1)
 
 
 def median(values: torch.Tensor, dim: int = -1) -> torch.Tensor:
@@ -215,7 +202,8 @@ def beam_profile(pattern: torch.Tensor, dark: torch.Tensor, centre: tuple[float,
     glare for the spot (camsim halo case, docs/bench/camsim_session17.md). A power-law glare
     beyond the continued beam is the halo's to model."""
     _, height, width = pattern.shape
-    smooth = gaussian_smooth(pattern, BEAM_SMOOTHING_PX)
+    # scipy.ndimage.gaussian_filter's cut at four deviations, borders replicated (its mode="nearest")
+    smooth = gaussian_spread(pattern[None], BEAM_SMOOTHING_PX, radius=int(4.0 * BEAM_SMOOTHING_PX + 0.5))[0]
     ys, xs = torch.meshgrid(
         torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
     )
