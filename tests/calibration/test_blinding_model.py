@@ -229,13 +229,14 @@ def test_the_report_says_which_pairs_had_a_dark_frame():
     assert "for 1 of 2 pairs" in facts[1]
     assert "quadratic surface fitted to its dark frame" in facts[2]
     mixed = BlindingFrames([without, with_frame], seed=0)
-    alone = [BlindingFrames([p], seed=0).dark_fields[0] for p in (without, with_frame)]
+    alone = [BlindingFrames([p], seed=0).readings[0].dark for p in (without, with_frame)]
     # the same up to rounding: the dark frame's least-squares surface may differ in its last bit between calls
     # (the BLAS's blocking follows memory alignment; CI saw one such pair)
     assert all(
-        torch.allclose(a, b, rtol=0.0, atol=1e-12) for a, b in zip(mixed.dark_fields, alone, strict=True)
+        torch.allclose(a, b, rtol=0.0, atol=1e-12)
+        for a, b in zip((r.dark for r in mixed.readings), alone, strict=True)
     )
-    assert not torch.allclose(mixed.dark_fields[0], mixed.dark_fields[1], rtol=0.0, atol=1e-3)
+    assert not torch.allclose(mixed.readings[0].dark, mixed.readings[1].dark, rtol=0.0, atol=1e-3)
 
 
 def test_pairs_with_a_dark_frame_load_it_and_other_attacks_refuse_it(tmp_path):

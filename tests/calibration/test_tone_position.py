@@ -117,7 +117,7 @@ def test_a_laser_blinding_gamma_holds_near_the_spot_and_away_from_it(
     problem, items = sim.drawn_problem("blinding_null", 7, tmp_path)
     for near, far, i in zip(*problem.position_halves(items), items, strict=True):
         pair = problem.pairs[int(i)]
-        x_spot, y_spot = problem.centres[int(i)]
+        x_spot, y_spot = problem.centre(int(i))
 
         def from_spot(rows, pair=pair, x_spot=x_spot, y_spot=y_spot):
             return torch.hypot(

@@ -115,7 +115,6 @@ from lerobot_phantom.calibration.tone import (
 )
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.capture import (
-    BeamReading,
     core_continued,
     dark_level,
     dark_region,
@@ -322,13 +321,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
         # each capture read as the physical attack reads one (capture.read_capture), its dark frame's field
         # standing for the one level the attack reads
-        readings = [read_capture(p.pattern, dark_field(p, pattern_centre(p.pattern))) for p in pairs]
-        self.centres = [r.centre for r in readings]
-        self.dark_fields = [r.dark for r in readings]
-        self.dark_radii = [r.dark_radius for r in readings]
-        self.beams = [BeamReading(r.beam, r.measured) for r in readings]
-        self.core_depths = [r.core_depth for r in readings]
-        self.core_radii = [r.core_radius for r in readings]  # a channel's saturated area as a disc's radius
+        self.readings = [read_capture(p.pattern, dark_field(p, pattern_centre(p.pattern))) for p in pairs]
         # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
         probe_rng = np.random.default_rng(seed + 7)
         self.probes = [
@@ -366,11 +359,11 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         return {"capture_dark_level": source}
 
     def centre(self, index: int) -> tuple[float, float]:
-        return self.centres[index]
+        return self.readings[index].centre
 
     def unmeasured(self, index: int, pixels: torch.Tensor | None) -> torch.Tensor:
         """(n, 1): 1 where the capture did not measure the laser's light (below its noise floor), else 0."""
-        flat = (~self.beams[index].measured).reshape(-1, 1).double()
+        flat = (~self.readings[index].measured).reshape(-1, 1).double()
         return flat if pixels is None else flat[pixels]
 
     def features(self, index: int, pixels: torch.Tensor | None) -> dict[str, torch.Tensor]:
@@ -380,7 +373,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             torch.arange(pair.width, dtype=torch.float64),
             indexing="ij",
         )
-        cx, cy = self.centres[index]
+        reading = self.readings[index]
+        cx, cy = reading.centre
         radius = (torch.hypot(xs - cx, ys - cy) * pair.to_reference).reshape(-1, 1)
         if pixels is not None:
             radius = radius[pixels]
@@ -388,13 +382,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         return {
             "scene": flat_pixels(pair.clean, pixels),
             "pattern": flat_pixels(pair.pattern, pixels),
-            "beam": flat_pixels(self.beams[index].profile, pixels),
+            "beam": flat_pixels(reading.beam, pixels),
             "unmeasured": self.unmeasured(index, pixels),
-            "dark": flat_pixels(self.dark_fields[index], pixels),
-            "core_depth": flat_pixels(self.core_depths[index], pixels),
-            "core_radius": self.core_radii[index].reshape(1, 3).expand(n, 3),
+            "dark": flat_pixels(reading.dark, pixels),
+            "core_depth": flat_pixels(reading.core_depth, pixels),
+            "core_radius": reading.core_radius.reshape(1, 3).expand(n, 3),
             "radius": radius,
-            "dark_radius": torch.full((n, 1), self.dark_radii[index], dtype=torch.float64),
+            "dark_radius": torch.full((n, 1), reading.dark_radius, dtype=torch.float64),
             "strength": torch.full((n, 1), pair.intensity, dtype=torch.float64),
             "pair": torch.full((n,), index, dtype=torch.long),
             "colour": self.colours[index].reshape(1, 3).expand(n, 3),
