@@ -1,5 +1,6 @@
-"""The laser blinding frame model's capture readings (spot, dark field and its distance, beam profile, where it was
-measured, saturated core) on camsim blinding draws, written by one package and compared with another's: session 89
+"""The laser blinding frame model's capture readings (beam profile, where it was measured, dark field, saturated core
+depth and radius, each pixel's distance from the spot, the dark level's distance; its ``features``) on camsim
+blinding draws, written by one package and compared with another's: session 89
 moved the reading from scipy (``calibration/frame_models/laser_blinding.py``) to torch (``transforms/capture.py``).
 
 Usage (from the repository root; CAMSIM_SEED only satisfies test_independent_sim's import)::
@@ -36,17 +37,10 @@ def dump(out: Path, workdir: Path) -> None:
         folder = workdir / f"{case}_{seed}"
         folder.mkdir(parents=True, exist_ok=True)
         problem, _, _ = sim.drawn_split(case, seed, folder)
-        readings[f"{case}:{seed}"] = {
-            "beam": [b.profile for b in problem.beams],
-            "measured": [b.measured.double() for b in problem.beams],
-            "core_depth": problem.core_depths,
-            "core_radius": [r.reshape(-1) for r in problem.core_radii],
-            "dark_radius": [torch.tensor(r) for r in problem.dark_radii],
-            "dark_field": [
-                d.expand_as(b.profile) for d, b in zip(problem.dark_fields, problem.beams, strict=True)
-            ],
-            "centre": [torch.tensor(c) for c in problem.centres],
-        }
+        # the frame model's inputs from its captures, read through its public features (any package's)
+        names = ("beam", "unmeasured", "dark", "core_depth", "core_radius", "radius", "dark_radius")
+        features = [problem.features(i, None) for i in range(len(problem.pairs))]
+        readings[f"{case}:{seed}"] = {name: [f[name] for f in features] for name in names}
     torch.save(readings, out)
     print(
         f"{len(readings)} draws, {sum(len(r['beam']) for r in readings.values())} captures: {list(readings)}"
