@@ -73,6 +73,47 @@ def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> flo
     return float(radius[far].median())
 
 
+def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
+    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): a quadratic surface per channel
+    fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
+    towards the corners), a capture's noise from pixel to pixel."""
+    light = srgb_to_linear(dark_frame)
+    _, height, width = light.shape
+    ys, xs = torch.meshgrid(
+        torch.linspace(-0.5, 0.5, height, dtype=torch.float64),
+        torch.linspace(-0.5, 0.5, width, dtype=torch.float64),
+        indexing="ij",
+    )
+    terms = torch.stack([torch.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys]).reshape(6, -1).T
+    coefficients = torch.linalg.lstsq(terms, light.reshape(3, -1).T).solution
+    return (terms @ coefficients).T.reshape(3, height, width)
+
+
+def dark_field(
+    capture: torch.Tensor, dark_frame: torch.Tensor | None, centre: tuple[float, float]
+) -> torch.Tensor:
+    """(3, H, W) encoded: the capture's dark level at every pixel, :func:`dark_level` where it is read. With a dark
+    frame (the capture repeated with the laser off, as beam profilers record one), the room's light departs from its
+    level as the frame's :func:`dark_surface` departs from its own median there: the capture, that departure taken
+    out, is read as a capture of a uniform room (its median holding the glare at :func:`dark_level_radius`, which
+    the physical model's halo adds back), and the departure put back. Subtracted whole (the surface, no glare added
+    back), the dark frame leaves the capture's faint glare a few noise deviations above it, which the beam then
+    reads pixel by pixel, noise and all, times the gain, where the halo had modelled it: on camsim's glare case the
+    halo was named on fewer draws (docs/bench/session80.md)."""
+    if dark_frame is None:
+        return dark_level(capture, centre).expand_as(capture)
+    if dark_frame.shape != capture.shape:
+        raise ValueError(
+            f"a dark frame must have its capture's shape {tuple(capture.shape)}, got {tuple(dark_frame.shape)}"
+        )
+    surface = dark_surface(dark_frame)
+    _, far = dark_region(capture, centre)
+    departure = surface - far_median(surface, far)
+    # read in linear light: the median commutes with the tone curve, so this is dark_level of the flattened capture
+    level = far_median((srgb_to_linear(capture) - departure).clamp(0.0, 1.0), far)
+    return linear_to_srgb((level + departure).clamp(min=0.0))
+
+
 # -- image operations --------------------------------------------------------------------------------------------
 
 
@@ -289,7 +330,7 @@ class CaptureReading:
     """Everything the physical laser blinding reads from a capture at one frame size (:func:`read_capture`)."""
 
     centre: tuple[float, float]  # the spot, (x, y) pixels
-    dark: torch.Tensor  # (3, 1, 1) or (3, H, W) encoded dark level
+    dark: torch.Tensor  # (3, H, W) encoded dark level (:func:`dark_field`)
     beam: torch.Tensor  # (3, H, W) encoded beam profile, continued below the noise floor
     measured: torch.Tensor  # (H, W) bool: where the capture measured the laser's light
     core_depth: torch.Tensor  # (3, H, W) reference pixels into each channel's saturated core
@@ -297,14 +338,14 @@ class CaptureReading:
     dark_radius: float  # reference pixels from the spot at which the dark level was read
 
 
-def read_capture(capture: torch.Tensor, dark: torch.Tensor | None = None) -> CaptureReading:
-    """A capture ``(3, H, W)`` in [0, 1] (float64) read as the calibration reads its pairs' captures: its spot,
-    dark level (``dark``, encoded, when the caller knows it better, e.g. from a dark frame; else
-    :func:`dark_level`), beam profile, saturated core, and the dark level's distance."""
+def read_capture(capture: torch.Tensor, dark_frame: torch.Tensor | None = None) -> CaptureReading:
+    """A capture ``(3, H, W)`` in [0, 1] (float64) read as the calibration reads its pairs' captures: its spot, dark
+    level (:func:`dark_field`, from ``dark_frame``, the capture repeated with the laser off, where there is one),
+    beam profile, saturated core, and the dark level's distance."""
     height, width = capture.shape[-2:]
     to_reference = REFERENCE_SIZE / max(height, width)
     centre = pattern_centre(capture)
-    dark = dark_level(capture, centre) if dark is None else dark
+    dark = dark_field(capture, dark_frame, centre)
     depth = saturated_depth(capture) * to_reference
     reading = beam_profile(capture, dark, centre)
     return CaptureReading(

@@ -27,7 +27,8 @@ position are random; the pattern is fixed per instance.
 blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is
 then a capture of the laser alone, read as the calibration reads its captures (``capture.read_capture``): its dark
 level (the dark room and the black level) is no laser light and is taken out before the light is scaled by the
-gain, its noise is smoothed away and its beam continued below the noise floor, its saturated core is continued as
+gain (read over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with
+the laser off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise floor, its saturated core is continued as
 a Gaussian beam of width ``core_sigma_ref_px``, and the glare is centred on the capture's spot, added back where
 the capture measured the laser (its light holds the glare, less what the dark level took out) and taken as the
 larger of glare and continued beam elsewhere; ``position`` moves the reading with the capture. The auto-exposure is
@@ -289,6 +290,7 @@ class LaserBlinding(CameraAttack):
         intensity: IntensitySpec = "medium",
         *,
         pattern: str | Path | None = None,
+        pattern_dark: str | Path | None = None,
         position: str | Sequence[float] = "center",
         position_range: Sequence[float] = (0.15, 0.85),
         levels: Sequence[float] = ALPHA_LEVELS,
@@ -337,6 +339,20 @@ class LaserBlinding(CameraAttack):
             raise ValueError(
                 f"unknown laser pattern {pattern!r}; valid: {', '.join(PROCEDURAL_PATTERNS)} or an image path"
             )
+        self.pattern_dark = None if pattern_dark is None else str(pattern_dark)
+        self._user_dark = None
+        if pattern_dark is not None:
+            if model != "physical" or self._user_pattern is None:
+                raise ValueError(
+                    "pattern_dark (the capture repeated with the laser off) is read with a capture: pass "
+                    "model='physical' and pattern=PATH of the capture"
+                )
+            self._user_dark = load_pattern_image(self.pattern_dark, keep_alpha=False)
+            if self._user_dark.shape != self._user_pattern.shape:
+                raise ValueError(
+                    f"pattern_dark {self.pattern_dark!r} is {tuple(self._user_dark.shape)} but the capture "
+                    f"{self.pattern!r} is {tuple(self._user_pattern.shape)}: a dark frame repeats its capture"
+                )
         # the laser colour of the physical model's glare halo
         self.color = LASER_COLORS["red"] if self.pattern == "red" else self.spot.color
         self.position = position
@@ -390,7 +406,7 @@ class LaserBlinding(CameraAttack):
         self, height: int, width: int, device: torch.device
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
         """A capture (``pattern=PATH``) read as the calibration reads its pairs' (``capture.read_capture``, on the
-        capture resized to the frame): its light per unit power ``(3, H, W)`` in the camera's tone curve (the dark
+        capture resized to the frame, with its dark frame ``pattern_dark`` where given): its light per unit power ``(3, H, W)`` in the camera's tone curve (the dark
         level out, the beam continued below the noise floor, the saturated core continued when
         ``core_sigma_ref_px`` is set), where it measured the laser ``(H, W)``, its spot as an (x, y) pixel offset
         from the frame's centre (where ``position`` puts the capture's centre), and the dark level's distance from
@@ -398,7 +414,12 @@ class LaserBlinding(CameraAttack):
 
         def make() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
             tone = self.physics.tone
-            reading = read_capture(self._resized_user_pattern(height, width, torch.device("cpu")).double())
+            cpu = torch.device("cpu")
+            dark_frame = None if self._user_dark is None else resize_pattern(self._user_dark, height, width)
+            reading = read_capture(
+                self._resized_user_pattern(height, width, cpu).double(),
+                None if dark_frame is None else dark_frame.double(),
+            )
             beam, dark = physics.decode(reading.beam, tone), physics.decode(reading.dark, tone)
             if self.physics.core_sigma_ref_px is None:
                 light = (beam - dark).clamp(min=0.0)

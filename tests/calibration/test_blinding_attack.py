@@ -84,3 +84,59 @@ def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
     every_frame = dataclasses.replace(fit, extra={**fit.extra, "items": np.arange(len(pairs))})
     read_from_every_frame = altered.transform_kwargs(every_frame)
     assert read_from_every_frame["color"] != pytest.approx(options["color"])
+
+
+def test_the_attack_reads_a_dark_frame_as_the_fit_does(tmp_path):
+    """A capture over a dark room 15% brighter on one side than its mean (test_blinding_model's glare capture, stored
+    in 8 bits) and its dark frame: the fit reads the room's shape from the dark frame (``capture.dark_field``), and
+    so does the attack given it as ``pattern_dark``, so on a black scene the two compose the same light. Read as one
+    level, as the attack read every capture until session 90, the room's slope, scaled by the gain of 100, lights
+    one side of the frame and darkens the other."""
+    from PIL import Image
+    from test_blinding_model import GLARE_REFERENCE_PX, capture_glare, glare_capture
+
+    from lerobot_phantom.calibration.core import Fit
+
+    gain = 100.0
+    pair = glare_capture(gain, room_slope=0.3, dark_frame=True)[0].pairs[0]
+    stored = {name: torch.round(getattr(pair, name) * 255.0) / 255.0 for name in ("pattern", "pattern_dark")}
+    frames = BlindingFrames([dataclasses.replace(pair, **stored)], seed=0)
+    for name, image in stored.items():
+        pixels = (image * 255.0).round().byte().permute(1, 2, 0).numpy()
+        Image.fromarray(pixels).save(tmp_path / f"{name}.png")
+    params = {
+        "log10_gain": np.log10(gain),
+        "core_sigma_ref_px": 20.0,
+        "halo_level": gain * float(capture_glare(torch.tensor(GLARE_REFERENCE_PX / 4.0))),
+        "halo_exponent": 2.0,
+    }
+    fit = Fit(frozenset({"linear_light_saturation", "halo_power_law"}), params)
+    fit.extra["items"] = np.array([0])
+    fitted = frames.predict_pair(fit, 0)
+    options = {**frames.transform_kwargs(fit), "pattern": str(tmp_path / "pattern.png")}
+    black = pair.clean.unsqueeze(0).float()
+    with_frame = LaserBlinding(1.0, pattern_dark=str(tmp_path / "pattern_dark.png"), **options)(black)[0]
+    one_level = LaserBlinding(1.0, **options)(black)[0]
+    # with the dark frame the same light to float32's rounding (9e-6 grey levels RMS, 3e-5 at most); read as one
+    # level, 5.2 grey levels RMS and 31 at most
+    apart = 255 * (with_frame.double() - fitted)
+    assert float(apart.pow(2).mean().sqrt()) < 0.01 and float(apart.abs().max()) < 0.05
+    assert 255 * float((one_level.double() - fitted).pow(2).mean().sqrt()) > 2.0
+
+
+def test_a_dark_frame_needs_its_capture(tmp_path):
+    """``pattern_dark`` repeats a capture: refused without one (a procedural pattern or the paper's blend) and when its
+    size is not the capture's, each error naming what is valid."""
+    from PIL import Image
+
+    for name, size in (("capture", (64, 48)), ("dark", (64, 48)), ("small", (32, 24))):
+        Image.new("RGB", size, (8, 8, 8)).save(tmp_path / f"{name}.png")
+    dark = str(tmp_path / "dark.png")
+    with pytest.raises(ValueError, match="model='physical' and pattern=PATH"):
+        LaserBlinding(model="physical", pattern="spot", pattern_dark=dark)
+    with pytest.raises(ValueError, match="model='physical' and pattern=PATH"):
+        LaserBlinding(pattern=str(tmp_path / "capture.png"), pattern_dark=dark)
+    with pytest.raises(ValueError, match="a dark frame repeats its capture"):
+        LaserBlinding(
+            model="physical", pattern=str(tmp_path / "capture.png"), pattern_dark=str(tmp_path / "small.png")
+        )

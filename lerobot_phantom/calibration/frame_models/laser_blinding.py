@@ -10,7 +10,7 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   light, lit the frames by up to 0.12 full wells per unit intensity and stood in for glare (on the independent
   simulator's halo case the glare's fit ran to its bound, docs/bench/session79.md). With a dark frame
   (``pattern_dark``: the capture repeated with the laser off, as beam profilers record one), the level varies over
-  the frame as the dark frame's light does (:func:`dark_field`);
+  the frame as the dark frame's light does (``capture.dark_field``);
 * where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
   extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
   radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
@@ -116,10 +116,6 @@ from lerobot_phantom.calibration.tone import (
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.capture import (
     core_continued,
-    dark_level,
-    dark_region,
-    far_median,
-    pattern_centre,
     read_capture,
 )
 
@@ -237,40 +233,6 @@ def laser_gain(params: dict):
     return 10.0 ** params["log10_gain"]
 
 
-def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
-    """(3, H, W) linear light (sRGB, as ``capture.beam_profile`` reads a capture): a quadratic surface per channel
-    fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
-    towards the corners), a capture's noise from pixel to pixel."""
-    light = physics.srgb_to_linear(dark_frame)
-    _, height, width = light.shape
-    ys, xs = torch.meshgrid(
-        torch.linspace(-0.5, 0.5, height, dtype=torch.float64),
-        torch.linspace(-0.5, 0.5, width, dtype=torch.float64),
-        indexing="ij",
-    )
-    terms = torch.stack([torch.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys]).reshape(6, -1).T
-    coefficients = torch.linalg.lstsq(terms, light.reshape(3, -1).T).solution
-    return (terms @ coefficients).T.reshape(3, height, width)
-
-
-def dark_field(pair: Pair, centre: tuple[float, float]) -> torch.Tensor:
-    """(3, H, W) encoded: the capture's dark level at every pixel, ``capture.dark_level`` where it is read. With the
-    pair's dark frame, the room's light departs from its level as the frame's :func:`dark_surface` departs from its
-    own median there: the capture, that departure taken out, is read as a capture of a uniform room (its median
-    holding the glare at ``capture.dark_level_radius``, which the halo adds back), and the departure put back.
-    Subtracted whole (the surface, no glare added back), the dark frame leaves the capture's faint glare a few
-    noise deviations above it, which the beam then reads pixel by pixel, noise and all, times the gain, where the
-    halo had modelled it: on camsim's glare case the halo was named on fewer draws (docs/bench/session80.md)."""
-    if pair.pattern_dark is None:
-        return dark_level(pair.pattern, centre).expand_as(pair.pattern)
-    surface = dark_surface(pair.pattern_dark)
-    _, far = dark_region(pair.pattern, centre)
-    departure = surface - far_median(surface, far)
-    # read in linear light: the median commutes with the tone curve, so this is dark_level of the flattened capture
-    level = far_median((physics.srgb_to_linear(pair.pattern) - departure).clamp(0.0, 1.0), far)
-    return physics.linear_to_srgb((level + departure).clamp(min=0.0))
-
-
 # reference pixels from the spot at which the glare's level is fitted: a quarter of the reference frame's side
 GLARE_REFERENCE_PX = 64.0
 # the glare's inner scale (``physics.power_law_halo``), reference pixels. The halo only lights what the capture did
@@ -319,9 +281,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             )
         super().__init__(pairs, seed)
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
-        # each capture read as the physical attack reads one (capture.read_capture), its dark frame's field
-        # standing for the one level the attack reads
-        self.readings = [read_capture(p.pattern, dark_field(p, pattern_centre(p.pattern))) for p in pairs]
+        # each capture read as the physical attack reads one (capture.read_capture), with its dark frame if any
+        self.readings = [read_capture(p.pattern, p.pattern_dark) for p in pairs]
         # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
         probe_rng = np.random.default_rng(seed + 7)
         self.probes = [
@@ -761,9 +722,10 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
         Fed a capture, the physical attack reads it with this model's functions (``capture.read_capture``), continues
         its core at the fitted width and meters with this model's meter, so on a new scene it predicts as the fit
-        does, but for three differences: it meters every pixel where the fit meters a sample; it reads one dark
-        level where a pair's dark frame gives the fit a field; and under ``colour_correction`` it takes the
-        capture's stored channels as raw light where the fit reads the laser's channel in its fitted raw colour."""
+        does (given the pair's dark frame as ``pattern_dark``, it reads the same dark field), but for two
+        differences: it meters every pixel where the fit meters a sample; and under ``colour_correction`` it takes
+        the capture's stored channels as raw light where the fit reads the laser's channel in its fitted raw
+        colour."""
         p, effects = fit.params, fit.effects
         if not effects:
             alpha = min(p["alpha"], 1.0)
