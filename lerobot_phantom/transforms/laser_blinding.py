@@ -23,20 +23,20 @@ pattern is shifted, black filling the uncovered part); ``"random"`` draws it per
 ``position_range`` on both axes, rounded to whole pixels. Only alpha (via the intensity) and, when asked, the
 position are random; the pattern is fixed per instance.
 
-``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of
-blending (``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is
-then a capture of the laser alone, read as the calibration reads its captures (``capture.read_capture``): its dark
-level (the dark room and the black level) is no laser light and is taken out before the light is scaled by the
-gain (read over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with
-the laser off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise floor, its saturated core is continued as
-a Gaussian beam of width ``core_sigma_ref_px``, and the glare is centred on the capture's spot, added back where
-the capture measured the laser (its light holds the glare, less what the dark level took out) and taken as the
-larger of glare and continued beam elsewhere; ``position`` moves the reading with the capture. The auto-exposure is
-the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``, ``k`` the exposure at which its
-clipped mean reads as the clean frame's; ``physics.metered_exposure``), or the divisor ``auto_exposure``. With
-``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``, ``z`` standard normal
-drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
-(``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
+``model="physical"`` (written by ``lerobot-phantom-calibrate``) adds the pattern as linear light instead of blending
+(``physics.laser_injection``, options in a ``LaserPhysics``); its default pattern is ``"spot"``. A PATH is then a
+capture of the laser alone, read as the calibration reads its captures (``capture.read_capture``): its dark level
+(the dark room and the black level) is no laser light and is taken out before the light is scaled by the gain (read
+over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with the laser
+off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise
+floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_ref_px``, and the glare is centred
+on the capture's spot, added back where the capture measured the laser (its light holds the glare, less what the
+dark level took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading
+with the capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
+``k`` the exposure at which its clipped mean reads as the clean frame's; ``physics.metered_exposure``), or the
+divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by
+``exp(spread z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives
+each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
 1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
 light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well, not
 its light, is taken out of the others (``colour_correction`` in the calibration).
@@ -406,11 +406,11 @@ class LaserBlinding(CameraAttack):
         self, height: int, width: int, device: torch.device
     ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
         """A capture (``pattern=PATH``) read as the calibration reads its pairs' (``capture.read_capture``, on the
-        capture resized to the frame, with its dark frame ``pattern_dark`` where given): its light per unit power ``(3, H, W)`` in the camera's tone curve (the dark
-        level out, the beam continued below the noise floor, the saturated core continued when
-        ``core_sigma_ref_px`` is set), where it measured the laser ``(H, W)``, its spot as an (x, y) pixel offset
-        from the frame's centre (where ``position`` puts the capture's centre), and the dark level's distance from
-        the spot in pixels."""
+        capture resized to the frame, with its dark frame ``pattern_dark`` where given): its light per unit power
+        ``(3, H, W)`` in the camera's tone curve (the dark level out, the beam continued below the noise floor, the
+        saturated core continued when ``core_sigma_ref_px`` is set), where it measured the laser ``(H, W)``, its
+        spot as an (x, y) pixel offset from the frame's centre (where ``position`` puts the capture's centre), and
+        the dark level's distance from the spot in pixels."""
 
         def make() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
             tone = self.physics.tone
@@ -601,4 +601,6 @@ class LaserBlinding(CameraAttack):
         )
 
     def extra_repr(self) -> str:
-        return f"{super().extra_repr()}, pattern={self.pattern!r}, position={self.position!r}, model={self.model!r}"
+        dark = "" if self.pattern_dark is None else f", pattern_dark={self.pattern_dark!r}"
+        where = f"position={self.position!r}, model={self.model!r}"
+        return f"{super().extra_repr()}, pattern={self.pattern!r}{dark}, {where}"

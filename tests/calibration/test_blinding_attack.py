@@ -115,7 +115,9 @@ def test_the_attack_reads_a_dark_frame_as_the_fit_does(tmp_path):
     fitted = frames.predict_pair(fit, 0)
     options = {**frames.transform_kwargs(fit), "pattern": str(tmp_path / "pattern.png")}
     black = pair.clean.unsqueeze(0).float()
-    with_frame = LaserBlinding(1.0, pattern_dark=str(tmp_path / "pattern_dark.png"), **options)(black)[0]
+    reads_dark_frame = LaserBlinding(1.0, pattern_dark=str(tmp_path / "pattern_dark.png"), **options)
+    assert "pattern_dark=" in repr(reads_dark_frame)
+    with_frame = reads_dark_frame(black)[0]
     one_level = LaserBlinding(1.0, **options)(black)[0]
     # with the dark frame the same light to float32's rounding (9e-6 grey levels RMS, 3e-5 at most); read as one
     # level, 5.2 grey levels RMS and 31 at most
