@@ -83,7 +83,10 @@ def grey_rms(a, b) -> float:
     )
 
 
-def main() -> None:
+def recorded_draws(specs: list[str]):
+    """Each draw ``CASE:CASE_SEED`` calibrated (``calibrated_draws``) with camsim's capture calls recorded while it
+    renders: (draw, calls, the clean frames' calls, the attacked frames' calls), each call (irradiance, camera, the
+    exposure asked for or None when metered, the exposure used)."""
     calls = []
 
     def recorded(irradiance, cam, rng, **kwargs):
@@ -92,13 +95,17 @@ def main() -> None:
         return out, exposure
 
     camsim.capture = recorded
-    for spec in sys.argv[1:]:
+    for spec in specs:
         calls.clear()
         draw = next(calibrated_draws("laser_blinding", [spec]))
-        problem, fit = draw.problem, draw.fit()
         # calls: clean 0, the laser capture (and its dark frame), attacked 0, then clean i, attacked i
         attacked_calls = [k for k, c in enumerate(calls) if c[2] is None]
-        clean_calls = [0] + [k - 1 for k in attacked_calls[1:]]
+        yield draw, calls, [0] + [k - 1 for k in attacked_calls[1:]], attacked_calls
+
+
+def main() -> None:
+    for draw, calls, clean_calls, attacked_calls in recorded_draws(sys.argv[1:]):
+        problem, fit = draw.problem, draw.fit()
         capture_exposure = calls[1][3]
         true_log_u = np.log([calls[k][3] / capture_exposure for k in clean_calls])
         meter_true = [calls[a][3] / calls[c][3] for a, c in zip(attacked_calls, clean_calls, strict=True)]

@@ -29,11 +29,9 @@ from __future__ import annotations
 import dataclasses
 import sys
 
-import camsim
 import numpy as np
 import torch
-from blinding_exposure_sensitivity import CAPTURE, GRID, predict, rerendered
-from calibrated_draws import calibrated_draws
+from blinding_exposure_sensitivity import GRID, predict, recorded_draws, rerendered
 
 import lerobot_phantom.calibration.frame_models.laser_blinding as lb
 from lerobot_phantom.calibration.core import Param
@@ -115,26 +113,14 @@ def rmse(squared_and_counts) -> float:
 
 
 def main() -> None:
-    calls = []
-
-    def recorded(irradiance, cam, rng, **kwargs):
-        out, exposure = CAPTURE(irradiance, cam, rng, **kwargs)
-        calls.append((irradiance.copy(), cam, kwargs.get("exposure"), exposure))
-        return out, exposure
-
-    camsim.capture = recorded
     torch.set_num_threads(1)
     specs = sys.argv[1:]
     forms = (("power", BlindingFrames), ("uniform", UniformMeter), ("centre", CentreMeter))
     if specs[0] == "--every-pixel":
         meter_on_every_pixel()
         specs, forms = specs[1:], forms[:1]
-    for spec in specs:
-        calls.clear()
-        draw = next(calibrated_draws("laser_blinding", [spec]))
+    for draw, calls, clean_calls, attacked_calls in recorded_draws(specs):
         effects = frozenset(draw.report["extended"]["effects"])
-        attacked_calls = [k for k, c in enumerate(calls) if c[2] is None]
-        clean_calls = [0] + [k - 1 for k in attacked_calls[1:]]
         print(f"{draw.name} case seed {draw.seed}: selected {sorted(effects)}, held-out {list(draw.heldout)}")
         if "frame_exposure" not in effects:
             print("  no frame_exposure selected: skipped")

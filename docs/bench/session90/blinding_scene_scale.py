@@ -20,8 +20,7 @@ import sys
 import camsim
 import numpy as np
 import torch
-from blinding_exposure_sensitivity import CAPTURE
-from calibrated_draws import calibrated_draws
+from blinding_exposure_sensitivity import recorded_draws
 
 from lerobot_phantom.calibration.frame_models.laser_blinding import METER_PROBES, exposure_nodes
 from lerobot_phantom.transforms import physics
@@ -41,20 +40,8 @@ def meter_at_best_node(problem, fit, index: int) -> float:
 
 
 def main() -> None:
-    calls = []
-
-    def recorded(irradiance, cam, rng, **kwargs):
-        out, exposure = CAPTURE(irradiance, cam, rng, **kwargs)
-        calls.append((irradiance.copy(), cam, kwargs.get("exposure"), exposure))
-        return out, exposure
-
-    camsim.capture = recorded
-    for spec in sys.argv[1:]:
-        calls.clear()
-        draw = next(calibrated_draws("laser_blinding", [spec]))
+    for draw, calls, clean_calls, attacked_calls in recorded_draws(sys.argv[1:]):
         problem, fit = draw.problem, draw.fit()
-        attacked_calls = [k for k, c in enumerate(calls) if c[2] is None]
-        clean_calls = [0] + [k - 1 for k in attacked_calls[1:]]
         truth = []
         for k in clean_calls:
             irradiance, cam, _, exposure = calls[k]
