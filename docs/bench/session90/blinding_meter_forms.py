@@ -17,11 +17,13 @@ prediction at the median exposure), beside camsim's own frames re-rendered witho
 exposures (12 quantile nodes of their normal, as the model's) and at their mean: the floor no model without the
 frame's exposure goes under.
 
+``--luma`` (first): the ``luma`` form alone, the package's meter (its power fitted) reading each pixel's luminance
+(Rec. 709 weights) where it reads the channel mean (session 90's lead from ``camsim_meter_parts.py``).
 ``--every-pixel`` (first): the package's meter (``power`` alone) reads every pixel of a frame, not its sample of
 ``METER_PROBES`` drawn with replacement, in the calibration too.
 
 Usage: ``CAMSIM_SEED=0 PYTHONPATH=.:tests/calibration:tests:docs/bench/session88:docs/bench/session90 python
-docs/bench/session90/blinding_meter_forms.py [--every-pixel] CASE:CASE_SEED...``
+docs/bench/session90/blinding_meter_forms.py [--every-pixel | --luma] CASE:CASE_SEED...``
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
 from lerobot_phantom.transforms import physics
 
 STEP = 0.3
+LUMA = (0.2126, 0.7152, 0.0722)
 
 
 def weighted_exposure(total: torch.Tensor, scene: torch.Tensor, weight: torch.Tensor, steps: int = 12):
@@ -67,6 +70,18 @@ class UniformMeter(BlindingFrames):
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         return physics.metered_exposure(total, scene)
+
+
+class LumaMeter(BlindingFrames):
+    """The package's meter (power fitted) reading each pixel's luminance (Rec. 709 weights of the linear channels)
+    instead of its channel mean: a camera's auto-exposure statistic."""
+
+    def exposure_factor(self, effects, params, decode, probes=None):
+        f = self.probe_features if probes is None else probes
+        luma = torch.tensor(LUMA, dtype=torch.float64)
+        total = (self.compose(effects, params, f, decode) @ luma).reshape(-1, METER_PROBES)
+        scene = (self.scene_light(effects, params, f, decode) @ luma).reshape(-1, METER_PROBES)
+        return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
 
 class CentreMeter(UniformMeter):
@@ -119,6 +134,8 @@ def main() -> None:
     if specs[0] == "--every-pixel":
         meter_on_every_pixel()
         specs, forms = specs[1:], forms[:1]
+    elif specs[0] == "--luma":
+        specs, forms = specs[1:], (("luma", LumaMeter),)
     for draw, calls, clean_calls, attacked_calls in recorded_draws(specs):
         effects = frozenset(draw.report["extended"]["effects"])
         print(f"{draw.name} case seed {draw.seed}: selected {sorted(effects)}, held-out {list(draw.heldout)}")
