@@ -36,10 +36,10 @@ with the capture. The auto-exposure is the calibration's meter with ``meter_powe
 ``k`` the exposure at which its clipped mean reads as the clean frame's; ``physics.metered_exposure``), or the
 divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by
 ``exp(spread z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives
-each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
-1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
-light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well, not
-its light, is taken out of the others (``colour_correction`` in the calibration).
+each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose
+rows sum to 1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour
+are raw light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well,
+not its light, is taken out of the others (``colour_correction`` in the calibration).
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
@@ -414,12 +414,11 @@ class LaserBlinding(CameraAttack):
 
         def make() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
             tone = self.physics.tone
-            cpu = torch.device("cpu")
-            dark_frame = None if self._user_dark is None else resize_pattern(self._user_dark, height, width)
-            reading = read_capture(
-                self._resized_user_pattern(height, width, cpu).double(),
-                None if dark_frame is None else dark_frame.double(),
+            capture = self._resized_user_pattern(height, width, torch.device("cpu")).double()
+            dark_frame = (
+                None if self._user_dark is None else resize_pattern(self._user_dark, height, width).double()
             )
+            reading = read_capture(capture, dark_frame)
             beam, dark = physics.decode(reading.beam, tone), physics.decode(reading.dark, tone)
             if self.physics.core_sigma_ref_px is None:
                 light = (beam - dark).clamp(min=0.0)

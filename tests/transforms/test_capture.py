@@ -17,7 +17,7 @@ import torch
 from PIL import Image
 
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.capture import beam_profile, dark_level, pattern_centre
+from lerobot_phantom.transforms.capture import beam_profile, dark_field, dark_level, pattern_centre
 
 HEIGHT, WIDTH = 48, 64
 CENTRE = (30.0, 22.0)  # (x, y)
@@ -170,3 +170,16 @@ def test_the_image_operations_are_scipys_to_rounding():
         read.distance_to_background(row, pairs=1),
         torch.from_numpy(ndimage.distance_transform_edt(row.numpy())),
     )
+
+
+def test_a_dark_frame_of_another_size_is_refused():
+    """A dark frame repeats its capture pixel for pixel: one of another size (a pairs.csv row pointing at another
+    camera's frame) is refused with both shapes named, where its fitted surface would not broadcast onto the capture
+    or would silently describe another frame; without a dark frame the field is the capture's one level."""
+    capture = torch.full((3, 24, 32), 0.05, dtype=torch.float64)
+    capture[:, 10:14, 14:18] = 1.0
+    centre = pattern_centre(capture)
+    with pytest.raises(ValueError, match=r"its capture's shape \(3, 24, 32\), got \(3, 12, 16\)"):
+        dark_field(capture, torch.zeros(3, 12, 16, dtype=torch.float64), centre)
+    field = dark_field(capture, None, centre)
+    assert field.shape == capture.shape and torch.equal(field, dark_level(capture, centre).expand_as(capture))
