@@ -19,11 +19,13 @@ frame's exposure goes under.
 
 ``--luma`` (first): the ``luma`` form alone, the package's meter (its power fitted) reading each pixel's luminance
 (Rec. 709 weights) where it reads the channel mean (session 90's lead from ``camsim_meter_parts.py``).
+``--luma-channel-clip`` (first): the ``luma, channels clipped`` form alone, the luma meter with each channel
+clipped before the weighting, as a meter reading the sensor's raw channels would (session 91).
 ``--every-pixel`` (first): the package's meter (``power`` alone) reads every pixel of a frame, not its sample of
 ``METER_PROBES`` drawn with replacement, in the calibration too.
 
 Usage: ``CAMSIM_SEED=0 PYTHONPATH=.:tests/calibration:tests:docs/bench/session88:docs/bench/session90 python
-docs/bench/session90/blinding_meter_forms.py [--every-pixel | --luma] CASE:CASE_SEED...``
+docs/bench/session90/blinding_meter_forms.py [--every-pixel | --luma | --luma-channel-clip] CASE:CASE_SEED...``
 """
 
 from __future__ import annotations
@@ -84,6 +86,19 @@ class LumaMeter(BlindingFrames):
         return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
 
+class LumaChannelClipMeter(BlindingFrames):
+    """The package's meter (power fitted) reading the Rec. 709 luminance of each pixel's channels clipped one by
+    one, ``sum_c w_c min(k total_c, 1)``: a meter fed by the sensor's raw channels, each saturating at its own
+    photosite (session 91), where ``LumaMeter`` clips the luminance as a whole (camsim's statistic)."""
+
+    def exposure_factor(self, effects, params, decode, probes=None):
+        f = self.probe_features if probes is None else probes
+        total = self.compose(effects, params, f, decode).reshape(-1, METER_PROBES * 3)
+        scene = self.scene_light(effects, params, f, decode).reshape(-1, METER_PROBES * 3)
+        weight = torch.tensor(LUMA, dtype=torch.float64).repeat(METER_PROBES).expand_as(total)
+        return weighted_exposure(total, scene, weight) ** params["auto_exposure"]
+
+
 class CentreMeter(UniformMeter):
     def param_specs(self, effects):
         return [*super().param_specs(effects), Param("meter_width", 0.6, 0.05, 5.0, scale=0.2)]
@@ -136,6 +151,8 @@ def main() -> None:
         specs, forms = specs[1:], forms[:1]
     elif specs[0] == "--luma":
         specs, forms = specs[1:], (("luma", LumaMeter),)
+    elif specs[0] == "--luma-channel-clip":
+        specs, forms = specs[1:], (("luma, channels clipped", LumaChannelClipMeter),)
     for draw, calls, clean_calls, attacked_calls in recorded_draws(specs):
         effects = frozenset(draw.report["extended"]["effects"])
         print(f"{draw.name} case seed {draw.seed}: selected {sorted(effects)}, held-out {list(draw.heldout)}")
