@@ -178,15 +178,28 @@ def metered_exposure(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) 
     channels, each clipped at its own photosite: ``sum_c w_c mean(min(k total_c, 1)) = sum_c w_c
     mean(min(scene_c, 1))``. A laser's light in one channel thus darkens the frame by that channel's share of the
     luminance, not by a third. The reading is concave and piecewise linear in ``k``: Newton steps from ``k = 1``
-    (differentiable through the iterations), ``k`` kept in [1e-4, 10]."""
-    weight = torch.tensor(METER_LUMA, dtype=total.dtype, device=total.device).reshape(3, 1)
-    target = (scene.clamp(max=1.0) * weight).sum(1).mean(1)
-    k = torch.ones(len(total), dtype=total.dtype, device=total.device)
+    (differentiable through the iterations) until they move ``k`` by rounding only, at most ``steps``; ``k`` kept
+    in [1e-4, 10]."""
+    n, _, pixels = total.shape
+    # one weight per channel and pixel, a frame's channels in one row: a matrix product per reading (channels as
+    # separate rows read 7-19x slower than the channel mean, docs/bench/session91/meter_speed_*.txt)
+    weight = (
+        torch.tensor(METER_LUMA, dtype=total.dtype, device=total.device).div(pixels).repeat_interleave(pixels)
+    )
+    total = total.reshape(n, -1)
+    target = scene.reshape(n, -1).clamp(max=1.0) @ weight
+    weighted = total * weight
+    k = torch.ones(n, dtype=total.dtype, device=total.device)
     for _ in range(steps):
-        scaled = k[:, None, None] * total
-        reading = (torch.minimum(scaled, torch.ones_like(total)) * weight).sum(1).mean(1)
-        slope = (total * (scaled < 1.0).to(total.dtype) * weight).sum(1).mean(1).clamp(min=1e-9)
-        k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+        scaled = k[:, None] * total
+        reading = scaled.clamp(max=1.0) @ weight
+        slope = torch.where(scaled < 1.0, weighted, 0.0).sum(1).clamp(min=1e-9)
+        stepped = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+        # on a linear piece Newton lands on the root: later steps move it by rounding only
+        settled = bool(((stepped - k).abs() <= 8 * torch.finfo(k.dtype).eps * k).all())
+        k = stepped
+        if settled:
+            break
     return k
 
 
