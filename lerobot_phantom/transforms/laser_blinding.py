@@ -33,7 +33,7 @@ floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_
 on the capture's spot, added back where the capture measured the laser (its light holds the glare, less what the
 dark level took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading
 with the capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
-``k`` the exposure at which its clipped luminance reads as the clean frame's; ``physics.metered_exposure``), or the
+``k`` the exposure at which its clipped mean reads as the clean frame's; ``physics.metered_exposure``), or the
 divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by
 ``exp(spread z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives
 each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose

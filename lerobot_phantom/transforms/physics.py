@@ -142,7 +142,7 @@ def inject_linear_light(
 
     ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean(metered_light))`` (default: the injected
     light), darkening the whole frame; ``meter_power`` a, its alternative: the exposure scales by ``k ** a``, ``k``
-    the exposure at which the frame's clipped luminance meters as the scene's (:func:`metered_exposure`);
+    the exposure at which the frame's clipped mean level equals the scene's (:func:`metered_exposure`);
     ``white``: linear level at which the sensor saturates; ``gamma``: None = the sRGB tone curve, a number = a
     power law (1 = compose the encoded values); ``colour_correction``: a (3, 3) matrix the camera mixes its clipped
     raw channels with (``light`` is then raw light, the scene is taken to the raw channels by its inverse).
@@ -157,7 +157,9 @@ def inject_linear_light(
     if meter_power > 0.0:
         total = scene + light
         flat = (-1, *([1] * (x.ndim - 1)))
-        total = total * metered_exposure(total.flatten(-2), scene.flatten(-2)).reshape(flat) ** meter_power
+        total = total * metered_exposure(total.mean(-3).flatten(-2), scene.mean(-3).flatten(-2)).reshape(
+            flat
+        ) ** (meter_power)
     else:
         metered = light if metered_light is None else metered_light
         mean_light = metered.reshape(metered.shape[0], -1).mean(dim=1).reshape(-1, *([1] * (x.ndim - 1)))
@@ -168,32 +170,18 @@ def inject_linear_light(
     return encode(total, gamma)
 
 
-# Rec. 709 luminance weights of linear R, G, B: the statistic a camera's auto-exposure meters
-METER_LUMA = (0.2126, 0.7152, 0.0722)
-
-
 def metered_exposure(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) -> torch.Tensor:
-    """``(n,)``: per frame, the exposure ``k`` at which a meter reads the blinded frame as it read the clean one,
-    over the pixels of ``(n, 3, P)`` linear light. The meter reads the luminance (``METER_LUMA``) of the sensor's
-    channels, each clipped at its own photosite: ``sum_c w_c mean(min(k total_c, 1)) = sum_c w_c
-    mean(min(scene_c, 1))``. A laser's light in one channel thus darkens the frame by that channel's share of the
-    luminance, not by a third. The reading is concave and piecewise linear in ``k``: Newton steps from ``k = 1``
-    (differentiable through the iterations) until they move ``k`` by rounding only, at most ``steps``; ``k`` kept
-    in [1e-4, 10]."""
-    n, _, pixels = total.shape
-    # one weight per channel and pixel, a frame's channels in one row: a matrix product per reading (channels as
-    # separate rows read 7-19x slower than the channel mean, docs/bench/session91/meter_speed_*.txt)
-    weight = (
-        torch.tensor(METER_LUMA, dtype=total.dtype, device=total.device).div(pixels).repeat_interleave(pixels)
-    )
-    total = total.reshape(n, -1)
-    target = scene.reshape(n, -1).clamp(max=1.0) @ weight
-    weighted = total * weight
-    k = torch.ones(n, dtype=total.dtype, device=total.device)
+    """``(n,)``: per frame, the exposure ``k`` at which a meter reading the sensor's clipped light reads the blinded
+    frame as it read the clean one, ``mean(min(k total, 1)) = mean(min(scene, 1))``, over the pixels of ``(n, P)``
+    light (a channel's mean per pixel). The reading is concave and piecewise linear in ``k``: Newton steps from
+    ``k = 1`` (differentiable through the iterations) until they move ``k`` by rounding only, at most ``steps``;
+    ``k`` kept in [1e-4, 10]."""
+    target = scene.clamp(max=1.0).mean(1)
+    k = torch.ones(len(total), dtype=total.dtype, device=total.device)
     for _ in range(steps):
-        scaled = k[:, None] * total
-        reading = scaled.clamp(max=1.0) @ weight
-        slope = torch.where(scaled < 1.0, weighted, 0.0).sum(1).clamp(min=1e-9)
+        lit = (k[:, None] * total < 1.0).to(total.dtype)
+        reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+        slope = (total * lit).mean(1).clamp(min=1e-9)
         stepped = (k - (reading - target) / slope).clamp(1e-4, 10.0)
         # on a linear piece Newton lands on the root: later steps move it by rounding only
         settled = bool(((stepped - k).abs() <= 8 * torch.finfo(k.dtype).eps * k).all())

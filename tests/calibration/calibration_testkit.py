@@ -101,11 +101,9 @@ def laser_pattern(rng: np.random.Generator, height: int, width: int) -> tuple[np
 
 def metered_exposure(blinded: np.ndarray, clean: np.ndarray) -> float:
     """The library's auto-exposure meter (``frame_models/laser_blinding.py``): the exposure ``k`` at which the
-    blinded frame's clipped luminance (each channel clipped at white, then Rec. 709's weights) equals the clean
-    frame's; ``(..., 3)`` linear light."""
-    weight = np.array([0.2126, 0.7152, 0.0722])
-    target = (np.minimum(clean, 1.0) @ weight).mean()
-    return optimize.brentq(lambda k: (np.minimum(k * blinded, 1.0) @ weight).mean() - target, 1e-4, 10.0)
+    blinded frame's clipped mean level (channel means, clipped at white) equals the clean frame's."""
+    level, target = blinded.mean(-1), np.minimum(clean.mean(-1), 1.0).mean()
+    return optimize.brentq(lambda k: np.minimum(k * level, 1.0).mean() - target, 1e-4, 10.0)
 
 
 def render_laser_blinding(folder: Path, effects: set[str], seed: int, n_pairs: int = 10) -> dict:

@@ -1,9 +1,11 @@
-"""The auto-exposure meter's cost, one run: session 90's channel-mean meter (``(n, P)``, one level per pixel),
-3912454's luminance meter (the ``(n, 3, P)`` light read channel by channel, as the calibration passes it: a
-transposed view of its ``(n * P, 3)`` probes) and the package's (``physics.metered_exposure``), on the calibration's
-shape (8 frames of ``METER_PROBES`` pixels, float64, one thread) and on an attack's (a batch of 8 224x224 frames,
-float32, contiguous). Prints each one's time per call, its ratio to the channel mean's, and the largest difference of the
-package's exposures from 3912454's.
+"""The auto-exposure meter's cost, one run: session 90's channel-mean meter (``(n, P)``, one level per pixel, 12 Newton
+steps), 3912454's luminance meter (the ``(n, 3, P)`` light read channel by channel, as the calibration passes it: a
+transposed view of its ``(n * P, 3)`` probes), fc04f55's (a frame's channels in one row, stopped once Newton's steps
+move ``k`` by rounding only) and the package's (``physics.metered_exposure``: after session 91's revert the channel
+mean again, with that stop), on the calibration's shape (8 frames of ``METER_PROBES`` pixels, float64, one thread)
+and on an attack's (a batch of 8 224x224 frames, float32, contiguous). Prints each one's time per call, its ratio to
+session 90's, and the largest difference of fc04f55's exposures from 3912454's and of the package's from session
+90's. (``meter_speed_fc04f55.txt`` is this script as at aa0747b, whose "package" was fc04f55's luminance meter.)
 
 Usage: ``PYTHONPATH=. python docs/bench/session91/meter_speed.py``
 """
@@ -16,6 +18,8 @@ import torch
 
 from lerobot_phantom.calibration.frame_models.laser_blinding import METER_PROBES
 from lerobot_phantom.transforms import physics
+
+LUMA = (0.2126, 0.7152, 0.0722)  # Rec. 709
 
 
 def channel_mean_meter(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) -> torch.Tensor:
@@ -32,7 +36,7 @@ def channel_mean_meter(total: torch.Tensor, scene: torch.Tensor, steps: int = 12
 
 def channel_rows_meter(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) -> torch.Tensor:
     """3912454's ``physics.metered_exposure``: the luminance of the clipped channels on ``(n, 3, P)`` as given."""
-    weight = torch.tensor(physics.METER_LUMA, dtype=total.dtype).reshape(3, 1)
+    weight = torch.tensor(LUMA, dtype=total.dtype).reshape(3, 1)
     target = (scene.clamp(max=1.0) * weight).sum(1).mean(1)
     k = torch.ones(len(total), dtype=total.dtype)
     for _ in range(steps):
@@ -40,6 +44,27 @@ def channel_rows_meter(total: torch.Tensor, scene: torch.Tensor, steps: int = 12
         reading = (torch.minimum(scaled, torch.ones_like(total)) * weight).sum(1).mean(1)
         slope = (total * (scaled < 1.0).to(total.dtype) * weight).sum(1).mean(1).clamp(min=1e-9)
         k = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+    return k
+
+
+def one_row_meter(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) -> torch.Tensor:
+    """fc04f55's ``physics.metered_exposure``: the luminance of the clipped channels, a frame's channels in one row,
+    stopped once the steps move ``k`` by rounding only."""
+    n, _, pixels = total.shape
+    weight = torch.tensor(LUMA, dtype=total.dtype).div(pixels).repeat_interleave(pixels)
+    total = total.reshape(n, -1)
+    target = scene.reshape(n, -1).clamp(max=1.0) @ weight
+    weighted = total * weight
+    k = torch.ones(n, dtype=total.dtype)
+    for _ in range(steps):
+        scaled = k[:, None] * total
+        reading = scaled.clamp(max=1.0) @ weight
+        slope = torch.where(scaled < 1.0, weighted, 0.0).sum(1).clamp(min=1e-9)
+        stepped = (k - (reading - target) / slope).clamp(1e-4, 10.0)
+        settled = bool(((stepped - k).abs() <= 8 * torch.finfo(k.dtype).eps * k).all())
+        k = stepped
+        if settled:
+            break
     return k
 
 
@@ -73,12 +98,22 @@ def main() -> None:
         total, scene = light(frames, pixels, dtype, seed=0, probes=probes)
         mean_ms = per_call_ms(channel_mean_meter, total.mean(1), scene.mean(1), calls)
         rows_ms = per_call_ms(channel_rows_meter, total, scene, calls)
-        package_ms = per_call_ms(physics.metered_exposure, total, scene, calls)
-        gap = (physics.metered_exposure(total, scene) - channel_rows_meter(total, scene)).abs().max()
+        one_row_ms = per_call_ms(one_row_meter, total, scene, calls)
+        package_ms = per_call_ms(physics.metered_exposure, total.mean(1), scene.mean(1), calls)
+        luma_gap = (one_row_meter(total, scene) - channel_rows_meter(total, scene)).abs().max()
+        mean_gap = (
+            (
+                physics.metered_exposure(total.mean(1), scene.mean(1))
+                - channel_mean_meter(total.mean(1), scene.mean(1))
+            )
+            .abs()
+            .max()
+        )
         print(
-            f"{label}: channel mean {mean_ms:.3f} ms, 3912454's luminance {rows_ms:.3f} ms "
-            f"({rows_ms / mean_ms:.2f}x), package {package_ms:.3f} ms ({package_ms / mean_ms:.2f}x); "
-            f"package's k from 3912454's: largest difference {float(gap):.2e}"
+            f"{label}: session 90's channel mean {mean_ms:.3f} ms, 3912454's luminance {rows_ms:.3f} ms "
+            f"({rows_ms / mean_ms:.2f}x), fc04f55's luminance {one_row_ms:.3f} ms ({one_row_ms / mean_ms:.2f}x), "
+            f"package's channel mean {package_ms:.3f} ms ({package_ms / mean_ms:.2f}x); largest difference of k: "
+            f"fc04f55's from 3912454's {float(luma_gap):.2e}, the package's from session 90's {float(mean_gap):.2e}"
         )
 
 

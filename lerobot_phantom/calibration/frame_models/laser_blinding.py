@@ -40,14 +40,14 @@ a refinement of it: the shoulder alone follows a filmic curve to half a grey lev
 the curve can stretch the light's scale freely, so the laser's gain is no longer pinned by the frames.
 
 ``auto_exposure`` is a meter, not a divisor: the camera scales its exposure by ``k`` so that the blinded frame's
-*clipped* luminance (what a meter reads from the sensor: each channel clipped at its photosite, weighted by Rec.
-709's ``physics.METER_LUMA``) equals the clean frame's, ``sum_c w_c mean(min(k (scene_c + light_c), 1)) = sum_c w_c
-mean(min(scene_c, 1))``, solved per frame on a fixed pixel sample (the channel mean read until session 91 weighs a
-blue laser's light as a green one's, a luminance meter a tenth as much; docs/bench/session91.md); the fitted
-``auto_exposure`` ``a`` applies ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the
-spot's region more than the frame average, as centre-weighted meters do when the spot is central). It builds on
-``linear_light_saturation``: a meter reacts to light the laser adds, which the paper's blend does not add (its
-opacity darkens the scene, and a meter would answer by raising the gain).
+*clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
+1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
+``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
+average, as centre-weighted meters do when the spot is central). A meter of luminance (Rec. 709 weights), tried in
+sessions 71 and 91, predicts camsim's unseen auto-exposed frames better on its default camera but loses the frames'
+exposures on colour-correcting ones (planted causes named on 1 of 8 draws against 5 of 8; docs/bench/session91.md).
+It builds on ``linear_light_saturation``: a meter reacts to light the laser adds, which the paper's blend does not
+add (its opacity darkens the scene, and a meter would answer by raising the gain).
 
 ``frame_exposure`` is the light's ratio to the scene changing from frame to frame. An auto-exposing camera exposes
 each *clean* frame for its own scene too (a dark scene longer), while the laser was captured once: a laser of one
@@ -546,8 +546,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         (``physics.metered_exposure``, the attack's meter; here on a sample of the frame's pixels). ``probes``:
         the meter's pixels, ``METER_PROBES`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
-        total = self.compose(effects, params, f, decode).reshape(-1, METER_PROBES, 3).transpose(1, 2)
-        scene = self.scene_light(effects, params, f, decode).reshape(-1, METER_PROBES, 3).transpose(1, 2)
+        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
+        scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
     def predict_features(self, effects, params, f, probes: dict | None = None):
