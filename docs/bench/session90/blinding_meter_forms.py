@@ -21,8 +21,8 @@ frame's exposure goes under.
 (Rec. 709 weights) where it reads the channel mean (session 90's lead from ``camsim_meter_parts.py``).
 ``--luma-channel-clip`` (first): the ``luma, channels clipped`` form alone, the luma meter with each channel
 clipped before the weighting, as a meter reading the sensor's raw channels would (session 91).
-``--power`` (first): the package's form alone (since session 91 the package's meter is the luminance of the
-clipped channels, so at its package this form is ``luma, channels clipped``).
+``--power`` (first): the package's form alone (at fc04f55, whose meter read the luminance of the clipped channels,
+the ``luma, channels clipped`` form; at every other package the channel mean).
 ``--every-pixel`` (first): the package's meter (``power`` alone) reads every pixel of a frame, not its sample of
 ``METER_PROBES`` drawn with replacement, in the calibration too.
 
@@ -73,7 +73,7 @@ class UniformMeter(BlindingFrames):
         f = self.probe_features if probes is None else probes
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
-        # the channel-mean meter the package had until session 91 (its physics.metered_exposure since reads luma)
+        # session 90's channel-mean meter written out, so the form holds at fc04f55 too (whose meter read luma)
         return weighted_exposure(total, scene, torch.ones_like(total))
 
 
