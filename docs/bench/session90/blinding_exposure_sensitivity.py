@@ -83,10 +83,9 @@ def grey_rms(a, b) -> float:
     )
 
 
-def recorded_draws(specs: list[str]):
-    """Each draw ``CASE:CASE_SEED`` calibrated (``calibrated_draws``) with camsim's capture calls recorded while it
-    renders: (draw, calls, the clean frames' calls, the attacked frames' calls), each call (irradiance, camera, the
-    exposure asked for or None when metered, the exposure used)."""
+def record_captures() -> list:
+    """From now on every camsim capture call is appended to the returned list as (irradiance, camera, the exposure
+    asked for or None when metered, the exposure used)."""
     calls = []
 
     def recorded(irradiance, cam, rng, **kwargs):
@@ -95,6 +94,13 @@ def recorded_draws(specs: list[str]):
         return out, exposure
 
     camsim.capture = recorded
+    return calls
+
+
+def recorded_draws(specs: list[str]):
+    """Each draw ``CASE:CASE_SEED`` calibrated (``calibrated_draws``) with camsim's capture calls recorded while it
+    renders (``record_captures``): (draw, calls, the clean frames' calls, the attacked frames' calls)."""
+    calls = record_captures()
     for spec in specs:
         calls.clear()
         draw = next(calibrated_draws("laser_blinding", [spec]))

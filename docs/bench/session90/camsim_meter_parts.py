@@ -15,7 +15,7 @@ import sys
 import camsim
 import numpy as np
 import test_independent_sim as sim
-from blinding_exposure_sensitivity import CAPTURE
+from blinding_exposure_sensitivity import record_captures
 
 
 def solve(statistic: np.ndarray, target: float, weight: np.ndarray) -> float:
@@ -31,21 +31,14 @@ def solve(statistic: np.ndarray, target: float, weight: np.ndarray) -> float:
 
 
 def main() -> None:
-    calls = []
-
-    def recorded(irradiance, cam, rng, **kwargs):
-        out, exposure = CAPTURE(irradiance, cam, rng, **kwargs)
-        calls.append((irradiance.copy(), kwargs.get("exposure"), exposure))
-        return out, exposure
-
-    camsim.capture = recorded
+    calls = record_captures()  # (irradiance, camera, exposure asked or None, exposure used)
     statistics = {"luma": lambda x: x @ camsim.LUMA, "channel mean": lambda x: x.mean(2)}
     for seed in [int(s) for s in sys.argv[1:]]:
         calls.clear()
         case = sim.CASE_BY_NAME["blinding_auto_exposure"]
         _, rng, cam = sim.case_camera(case, seed)
         case.render(rng, cam)
-        attacked_calls = [k for k, c in enumerate(calls) if c[1] is None]
+        attacked_calls = [k for k, c in enumerate(calls) if c[2] is None]
         clean_calls = [0] + [k - 1 for k in attacked_calls[1:]]
         ys, xs = np.mgrid[0 : cam.height, 0 : cam.width].astype(float)
         centre = np.exp(
@@ -60,10 +53,10 @@ def main() -> None:
         }
         rows = []
         for attacked, clean in zip(attacked_calls, clean_calls, strict=True):
-            exposure = calls[clean][2]
+            exposure = calls[clean][3]
             light = exposure * camsim.optics(calls[attacked][0], cam)
             scene = exposure * camsim.optics(calls[clean][0], cam)
-            row = {"camsim": calls[attacked][2] / exposure}
+            row = {"camsim": calls[attacked][3] / exposure}
             for statistic_name, statistic in statistics.items():
                 for weight_name, weight in weights.items():
                     target = float((np.minimum(statistic(scene), 1.0) * weight).sum())

@@ -18,19 +18,12 @@ import sys
 import camsim
 import numpy as np
 import test_independent_sim as sim
-from blinding_exposure_sensitivity import CAPTURE
+from blinding_exposure_sensitivity import record_captures
 from camsim_meter_parts import solve
 
 
 def main() -> None:
-    calls = []
-
-    def recorded(irradiance, cam, rng, **kwargs):
-        out, exposure = CAPTURE(irradiance, cam, rng, **kwargs)
-        calls.append((irradiance.copy(), kwargs.get("exposure"), exposure))
-        return out, exposure
-
-    camsim.capture = recorded
+    calls = record_captures()  # (irradiance, camera, exposure asked or None, exposure used)
     case = sim.CASE_BY_NAME["blinding_auto_exposure"]
     index = [c.name for c in sim.CASES].index(case.name)
     for master in [int(s) for s in sys.argv[1:]]:
@@ -41,7 +34,7 @@ def main() -> None:
             raise SystemExit("CAMSIM_CCM=1 is needed: this camera has no colour correction matrix")
         matrix = np.reshape(cam.ccm, (3, 3))
         case.render(rng, cam)
-        attacked_calls = [k for k, c in enumerate(calls) if c[1] is None]
+        attacked_calls = [k for k, c in enumerate(calls) if c[2] is None]
         clean_calls = [0] + [k - 1 for k in attacked_calls[1:]]
         forms = {
             "raw luma": lambda x: x @ camsim.LUMA,
@@ -52,10 +45,10 @@ def main() -> None:
         uniform = np.full((cam.height, cam.width), 1.0 / (cam.height * cam.width))
         log_k = {name: [] for name in ("camsim", *forms)}
         for attacked, clean in zip(attacked_calls, clean_calls, strict=True):
-            exposure = calls[clean][2]
+            exposure = calls[clean][3]
             light = exposure * camsim.optics(calls[attacked][0], cam)
             scene = exposure * camsim.optics(calls[clean][0], cam)
-            log_k["camsim"].append(np.log(calls[attacked][2] / exposure))
+            log_k["camsim"].append(np.log(calls[attacked][3] / exposure))
             for name, statistic in forms.items():
                 target = float((np.minimum(statistic(scene), 1.0) * uniform).sum())
                 log_k[name].append(np.log(solve(statistic(light), target, uniform)))
