@@ -21,13 +21,11 @@ frame's exposure goes under.
 (Rec. 709 weights) where it reads the channel mean (session 90's lead from ``camsim_meter_parts.py``).
 ``--luma-channel-clip`` (first): the ``luma, channels clipped`` form alone, the luma meter with each channel
 clipped before the weighting, as a meter reading the sensor's raw channels would (session 91).
-``--power`` (first): the package's form alone (at fc04f55, whose meter read the luminance of the clipped channels,
-the ``luma, channels clipped`` form; at every other package the channel mean).
 ``--every-pixel`` (first): the package's meter (``power`` alone) reads every pixel of a frame, not its sample of
 ``METER_PROBES`` drawn with replacement, in the calibration too.
 
 Usage: ``CAMSIM_SEED=0 PYTHONPATH=.:tests/calibration:tests:docs/bench/session88:docs/bench/session90 python
-docs/bench/session90/blinding_meter_forms.py [--power | --every-pixel | --luma | --luma-channel-clip] CASE:CASE_SEED...``
+docs/bench/session90/blinding_meter_forms.py [--every-pixel | --luma | --luma-channel-clip] CASE:CASE_SEED...``
 """
 
 from __future__ import annotations
@@ -46,14 +44,14 @@ from lerobot_phantom.calibration.frame_models.laser_blinding import (
     BlindingFrames,
     exposure_nodes,
 )
+from lerobot_phantom.transforms import physics
 
 STEP = 0.3
 LUMA = (0.2126, 0.7152, 0.0722)
 
 
 def weighted_exposure(total: torch.Tensor, scene: torch.Tensor, weight: torch.Tensor, steps: int = 12):
-    """Session 90's ``physics.metered_exposure`` (one level per pixel, ``(n, P)``) with the pixels weighted by
-    ``weight`` (n, P)."""
+    """``physics.metered_exposure`` with the pixels weighted by ``weight`` (n, P)."""
     weight = weight / weight.sum(1, keepdim=True)
     target = (scene.clamp(max=1.0) * weight).sum(1)
     k = torch.ones(len(total), dtype=total.dtype)
@@ -73,8 +71,7 @@ class UniformMeter(BlindingFrames):
         f = self.probe_features if probes is None else probes
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
         scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
-        # session 90's channel-mean meter written out, so the form holds at fc04f55 too (whose meter read luma)
-        return weighted_exposure(total, scene, torch.ones_like(total))
+        return physics.metered_exposure(total, scene)
 
 
 class LumaMeter(BlindingFrames):
@@ -86,7 +83,7 @@ class LumaMeter(BlindingFrames):
         luma = torch.tensor(LUMA, dtype=torch.float64)
         total = (self.compose(effects, params, f, decode) @ luma).reshape(-1, METER_PROBES)
         scene = (self.scene_light(effects, params, f, decode) @ luma).reshape(-1, METER_PROBES)
-        return weighted_exposure(total, scene, torch.ones_like(total)) ** params["auto_exposure"]
+        return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
 
 class LumaChannelClipMeter(BlindingFrames):
@@ -154,8 +151,6 @@ def main() -> None:
         specs, forms = specs[1:], forms[:1]
     elif specs[0] == "--luma":
         specs, forms = specs[1:], (("luma", LumaMeter),)
-    elif specs[0] == "--power":
-        specs, forms = specs[1:], forms[:1]
     elif specs[0] == "--luma-channel-clip":
         specs, forms = specs[1:], (("luma, channels clipped", LumaChannelClipMeter),)
     for draw, calls, clean_calls, attacked_calls in recorded_draws(specs):
