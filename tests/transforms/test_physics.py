@@ -127,6 +127,18 @@ def test_the_meter_exposes_the_blinded_frame_to_read_as_the_clean_one():
         physics.inject_linear_light(scene, light, meter_power=1.0, auto_exposure=2.0)
 
 
+def test_the_meter_stops_only_at_its_root():
+    """Light spread over three decades clips piece by piece: Newton's first step runs to the lower bound and the next
+    four climb back across the clipped pixels' breakpoints; the early stop waits until a step moves ``k`` by
+    rounding only, so the reading equals the clean frame's (stopping once a step is under 2e-3 would leave 2.4e-4)."""
+    total = torch.logspace(-1, 2, 400, dtype=torch.float64)[None]
+    scene = torch.full_like(total, 0.3)
+    k = physics.metered_exposure(total, scene)
+    reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
+    torch.testing.assert_close(reading, torch.tensor([0.3], dtype=torch.float64), atol=1e-12, rtol=0)
+    assert physics.metered_exposure(total, scene, steps=4) != k  # the root needs the fifth step
+
+
 def test_halo_is_power_law_and_saturation_radius_solves_profile():
     r = torch.tensor([10.0, 20.0, 40.0], dtype=torch.float64)
     halo = physics.power_law_halo(r, 1.0, 2.0, 1e-6)  # r >> scale: pure r^-2
