@@ -28,6 +28,15 @@ from lerobot_phantom.transforms.physics import gaussian_spread, linear_to_srgb, 
 logger = logging.getLogger(__name__)
 
 
+def capture_colour(capture: torch.Tensor) -> torch.Tensor:
+    """(3,) the laser's colour in a capture ``(3, H, W)`` in [0, 1]: its linear light per channel, each pixel
+    weighted by its mean light (so the beam outweighs the dark room), over the brightest channel's."""
+    light = srgb_to_linear(capture).reshape(3, -1)
+    weight = light.mean(0)
+    colour = (light * weight).sum(1) / weight.sum().clamp(min=1e-9)
+    return colour / colour.max().clamp(min=1e-9)
+
+
 def pattern_centre(pattern: torch.Tensor) -> tuple[float, float]:
     """(x, y) centroid of the brightest part of a laser pattern."""
     luminance = pattern.mean(0)

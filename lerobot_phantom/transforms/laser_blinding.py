@@ -39,7 +39,10 @@ divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's laser 
 each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose
 rows sum to 1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour
 are raw light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well,
-not its light, is taken out of the others (``colour_correction`` in the calibration).
+not its light, is taken out of the others (``colour_correction`` in the calibration). A capture through such a
+matrix stores the laser's fainter channels at 0; with ``raw_colour`` (the laser's raw light in each channel over its
+own channel's, the calibration's ``laser_colour_*``) its laser channel is read alone and spread over the raw
+channels in that colour, which the glare takes too, as the calibration reads its pairs' captures.
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the
@@ -53,7 +56,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, NamedTuple
 
 import torch
 
@@ -65,7 +68,7 @@ from lerobot_phantom.transforms.base import (
     from_float_rgb,
     to_float_rgb,
 )
-from lerobot_phantom.transforms.capture import core_continued, read_capture
+from lerobot_phantom.transforms.capture import capture_colour, core_continued, read_capture
 from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter, interpolate_levels
 from lerobot_phantom.transforms.patterns import (
     LASER_COLORS,
@@ -128,6 +131,10 @@ class LaserPhysics:
     # the camera's colour correction matrix (9 numbers, row-major, rows summing to 1) mixing its clipped raw
     # channels; the laser's pattern and colour are then raw light
     colour_correction: tuple[float, ...] | None = None
+    # under colour_correction, the laser's raw light in each channel over its own channel's (1 there): a capture
+    # stores the fainter channels at 0, so its laser channel is read alone and spread by this colour, the glare's
+    # colour too (physics.raw_light_per_stored); None: the capture's stored channels are taken as raw light
+    raw_colour: tuple[float, ...] | None = None
     # the tone curve the options give, built (and so checked) once
     _tone: physics.Tone = dataclasses.field(init=False, repr=False, compare=False)
 
@@ -161,6 +168,14 @@ class LaserPhysics:
                     "whose rows sum to 1"
                 )
             object.__setattr__(self, "colour_correction", tuple(float(v) for v in self.colour_correction))
+        if self.raw_colour is not None:
+            colour = tuple(float(v) for v in self.raw_colour)
+            if self.colour_correction is None or len(colour) != 3 or min(colour) < 0 or max(colour) != 1.0:
+                raise ValueError(
+                    f"raw_colour {self.raw_colour}; valid: None, or with colour_correction 3 numbers >= 0 whose "
+                    "largest is 1 (the laser's own channel)"
+                )
+            object.__setattr__(self, "raw_colour", colour)
 
     @property
     def tone(self) -> physics.Tone:
@@ -193,6 +208,16 @@ def _as_batch_values(value: float | torch.Tensor, batch: int, device: torch.devi
     if values.numel() not in (1, batch):
         raise ValueError(f"expected 1 or {batch} per-sample values, got {values.numel()}")
     return values.reshape(-1, 1, 1, 1)
+
+
+class CaptureLight(NamedTuple):
+    """What the physical attack reads from a capture at one frame size (``LaserBlinding.capture_light``)."""
+
+    light: torch.Tensor  # (3, H, W) laser light per unit power, in the tone curve's linear light
+    measured: torch.Tensor  # (H, W) bool: where the capture measured the laser's light
+    offset: torch.Tensor  # (x, y) pixels from the frame's centre to the capture's spot
+    dark_radius_px: float  # pixels from the spot at which the dark level was read
+    glare_colour: torch.Tensor | None  # (3,) under raw_colour: raw light per unit the laser's channel stores
 
 
 CHUNK_BYTES = 1 << 20
@@ -355,6 +380,15 @@ class LaserBlinding(CameraAttack):
                 )
         # the laser colour of the physical model's glare halo
         self.color = LASER_COLORS["red"] if self.pattern == "red" else self.spot.color
+        # under raw_colour a capture is read in its laser channel alone: the one holding most of its light
+        self._laser_channel = None
+        if model == "physical" and self._user_pattern is not None and self.physics.raw_colour is not None:
+            self._laser_channel = int(capture_colour(self._user_pattern.double()).argmax())
+            if self.physics.raw_colour[self._laser_channel] != 1.0:
+                raise ValueError(
+                    f"raw_colour {self.physics.raw_colour} is the laser's light over its own channel's, which must "
+                    f"be 1: the capture {self.pattern!r} holds its laser light in channel {self._laser_channel}"
+                )
         self.position = position
         self._fixed_position = _parse_position(position)
         low, high = (float(v) for v in position_range)
@@ -402,38 +436,46 @@ class LaserBlinding(CameraAttack):
             lambda: resize_pattern(self._user_pattern, height, width).to(device).contiguous(),
         )
 
-    def capture_light(
-        self, height: int, width: int, device: torch.device
-    ) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
+    def capture_light(self, height: int, width: int, device: torch.device) -> CaptureLight:
         """A capture (``pattern=PATH``) read as the calibration reads its pairs' (``capture.read_capture``, on the
         capture resized to the frame, with its dark frame ``pattern_dark`` where given): its light per unit power
-        ``(3, H, W)`` in the camera's tone curve (the dark level out, the beam continued below the noise floor, the
-        saturated core continued when ``core_sigma_ref_px`` is set), where it measured the laser ``(H, W)``, its
-        spot as an (x, y) pixel offset from the frame's centre (where ``position`` puts the capture's centre), and
-        the dark level's distance from the spot in pixels."""
+        in the camera's tone curve (the dark level out, the beam continued below the noise floor, the saturated core
+        continued when ``core_sigma_ref_px`` is set; under ``raw_colour``, its laser channel spread over the raw
+        channels), where it measured the laser, its spot's offset from the frame's centre, the dark level's
+        distance from the spot, and the glare's colour under ``raw_colour``."""
 
-        def make() -> tuple[torch.Tensor, torch.Tensor, torch.Tensor, float]:
-            tone = self.physics.tone
+        def make() -> CaptureLight:
+            p = self.physics
             capture = self._resized_user_pattern(height, width, torch.device("cpu")).double()
             dark_frame = (
                 None if self._user_dark is None else resize_pattern(self._user_dark, height, width).double()
             )
             reading = read_capture(capture, dark_frame)
-            beam, dark = physics.decode(reading.beam, tone), physics.decode(reading.dark, tone)
-            if self.physics.core_sigma_ref_px is None:
+            beam, dark = physics.decode(reading.beam, p.tone), physics.decode(reading.dark, p.tone)
+            if p.core_sigma_ref_px is None:
                 light = (beam - dark).clamp(min=0.0)
             else:
                 light = core_continued(
-                    beam, dark, reading.core_depth, reading.core_radius, self.physics.core_sigma_ref_px
+                    beam, dark, reading.core_depth, reading.core_radius, p.core_sigma_ref_px
                 )
+            glare_colour = None
+            if self._laser_channel is not None:
+                channel = self._laser_channel
+                glare_colour = physics.raw_light_per_stored(
+                    torch.tensor(p.colour_correction, dtype=torch.float64).reshape(3, 3),
+                    torch.tensor(p.raw_colour, dtype=torch.float64),
+                    channel,
+                )
+                light = light[channel : channel + 1] * glare_colour.reshape(3, 1, 1)
+                glare_colour = glare_colour.float().to(device)
             x, y = reading.centre
             offset = (x - round(0.5 * (width - 1)), y - round(0.5 * (height - 1)))
-            to_pixels = max(height, width) / REFERENCE_SIZE
-            return (
+            return CaptureLight(
                 light.float().to(device),
                 reading.measured.to(device),
                 torch.tensor(offset, device=device),
-                reading.dark_radius * to_pixels,
+                reading.dark_radius * max(height, width) / REFERENCE_SIZE,
+                glare_colour,
             )
 
         return self._cached(("capture", height, width, str(device)), make)
@@ -565,14 +607,18 @@ class LaserBlinding(CameraAttack):
         pixels = self.spot_pixel(params["position"].to(x.device), height, width)
         centre = pixels.flip(1).to(x.dtype)
         measured, dark_radius_px = None, 0.0
+        glare_colour = torch.tensor(self.color, dtype=x.dtype, device=x.device)
         if self._user_pattern is None:
             pattern = self.patterns_for(params["position"], height, width, x.device)
             light = physics.decode(pattern.to(x.dtype), p.tone)
         else:
             # the capture's reading, moved as position moves the capture (whole pixels; nothing measured where
             # the capture does not reach)
-            read, read_measured, offset, dark_radius_px = self.capture_light(height, width, x.device)
-            centre = centre + offset.to(x.dtype)
+            reading = self.capture_light(height, width, x.device)
+            read, read_measured, dark_radius_px = reading.light, reading.measured, reading.dark_radius_px
+            centre = centre + reading.offset.to(x.dtype)
+            if reading.glare_colour is not None:
+                glare_colour = reading.glare_colour.to(x.dtype)
             moves = (
                 pixels - pixels.new_tensor([round(0.5 * (height - 1)), round(0.5 * (width - 1))])
             ).tolist()
@@ -585,7 +631,7 @@ class LaserBlinding(CameraAttack):
             light,
             params["intensity"].to(x.device) * p.gain * params.get("exposure", torch.ones(())).to(x.device),
             centre=centre,
-            color=torch.tensor(self.color, dtype=x.dtype, device=x.device),
+            color=glare_colour,
             halo_amplitude=p.glare_amplitude,
             halo_exponent=p.glare_exponent,
             halo_scale_px=p.glare_scale_ref_px * max(height, width) / REFERENCE_SIZE,

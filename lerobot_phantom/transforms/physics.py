@@ -191,6 +191,17 @@ def metered_exposure(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) 
     return k
 
 
+def raw_light_per_stored(
+    colour_correction: torch.Tensor, raw_colour: torch.Tensor, channel: int
+) -> torch.Tensor:
+    """(3,) a laser's raw light in each channel per unit of the light its own ``channel`` stores, under a camera's
+    (3, 3) ``colour_correction``: the laser's raw colour ``raw_colour`` (1 in its own channel) over the share of it
+    the matrix leaves in that channel. A capture through the matrix stores the laser's fainter channels at 0 (pushed
+    below it), so its own channel, read this way, is the only measure of the laser's raw light."""
+    stored_share = (colour_correction.to(raw_colour.dtype) @ raw_colour)[channel]
+    return raw_colour / stored_share.clamp(min=1e-6)
+
+
 def mix_channels(matrix: torch.Tensor, image: torch.Tensor) -> torch.Tensor:
     """``matrix`` (3, 3) applied to every pixel of a ``(..., 3, H, W)`` image, in the image's dtype."""
     return torch.einsum("ij,...jhw->...ihw", matrix.to(image.dtype), image)

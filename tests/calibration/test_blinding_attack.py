@@ -58,6 +58,43 @@ def test_the_attack_fed_the_cameras_capture_is_the_fitted_frame_model(tmp_path):
     )
 
 
+def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_raw_colour(
+    tmp_path, monkeypatch
+):
+    """camsim's glare case on a colour-correcting camera (``CAMSIM_CCM=1``, case seed 1835569645, whose calibration
+    names the matrix). The capture stores the laser's fainter channels at 0, so the fit reads its laser channel alone
+    and spreads it over the raw channels in the fitted raw colour (``laser_colour_*``), the glare too; the attack
+    given ``raw_colour`` does the same and is the fitted model on the held-out frames. Until session 92 it took the
+    capture's stored channels as raw light and the glare in the stored colour."""
+    import test_independent_sim as sim
+
+    monkeypatch.setenv("CAMSIM_CCM", "1")
+    problem, fit_items, heldout = sim.drawn_split("blinding_halo", 1835569645, tmp_path)
+    effects = frozenset({"linear_light_saturation", "halo_power_law", "colour_correction"})
+    fit = problem.fit(effects, fit_items)
+    options = problem.transform_kwargs(fit)
+    assert options["raw_colour"] == problem.raw_laser_colour(fit.params).tolist()
+    assert options["raw_colour"][problem.laser_channel] == 1.0 and min(options["raw_colour"]) < 1.0
+    fitted = [problem.predict_pair(fit, int(i)) for i in heldout]
+
+    def apart(**changes) -> torch.Tensor:
+        differences = []
+        for i, prediction in zip(heldout, fitted, strict=True):
+            pair = problem.pairs[int(i)]
+            attack = LaserBlinding(
+                pair.intensity, pattern=str(tmp_path / f"pattern_{int(i):03d}.png"), **{**options, **changes}
+            )
+            differences.append(attack(pair.clean.unsqueeze(0).float())[0].double() - prediction)
+        return 255 * torch.cat([d.ravel() for d in differences])
+
+    # the same light to float32's rounding (3e-5 grey levels RMS); the stored channels as raw light, 51 RMS
+    read_in_raw_colour = apart()
+    assert (
+        float(read_in_raw_colour.pow(2).mean().sqrt()) < 0.01 and float(read_in_raw_colour.abs().max()) < 0.5
+    )
+    assert float(apart(raw_colour=None).pow(2).mean().sqrt()) > 10.0
+
+
 def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
     """camsim's auto-exposure case (case seed 1758681884: calibrated, it selects the meter and each frame's own
     exposure). The options calibrated.json holds (the meter's power, the glare's colour) must not change when the

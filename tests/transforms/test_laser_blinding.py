@@ -377,6 +377,34 @@ def test_a_physical_attack_fed_a_capture_takes_out_its_dark_level_and_centres_th
     torch.testing.assert_close(moved[:, 10:40], lit[:, 26:56])
 
 
+def test_under_a_colour_correction_a_capture_is_read_in_its_laser_channel_and_raw_colour(tmp_path):
+    """With ``raw_colour`` the capture's laser channel (green here) is read alone and spread over the raw channels
+    in that colour, over the share of it the matrix leaves in the laser's channel: on a black scene below the clip
+    the frame stores the capture's laser channel again, and the others as the matrix mixes the raw colour (red at
+    0.18 / 1.37 of green, blue pushed below 0). Options that do not fit are refused, naming what is valid."""
+    matrix = (1.4, -0.2, -0.2, -0.3, 1.5, -0.2, -0.1, -0.3, 1.4)
+    capture = _capture_file(tmp_path)
+    options = {"model": "physical", "gain": 0.5, "gamma": 1.0, "colour_correction": matrix}
+    black = torch.zeros(1, 3, 48, 64)
+    spot = LaserBlinding(1.0, pattern=str(capture), raw_colour=(0.3, 1.0, 0.2), **options)(black)[
+        0, :, 14, 44
+    ]
+    plain = {k: v for k, v in options.items() if k != "colour_correction"}
+    read_without_matrix = LaserBlinding(1.0, pattern=str(capture), **plain)(black)[0, 1, 14, 44]
+    assert float(spot[1]) == pytest.approx(float(read_without_matrix), rel=1e-5)
+    assert float(spot[0] / spot[1]) == pytest.approx(0.18 / 1.37, rel=1e-5) and float(spot[2]) < 1e-6
+    stored = LaserBlinding(1.0, pattern=str(capture), **options)(black)[0, :, 14, 44]
+    assert float(stored[0] / stored[1]) != pytest.approx(0.18 / 1.37, rel=0.1)
+    with pytest.raises(ValueError, match="holds its laser light in channel 1"):
+        LaserBlinding(1.0, pattern=str(capture), raw_colour=(1.0, 0.4, 0.2), **options)
+    for bad in (
+        {"raw_colour": (1.0, 0.2, 0.1)},
+        {"raw_colour": (0.5, 0.2, 0.1), "colour_correction": matrix},
+    ):
+        with pytest.raises(ValueError, match="largest is 1"):
+            LaserPhysics(**bad)
+
+
 def test_a_captures_noise_is_not_scaled_into_the_frame_as_laser_light(tmp_path):
     """The capture's pixel noise about its dark level is read as noise, not light (``capture.beam_profile``): at a
     gain of 40 the frame far from the spot stays as even as the scene, where the capture as stored (its dark level

@@ -117,6 +117,7 @@ from lerobot_phantom.calibration.tone import (
 )
 from lerobot_phantom.transforms import physics
 from lerobot_phantom.transforms.capture import (
+    capture_colour,
     core_continued,
     read_capture,
 )
@@ -290,12 +291,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         self.probes = [
             torch.as_tensor(np.sort(probe_rng.choice(p.height * p.width, METER_PROBES))) for p in pairs
         ]
-        self.colours = []
-        for p in pairs:
-            lin = physics.srgb_to_linear(p.pattern).reshape(3, -1)
-            weight = lin.mean(0)
-            colour = (lin * weight).sum(1) / weight.sum().clamp(min=1e-9)
-            self.colours.append(colour / colour.max().clamp(min=1e-9))
+        self.colours = [capture_colour(p.pattern) for p in pairs]
         # the channel holding most of the captures' laser light: colour_correction reads the beam from it alone
         self.laser_channel = int(torch.stack(self.colours).sum(0).argmax())
 
@@ -518,9 +514,10 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         """Scene plus laser light in the raw channels a colour correction matrix mixes (module docstring). The
         capture's laser channel stores the raw beam times that channel's share of the mixed colour; the beam's raw
         light in every channel is that, over the share, times the laser's fitted raw colour (the glare likewise)."""
-        colour = self.raw_laser_colour(params)
+        per_stored = physics.raw_light_per_stored(
+            correction_matrix(params), self.raw_laser_colour(params), self.laser_channel
+        )
         channel = slice(self.laser_channel, self.laser_channel + 1)
-        stored_share = (correction_matrix(params) @ colour)[self.laser_channel].clamp(min=1e-6)
         beam = core_continued(
             decode(f["beam"])[:, channel],
             decode(f["dark"])[:, channel],
@@ -529,7 +526,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             params["core_sigma_ref_px"],
         )
         s = f["strength"]
-        light = s * f["exposure"] * laser_gain(params) * beam * (colour / stored_share)
+        light = s * f["exposure"] * laser_gain(params) * beam * per_stored
         if "halo_power_law" in effects:
             # as in compose: the beam's measured light holds the glare, below the capture's floor the larger counts
             unmeasured = f["unmeasured"] > 0
@@ -537,7 +534,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             halo = physics.power_law_halo(
                 glare_at, halo_amplitude(params), params["halo_exponent"], GLARE_INNER_SCALE_REF_PX
             )
-            glare = s * f["exposure"] * halo * (colour / stored_share)
+            glare = s * f["exposure"] * halo * per_stored
             light = torch.where(unmeasured, torch.maximum(light, glare), light + glare)
         return self.scene_light(effects, params, f, decode) + light
 
@@ -724,10 +721,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
         Fed a capture, the physical attack reads it with this model's functions (``capture.read_capture``), continues
         its core at the fitted width and meters with this model's meter, so on a new scene it predicts as the fit
-        does (given the pair's dark frame as ``pattern_dark``, it reads the same dark field), but for two
-        differences: it meters every pixel where the fit meters a sample; and under ``colour_correction`` it takes
-        the capture's stored channels as raw light where the fit reads the laser's channel in its fitted raw
-        colour."""
+        does (given the pair's dark frame as ``pattern_dark``, it reads the same dark field; under
+        ``colour_correction`` it reads the capture's laser channel in the fitted raw colour, ``raw_colour``), but
+        for one difference: it meters every pixel where the fit meters a sample."""
         p, effects = fit.params, fit.effects
         if not effects:
             alpha = min(p["alpha"], 1.0)
@@ -750,6 +746,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "colour_correction": correction_matrix(p).reshape(-1).tolist()
             if "colour_correction" in effects
             else None,
+            **({"raw_colour": self.raw_laser_colour(p).tolist()} if "colour_correction" in effects else {}),
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); a fitted
             # shoulder under its display gamma (None: 1)
             "gamma": self.tone(effects, p),
