@@ -26,9 +26,10 @@ def test_the_attack_fed_the_cameras_capture_is_the_fitted_frame_model(tmp_path):
     """camsim's glare case (case seed 2074608951; calibrated, it selects linear light, its glare, the meter and a
     tone shoulder). The attack takes the pair's own capture as its pattern and reads it as the fit does
     (``capture.read_capture``: dark level out, noise smoothed, beam continued below the floor, core continued at
-    the fitted width, glare added back where the capture measured it) and meters as the fit does, so on the
-    held-out frames it is the fitted model but for the meter's pixels (all of them, where the fit reads a sample)
-    and float32. Until session 89 it read the capture as stored with a divisor for the meter: 2.58 grey levels
+    the fitted width, glare added back where the capture measured it) and meters as the fit does, on the same
+    pixels (``physics.meter_pixels``), so on the held-out frames it is the fitted model (0.022 grey levels RMS apart,
+    as without a meter; 0.076 while the fit metered a random third of the pixels and the attack all of them, until
+    session 92). Until session 89 it read the capture as stored with a divisor for the meter: 2.58 grey levels
     against the fit's 2.47; with the glare per unit intensity as the fit writes it, 23.04
     (docs/bench/session88/blinding_attack_*.txt)."""
     import test_independent_sim as sim
@@ -50,7 +51,7 @@ def test_the_attack_fed_the_cameras_capture_is_the_fitted_frame_model(tmp_path):
 
     attacks = [attacked(int(i)) for i in heldout]
     apart = torch.cat([(a - f).ravel() for a, f in zip(attacks, fitted, strict=True)])
-    assert 255 * float(apart.pow(2).mean().sqrt()) < 0.25 and 255 * float(apart.abs().max()) < 3.0
+    assert 255 * float(apart.pow(2).mean().sqrt()) < 0.05 and 255 * float(apart.abs().max()) < 3.0
     assert heldout_rmse(attacks, targets) < 1.02 * heldout_rmse(fitted, targets)
     per_intensity = {"glare_amplitude": options["glare_amplitude"] * options["gain"]}
     assert heldout_rmse([attacked(int(i), **per_intensity) for i in heldout], targets) > 3 * heldout_rmse(

@@ -717,6 +717,8 @@ def test_a_colour_correcting_cameras_blinding_halo_names_the_matrix(monkeypatch,
     matrix = np.reshape(attack.physics.colour_correction, (3, 3))
     assert np.allclose(matrix.sum(1), 1.0)
     assert np.allclose(-matrix[1, 0], params["ccm_red"]) and np.allclose(-matrix[0, 2], params["ccm_blue"])
+    # the laser's raw colour, which the attack reads a capture's laser channel in (session 92): red, 1 there
+    assert attack.physics.raw_colour == (1.0, params["laser_colour_green"], params["laser_colour_blue"])
 
 
 @pytest.mark.slow

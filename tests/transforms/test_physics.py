@@ -127,6 +127,31 @@ def test_the_meter_exposes_the_blinded_frame_to_read_as_the_clean_one():
         physics.inject_linear_light(scene, light, meter_power=1.0, auto_exposure=2.0)
 
 
+def test_the_meter_reads_a_regular_sample_of_the_frame():
+    """``meter_pixels``: 1024 distinct pixels of a 224 x 224 frame, every row band and column band holding its share
+    (within one pixel of it), every pixel of a frame of no more; the attack's meter reads those pixels only, so
+    light on a pixel outside them changes no frame's exposure and light on one of them darkens the frame."""
+    read = physics.meter_pixels(224, 224)
+    assert len(read) == 1024 == len(read.unique())
+    for counts in (
+        torch.bincount(read // 224 // 28, minlength=8),
+        torch.bincount(read % 224 // 28, minlength=8),
+    ):
+        assert int(counts.min()) >= 127 and int(counts.max()) <= 129
+    torch.testing.assert_close(physics.meter_pixels(20, 30), torch.arange(600))
+    scene = torch.full((1, 3, 64, 48), 0.3, dtype=torch.float64)
+    spots = physics.meter_pixels(64, 48)
+    unread = int(next(i for i in range(64 * 48) if i not in set(spots.tolist())))
+
+    def metered_with_light_at(pixel: int) -> torch.Tensor:
+        light = torch.zeros_like(scene)
+        light[0, :, pixel // 48, pixel % 48] = 50.0
+        return physics.inject_linear_light(scene, light, meter_power=1.0, gamma=1.0)
+
+    assert float(metered_with_light_at(unread)[0, 0, 63, 0]) == pytest.approx(0.3, abs=1e-12)
+    assert float(metered_with_light_at(int(spots[7]))[0, 0, 63, 0]) < 0.2995
+
+
 def test_the_meter_stops_only_at_its_root():
     """Light spread over three decades clips piece by piece: Newton's first step runs to the lower bound and the next
     four climb back across the clipped pixels' breakpoints; the early stop waits until a step moves ``k`` by

@@ -190,7 +190,7 @@ EXPOSURE_NODES = 12
 MAX_EXPOSURE_SPREAD = 1.5
 MAX_FRAME_LOG_EXPOSURE = 3.0
 # pixels of each frame the exposure meter reads
-METER_PROBES = 1024
+METER_PROBES = physics.METER_PIXELS
 # the least power of the meter's exposure factor (``auto_exposure``) beside which frames' own exposures are named: a
 # camera that re-exposes every scene meters the laser's light as a scene's (1 for a uniform meter, more for a
 # centre-weighted one and a spot near the centre; half of it for a spot far out in a strongly centre-weighted one)
@@ -286,11 +286,10 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
         # each capture read as the physical attack reads one (capture.read_capture), with its dark frame if any
         self.readings = [read_capture(p.pattern, p.pattern_dark) for p in pairs]
-        # a fixed sample of each frame's pixels: what the exposure meter reads, for any tone curve
-        probe_rng = np.random.default_rng(seed + 7)
-        self.probes = [
-            torch.as_tensor(np.sort(probe_rng.choice(p.height * p.width, METER_PROBES))) for p in pairs
-        ]
+        # the pixels the exposure meter reads in each frame, the attack's (physics.meter_pixels)
+        # (as many in every frame: a frame smaller than METER_PROBES pixels sets the count for all)
+        self.meter_count = min(METER_PROBES, *(p.height * p.width for p in pairs))
+        self.probes = [physics.meter_pixels(p.height, p.width, self.meter_count) for p in pairs]
         self.colours = [capture_colour(p.pattern) for p in pairs]
         # the channel holding most of the captures' laser light: colour_correction reads the beam from it alone
         self.laser_channel = int(torch.stack(self.colours).sum(0).argmax())
@@ -540,11 +539,11 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def exposure_factor(self, effects, params, decode, probes: dict | None = None) -> torch.Tensor:
         """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one
-        (``physics.metered_exposure``, the attack's meter; here on a sample of the frame's pixels). ``probes``:
-        the meter's pixels, ``METER_PROBES`` per frame in frame order (default: every pair's, in pair order)."""
+        (``physics.metered_exposure``, the attack's meter, on the attack's pixels: ``physics.meter_pixels``). ``probes``:
+        the meter's pixels, ``meter_count`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
-        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
-        scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, METER_PROBES)
+        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
+        scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
         return physics.metered_exposure(total, scene) ** params["auto_exposure"]
 
     def predict_features(self, effects, params, f, probes: dict | None = None):
@@ -561,9 +560,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def probe_slots(self, indices: list[int]) -> dict[str, torch.Tensor]:
         """The meter's pixels of the pairs ``indices`` (repeats kept), as frames 0..len-1 of one probe set."""
-        rows = torch.cat([torch.arange(i * METER_PROBES, (i + 1) * METER_PROBES) for i in indices])
+        rows = torch.cat([torch.arange(i * self.meter_count, (i + 1) * self.meter_count) for i in indices])
         probes = {k: v[rows] for k, v in self.probe_features.items()}
-        probes["pair"] = torch.arange(len(indices)).repeat_interleave(METER_PROBES)
+        probes["pair"] = torch.arange(len(indices)).repeat_interleave(self.meter_count)
         return probes
 
     def fit(self, effects: frozenset[str], items: np.ndarray, start: Fit | None = None) -> Fit:
