@@ -286,8 +286,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         self.decode_memo = ParameterMemo(DECODE_MEMO_SIZE)
         # each capture read as the physical attack reads one (capture.read_capture), with its dark frame if any
         self.readings = [read_capture(p.pattern, p.pattern_dark) for p in pairs]
-        # the pixels the exposure meter reads in each frame, the attack's (physics.meter_pixels)
-        # (as many in every frame: a frame smaller than METER_PROBES pixels sets the count for all)
+        # the pixels the exposure meter reads in each frame, the attack's (physics.meter_pixels), as many in every
+        # frame: a frame smaller than METER_PROBES pixels sets the count for all
         self.meter_count = min(METER_PROBES, *(p.height * p.width for p in pairs))
         self.probes = [physics.meter_pixels(p.height, p.width, self.meter_count) for p in pairs]
         self.colours = [capture_colour(p.pattern) for p in pairs]
@@ -539,8 +539,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
     def exposure_factor(self, effects, params, decode, probes: dict | None = None) -> torch.Tensor:
         """Per frame: ``k ** a``, ``k`` the exposure at which the blinded frame meters like the clean one
-        (``physics.metered_exposure``, the attack's meter, on the attack's pixels: ``physics.meter_pixels``). ``probes``:
-        the meter's pixels, ``meter_count`` per frame in frame order (default: every pair's, in pair order)."""
+        (``physics.metered_exposure`` on ``physics.meter_pixels``, as the attack meters). ``probes``: the meter's
+        pixels, ``meter_count`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
         total = self.compose(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
         scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
@@ -720,9 +720,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
 
         Fed a capture, the physical attack reads it with this model's functions (``capture.read_capture``), continues
         its core at the fitted width and meters with this model's meter, so on a new scene it predicts as the fit
-        does (given the pair's dark frame as ``pattern_dark``, it reads the same dark field; under
-        ``colour_correction`` it reads the capture's laser channel in the fitted raw colour, ``raw_colour``), but
-        for one difference: it meters every pixel where the fit meters a sample."""
+        does: given the pair's dark frame as ``pattern_dark``, it reads the same dark field; it meters the same
+        pixels (``physics.meter_pixels``); under ``colour_correction`` it reads the capture's laser channel in the
+        fitted raw colour (``raw_colour``)."""
         p, effects = fit.params, fit.effects
         if not effects:
             alpha = min(p["alpha"], 1.0)
