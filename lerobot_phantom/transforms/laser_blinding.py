@@ -134,7 +134,8 @@ class LaserPhysics:
     colour_correction: tuple[float, ...] | None = None
     # under colour_correction, the laser's raw light in each channel over its own channel's (1 there): a capture
     # stores the fainter channels at 0, so its laser channel is read alone and spread by this colour, the glare's
-    # colour too (physics.raw_light_per_stored); None: the capture's stored channels are taken as raw light
+    # colour too (physics.raw_light_per_stored); None: the capture's stored channels are taken as raw light. A
+    # procedural pattern is raw light already and does not read it
     raw_colour: tuple[float, ...] | None = None
     # the tone curve the options give, built (and so checked) once
     _tone: physics.Tone = dataclasses.field(init=False, repr=False, compare=False)

@@ -181,9 +181,9 @@ physical laser blinding meter the same ones."""
 def meter_pixels(height: int, width: int, count: int = METER_PIXELS) -> torch.Tensor:
     """Flat indices of the pixels a meter reads in a ``height`` x ``width`` frame: one at the middle of each of
     ``count`` equal runs of the frame in raster order, a regular sample of rows and columns (every pixel of a frame
-    with no more than ``count``). A random sample of a third of camsim's pixels moved the fit's meter from the whole
-    frame's by enough that the attack, metering every pixel, stood 1.31-6.20 grey levels RMS from its fitted model on
-    auto-exposed frames (docs/bench/session92.md)."""
+    with no more than ``count``). While the fit metered a random third of camsim's pixels and the attack every pixel,
+    the attack stood 1.31-5.32 grey levels RMS from its written model on four auto-exposed draws
+    (docs/bench/session92/blinding_attack_parity_b6c20ea.txt; 0.000 on the same pixels)."""
     count = min(count, height * width)
     centres = (torch.arange(count, dtype=torch.float64) + 0.5) * (height * width / count)
     return centres.floor().long()
