@@ -1,7 +1,8 @@
 #!/bin/bash
 # Every oracle of docs/bench/session93.md on the three colour-correcting auto-exposure draws that miss
 # frame_exposure, one output file per variant in OUT. Two streams (A and B) share the two cores.
-# Usage: bash docs/bench/session93/ccm_oracles.sh OUT A|B
+# Usage: bash docs/bench/session93/ccm_oracles.sh OUT A|B|C (C: the camera as drawn, its core measured, at a fixed
+# exposure; run after A and B)
 set -euo pipefail
 OUT=$1
 mkdir -p "$OUT"
@@ -28,6 +29,9 @@ if [ "$2" = A ]; then
     PROBE_NO_MOSAIC=1 PROBE_UNSATURATED=1
   run simplest_unsaturated_camera_tone $SIMPLE,tone_shoulder "{$NOISELESS, \"auto_exposure\": false}" PROBE_GREY=1 \
     PROBE_NO_MOSAIC=1 PROBE_UNSATURATED=1
+elif [ "$2" = C ]; then
+  run unsaturated_fixed_exposure linear_light_saturation,tone_shoulder,colour_correction '{"auto_exposure": false}' \
+    PROBE_UNSATURATED=1
 else
   run unsaturated $FULL '{}' PROBE_UNSATURATED=1
   run fixed_exposure linear_light_saturation,tone_shoulder,colour_correction '{"auto_exposure": false}'
