@@ -322,16 +322,30 @@ def core_continued(
     core_depth: torch.Tensor,
     core_radius: torch.Tensor,
     core_sigma_ref_px: float | torch.Tensor,
+    inner_core_peak: float | torch.Tensor = 0.0,
+    inner_core_sigma_ref_px: float | torch.Tensor = 1.0,
 ) -> torch.Tensor:
     """Laser light per unit power from the decoded capture ``pattern``: its decoded dark level ``dark`` removed, its
     saturated core continued as a Gaussian beam of width ``core_sigma_ref_px``: a channel saturated out to radius
     ``R`` (``core_radius``, from its saturated area) rises at depth ``d`` (``core_depth``, the distance to the
     nearest unsaturated pixel, capped at ``R``) by ``exp((2 R d - d^2) / (2 sigma^2))``, the Gaussian's ``exp((R^2 -
     r^2) / (2 sigma^2))`` written with the distance to the core's edge, so saturated areas of any shape are followed
-    (lengths in reference pixels)."""
+    (lengths in reference pixels).
+
+    ``inner_core_peak`` > 0 adds a narrower beam at the core's centre, ``inner_core_peak`` times the saturated level
+    there, of width ``s`` = ``inner_core_sigma_ref_px``, less its value at the edge: ``exp(-(R - d)^2 / (2 s^2)) -
+    exp(-R^2 / (2 s^2))`` times that. A spot is a focused core inside a wider skirt (defocus, a lens's point
+    spread); a capture saturated out into the skirt shows the skirt's edge only, whose Gaussian continued inwards
+    misses the core's steeper rise."""
     depth = torch.minimum(core_depth, core_radius)
     rise = (2.0 * core_radius * depth - depth**2) / (2.0 * core_sigma_ref_px**2)
-    return (pattern - dark).clamp(min=0.0) * torch.exp(rise.clamp(max=50.0))
+    continued = torch.exp(rise.clamp(max=50.0))
+    if not isinstance(inner_core_peak, torch.Tensor) and inner_core_peak == 0.0:
+        return (pattern - dark).clamp(min=0.0) * continued
+    spread = 2.0 * inner_core_sigma_ref_px**2
+    # 0 at the edge (depth 0) and outside the core
+    inner = torch.exp(-((core_radius - depth) ** 2) / spread) - torch.exp(-(core_radius**2) / spread)
+    return (pattern - dark).clamp(min=0.0) * (continued + inner_core_peak * inner)
 
 
 @dataclass(frozen=True)

@@ -29,8 +29,8 @@ capture of the laser alone, read as the calibration reads its captures (``captur
 (the dark room and the black level) is no laser light and is taken out before the light is scaled by the gain (read
 over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with the laser
 off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise
-floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_ref_px``, and the glare is centred
-on the capture's spot, added back where the capture measured the laser (its light holds the glare, less what the
+floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_ref_px`` (with a narrower beam at
+its centre where ``inner_core_peak`` is above 0: ``capture.core_continued``), and the glare is centred on the capture's spot, added back where the capture measured the laser (its light holds the glare, less what the
 dark level took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading
 with the capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
 ``k`` the exposure at which its clipped mean reads as the clean frame's on ``physics.meter_pixels``;
@@ -123,6 +123,10 @@ class LaserPhysics:
     # width (reference pixels) of the Gaussian beam a capture's saturated core is continued as (capture.py's
     # core_continued); None: the core's light held at the full well
     core_sigma_ref_px: float | None = None
+    # a narrower beam at the continued core's centre: its peak over the saturated level, 0 for none, and its width
+    # (reference pixels; core_continued)
+    inner_core_peak: float = 0.0
+    inner_core_sigma_ref_px: float = 1.0
     gamma: float | None = None
     # a tone curve whose highlights roll off (physics.ShoulderCurve) under the display power ``gamma`` (None: 1)
     shoulder: float | None = None
@@ -149,10 +153,17 @@ class LaserPhysics:
             or self.exposure_spread < 0
             or self.glare_scale_ref_px <= 0
             or (self.core_sigma_ref_px is not None and self.core_sigma_ref_px <= 0)
+            or self.inner_core_peak < 0
+            or self.inner_core_sigma_ref_px <= 0
         ):
             raise ValueError(
-                "gain, glare_amplitude, auto_exposure, meter_power and exposure_spread must be >= 0, "
-                "glare_scale_ref_px and core_sigma_ref_px > 0"
+                "gain, glare_amplitude, auto_exposure, meter_power, exposure_spread and inner_core_peak must be >= 0, "
+                "glare_scale_ref_px, core_sigma_ref_px and inner_core_sigma_ref_px > 0"
+            )
+        if self.inner_core_peak > 0 and self.core_sigma_ref_px is None:
+            raise ValueError(
+                f"inner_core_peak {self.inner_core_peak} continues a capture's saturated core: give core_sigma_ref_px "
+                "too, or inner_core_peak 0"
             )
         if self.auto_exposure > 0 and self.meter_power > 0:
             raise ValueError(
@@ -458,7 +469,13 @@ class LaserBlinding(CameraAttack):
                 light = (beam - dark).clamp(min=0.0)
             else:
                 light = core_continued(
-                    beam, dark, reading.core_depth, reading.core_radius, p.core_sigma_ref_px
+                    beam,
+                    dark,
+                    reading.core_depth,
+                    reading.core_radius,
+                    p.core_sigma_ref_px,
+                    p.inner_core_peak,
+                    p.inner_core_sigma_ref_px,
                 )
             glare_colour = None
             if self._laser_channel is not None:

@@ -719,6 +719,9 @@ def test_a_colour_correcting_cameras_blinding_halo_names_the_matrix(monkeypatch,
     assert np.allclose(-matrix[1, 0], params["ccm_red"]) and np.allclose(-matrix[0, 2], params["ccm_blue"])
     # the laser's raw colour, which the attack reads a capture's laser channel in (session 92): red, 1 there
     assert attack.physics.raw_colour == (1.0, params["laser_colour_green"], params["laser_colour_blue"])
+    # and the narrower core it continues the capture's saturated core with (session 94)
+    assert attack.physics.inner_core_peak == pytest.approx(10 ** params["inner_core_log10_peak"])
+    assert attack.physics.inner_core_sigma_ref_px == params["inner_core_sigma_ref_px"]
 
 
 @pytest.mark.slow

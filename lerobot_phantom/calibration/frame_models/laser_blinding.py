@@ -80,6 +80,17 @@ camera's true matrix and tone curve, the laser's true colour takes that case fro
 grey levels over all pairs, the capture's colour only to 39.4 and 34.1: the colour is what the capture loses
 (docs/bench/session69/ccm_oracle_*.txt).
 
+Through a matrix the frames also see inside the laser channel's saturated core: a fainter raw channel holds ``L
+c_j`` until it clips at ``L = 1 / c_j``, tens of times the laser channel's full well, so where the frames are exposed
+less than the capture the fainter channels store the beam's profile deep inside the core the capture lost. A spot is
+a focused core inside a wider skirt (defocus, a lens's point spread), and a capture saturated out into the skirt
+shows only the skirt's edge, whose Gaussian continued inwards misses the core's steeper rise; the matrix's take then
+paid for it (camsim's spot, a core with a bloom of 0.15 at 2.5 times its width: on three auto-exposure draws a take
+ran to its bound 1, and on its simplest camera the true matrix misfit by 8.0-9.3 grey levels against 2.9 without
+the bloom, docs/bench/session94/oracles/). So under ``colour_correction`` the core is continued with a narrower beam
+at its centre too (``capture.core_continued``): its peak over the saturated level (``inner_core_log10_peak``) and
+width (``inner_core_sigma_ref_px``) are fitted, and the true matrix then fits that camera to 1.8-2.0 grey levels.
+
 That loss is also the matrix's sign, and the term is offered only where the fit pairs' laser captures show it
 (``unoffered``): among the beam's lit pixels that did not clip white (the laser's channel stored at >= 128 of 255, some
 channel under 250), at least ``MIN_MIXED_SHARE`` store a fainter channel at <= 2. A camera storing its raw channels
@@ -229,6 +240,11 @@ def exposure_nodes(spread: float) -> torch.Tensor:
     ``exp(spread z)`` at the standard normal's quantile midpoints."""
     shares = (np.arange(EXPOSURE_NODES) + 0.5) / EXPOSURE_NODES
     return torch.from_numpy(np.exp(spread * stats.norm.ppf(shares)))
+
+
+def inner_core_peak(params: dict):
+    """The beam's narrower core's peak over a capture's saturated level (fitted as ``inner_core_log10_peak``)."""
+    return 10.0 ** params["inner_core_log10_peak"]
 
 
 def laser_gain(params: dict):
@@ -414,6 +430,20 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
                 for c in range(3)
                 if c != self.laser_channel
             ]
+            # the beam's focused core inside the skirt whose edge a saturated capture shows (module docstring): the
+            # frames' fainter channels measure it through the matrix. Its peak over the saturated level spans
+            # decades, so it is searched on its logarithm; at the bottom (1% of the level) it is no light
+            specs += [
+                Param(
+                    "inner_core_log10_peak",
+                    1.0,
+                    -2.0,
+                    4.0,
+                    scale=0.5,
+                    low_limit="the beam has no core narrower than its saturated edge's Gaussian",
+                ),
+                Param("inner_core_sigma_ref_px", 10.0, 0.5, 500.0, scale=3.0),
+            ]
         if "frame_exposure" in effects:
             # not searched: the sample deviation of the fit frames' registered latents (fit_frame_exposure)
             specs.append(Param("exposure_spread", 0.3, 0.0, MAX_EXPOSURE_SPREAD, scale=0.3))
@@ -523,6 +553,8 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             f["core_depth"][:, channel],
             f["core_radius"][:, channel],
             params["core_sigma_ref_px"],
+            inner_core_peak(params),
+            params["inner_core_sigma_ref_px"],
         )
         s = f["strength"]
         light = s * f["exposure"] * laser_gain(params) * beam * per_stored
@@ -746,6 +778,14 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             if "colour_correction" in effects
             else None,
             **({"raw_colour": self.raw_laser_colour(p).tolist()} if "colour_correction" in effects else {}),
+            **(
+                {
+                    "inner_core_peak": float(inner_core_peak(p)),
+                    "inner_core_sigma_ref_px": float(p["inner_core_sigma_ref_px"]),
+                }
+                if "colour_correction" in effects
+                else {}
+            ),
             # tone curve the light was composed in: sRGB (None), fitted, or the encoded values (1.0); a fitted
             # shoulder under its display gamma (None: 1)
             "gamma": self.tone(effects, p),
