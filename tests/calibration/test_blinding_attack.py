@@ -66,7 +66,8 @@ def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_ra
     names the matrix). The capture stores the laser's fainter channels at 0, so the fit reads its laser channel alone
     and spreads it over the raw channels in the fitted raw colour (``laser_colour_*``), the glare too; the attack
     given ``raw_colour`` does the same and is the fitted model on the held-out frames. Until session 92 it took the
-    capture's stored channels as raw light and the glare in the stored colour."""
+    capture's stored channels as raw light and the glare in the stored colour. The capture's saturated core is
+    continued with the fitted narrower beam at its centre as the fit continues it (``inner_core_*``, session 94)."""
     import test_independent_sim as sim
 
     monkeypatch.setenv("CAMSIM_CCM", "1")
@@ -94,6 +95,11 @@ def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_ra
         float(read_in_raw_colour.pow(2).mean().sqrt()) < 0.01 and float(read_in_raw_colour.abs().max()) < 0.5
     )
     assert float(apart(raw_colour=None).pow(2).mean().sqrt()) > 10.0
+    # the capture's saturated core continued with the fitted narrower beam at its centre (session 94)
+    assert options["inner_core_peak"] == pytest.approx(10 ** fit.params["inner_core_log10_peak"])
+    # (peak 15.3 times the saturated level on this draw; without it the attack is 1.85 grey levels RMS apart, 52.5 at
+    # most, in the core)
+    assert float(apart(inner_core_peak=0.0).pow(2).mean().sqrt()) > 0.5
 
 
 def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):

@@ -17,7 +17,15 @@ import torch
 from PIL import Image
 
 from lerobot_phantom.transforms import physics
-from lerobot_phantom.transforms.capture import beam_profile, dark_field, dark_level, pattern_centre
+from lerobot_phantom.transforms.base import REFERENCE_SIZE
+from lerobot_phantom.transforms.capture import (
+    beam_profile,
+    core_continued,
+    dark_field,
+    dark_level,
+    pattern_centre,
+    read_capture,
+)
 
 HEIGHT, WIDTH = 48, 64
 CENTRE = (30.0, 22.0)  # (x, y)
@@ -183,3 +191,44 @@ def test_a_dark_frame_of_another_size_is_refused():
         dark_field(capture, torch.zeros(3, 12, 16, dtype=torch.float64), centre)
     field = dark_field(capture, None, centre)
     assert field.shape == capture.shape and torch.equal(field, dark_level(capture, centre).expand_as(capture))
+
+
+def test_a_saturated_core_is_continued_with_the_beams_narrower_core_inside_its_skirt():
+    """A spot whose focused core sits inside a wider skirt, captured saturated out into the skirt (60 full wells at
+    the core's peak, the skirt 0.15 of it at 8/3 its width): the saturated edge is the skirt's, and its Gaussian
+    continued inwards reaches the skirt's own peak, 9 full wells, where the beam holds 69. With the narrower core
+    at its true width and peak over the saturated level (``inner_core_peak``) the continuation follows the beam
+    through the core; outside the core nothing changes, and a peak of 0 is the skirt's Gaussian alone."""
+    ys, xs = np.mgrid[0:HEIGHT, 0:WIDTH].astype(float)
+    radius = np.hypot(xs - CENTRE[0], ys - CENTRE[1])
+    core_px, skirt_px, peak = 3.0, 8.0, 60.0
+    light = peak * (np.exp(-(radius**2) / (2 * core_px**2)) + 0.15 * np.exp(-(radius**2) / (2 * skirt_px**2)))
+    stored = np.clip(light[None] * np.array([0.1, 1.0, 0.2])[:, None, None] + DARK, 0.0, 1.0)
+    pattern = torch.from_numpy(np.round(physics.linear_to_srgb(torch.from_numpy(stored)).numpy() * 255) / 255)
+    reading = read_capture(pattern)
+    to_reference = REFERENCE_SIZE / WIDTH
+    green = slice(1, 2)
+    beam, dark = physics.srgb_to_linear(reading.beam)[green], physics.srgb_to_linear(reading.dark)[green]
+    depth, core_radius = reading.core_depth[green], reading.core_radius[green]
+
+    def continued(inner_peak: float) -> np.ndarray:
+        light = core_continued(
+            beam, dark, depth, core_radius, skirt_px * to_reference, inner_peak, core_px * to_reference
+        )
+        return light[0].numpy()
+
+    level = float((beam - dark)[depth > 0].mean())
+    skirt_alone, with_core = continued(0.0), continued(peak / level)
+    centre = radius < 1.0
+    assert 0.95 < with_core[centre].mean() / light[centre].mean() < 1.05
+    assert skirt_alone[centre].mean() < 0.15 * light[centre].mean()
+    # where the core outshines the skirt: within 10% of the beam at the median, where the skirt alone is 3x off
+    inner = radius < 2 * core_px
+    assert np.median(np.abs(np.log(with_core[inner] / light[inner]))) < 0.1
+    assert np.median(np.abs(np.log(skirt_alone[inner] / light[inner]))) > 1.0
+    outside = (depth[0] == 0).numpy()
+    assert np.array_equal(with_core[outside], skirt_alone[outside])
+    assert torch.equal(
+        core_continued(beam, dark, depth, core_radius, 20.0),
+        core_continued(beam, dark, depth, core_radius, 20.0, 0.0),
+    )

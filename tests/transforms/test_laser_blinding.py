@@ -440,8 +440,22 @@ def test_a_captures_saturated_core_is_continued_at_the_calibrated_width(tmp_path
     narrow = LaserBlinding(1.0, pattern=str(capture), core_sigma_ref_px=3.0, **options)(scene)[0, 1, 14, 44]
     assert 0.15 < float(held) < 0.2  # the full well less the dark level, times the power ratio
     assert float(held) < float(wide) < float(narrow) and float(narrow) == 1.0
+    # a narrower beam at the core's centre (inner_core_peak over the saturated level) brightens it further
+    inner = LaserBlinding(
+        1.0,
+        pattern=str(capture),
+        core_sigma_ref_px=30.0,
+        inner_core_peak=3.0,
+        inner_core_sigma_ref_px=20.0,
+        **options,
+    )(scene)[0, 1, 14, 44]
+    assert float(wide) < float(inner)
     with pytest.raises(ValueError, match="core_sigma_ref_px > 0"):
         LaserPhysics(core_sigma_ref_px=0.0)
+    with pytest.raises(ValueError, match="inner_core_peak must be >= 0"):
+        LaserPhysics(core_sigma_ref_px=30.0, inner_core_peak=-1.0)
+    with pytest.raises(ValueError, match="give core_sigma_ref_px too, or inner_core_peak 0"):
+        LaserPhysics(inner_core_peak=2.0)
 
 
 def test_the_meter_darkens_the_frame_by_its_power_and_excludes_the_divisor():
