@@ -30,9 +30,10 @@ capture of the laser alone, read as the calibration reads its captures (``captur
 over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with the laser
 off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise
 floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_ref_px`` (with a narrower beam at
-its centre where ``inner_core_peak`` is above 0: ``capture.core_continued``), and the glare is centred on the capture's spot, added back where the capture measured the laser (its light holds the glare, less what the
-dark level took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading
-with the capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
+its centre where ``inner_core_peak`` is above 0: ``capture.core_continued``), and the glare is centred on the
+capture's spot, added back where the capture measured the laser (its light holds the glare, less what the dark level
+took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading with the
+capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
 ``k`` the exposure at which its clipped mean reads as the clean frame's on ``physics.meter_pixels``;
 ``physics.metered_exposure``), or the divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's
 laser power is also scaled by ``exp(spread z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure
