@@ -26,6 +26,10 @@ under ``colour_correction`` continued into its saturated core as the edge's Gaus
 spot's centre, ``edge * 10**core_narrow_log10_peak * (exp(-r^2 / 2 s^2) - exp(-R^2 / 2 s^2))`` (``s``:
 ``core_narrow_ref_px``; zero at the edge), two parameters fitted.
 
+The session-94 knobs' outputs (``docs/bench/session94/oracles/``) were made at a5edf90's package: from 220b408 on the
+package continues the core with its own narrower beam under ``colour_correction``, on which ``PROBE_NARROW_CORE``
+would stack a second one (run those knobs at a5edf90, e.g. with that checkout first on ``PYTHONPATH``).
+
 Usage: ``PROBE_EFFECTS=... CAMSIM_SEED=0 PYTHONPATH=.:tests/calibration:tests python
 docs/bench/session93/ccm_oracles.py MASTER_SEED...``
 """
@@ -104,7 +108,8 @@ if ON["PROBE_GREY"]:
     cs.scene_reflectance = lambda *a: np.repeat(reflectance(*a).mean(-1, keepdims=True), 3, axis=-1)
 if ON["PROBE_UNIFORM_METER"]:
     cs.meter = uniform_meter
-if ON["PROBE_CORE_UNSCORED"]:
+if ON["PROBE_CORE_UNSCORED"] or ON["PROBE_CORE_PROFILED"]:
+    # the fits' features carry the frame's values, which only a fit's prediction reads
     stacked_pixels, predict_features = (
         model.BlindingFrames.stacked_pixels,
         model.BlindingFrames.predict_features,
@@ -113,6 +118,9 @@ if ON["PROBE_CORE_UNSCORED"]:
     def stacked_with_target(self, items, pixels):
         stacked, target = stacked_pixels(self, items, pixels)
         return {**stacked, "attacked": target}, target
+
+    model.BlindingFrames.stacked_pixels = stacked_with_target
+if ON["PROBE_CORE_UNSCORED"]:
 
     def predict_unscored_core(self, effects, params, f, probes=None):
         prediction = predict_features(self, effects, params, f, probes)
@@ -123,21 +131,12 @@ if ON["PROBE_CORE_UNSCORED"]:
         unscored = core.unsqueeze(1) & fainter
         return torch.where(unscored, f["attacked"], prediction)
 
-    model.BlindingFrames.stacked_pixels = stacked_with_target
     model.BlindingFrames.predict_features = predict_unscored_core
 if ON["PROBE_CORE_PROFILED"]:
     from lerobot_phantom.transforms import physics
     from lerobot_phantom.transforms.capture import core_continued
 
     PROFILE_STEPS = 256
-    stacked_pixels, predict_features = (
-        model.BlindingFrames.stacked_pixels,
-        model.BlindingFrames.predict_features,
-    )
-
-    def stacked_with_target(self, items, pixels):
-        stacked, target = stacked_pixels(self, items, pixels)
-        return {**stacked, "attacked": target}, target
 
     def predict_profiled_core(self, effects, params, f, probes=None):
         prediction = predict_features(self, effects, params, f, probes)
@@ -176,7 +175,6 @@ if ON["PROBE_CORE_PROFILED"]:
         out[core] = encode(read)
         return out
 
-    model.BlindingFrames.stacked_pixels = stacked_with_target
     model.BlindingFrames.predict_features = predict_profiled_core
 if ON["PROBE_NARROW_CORE"]:
     from lerobot_phantom.transforms import capture as capture_module
