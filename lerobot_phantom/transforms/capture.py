@@ -340,8 +340,6 @@ def core_continued(
     depth = torch.minimum(core_depth, core_radius)
     rise = (2.0 * core_radius * depth - depth**2) / (2.0 * core_sigma_ref_px**2)
     continued = torch.exp(rise.clamp(max=50.0))
-    if not isinstance(inner_core_peak, torch.Tensor) and inner_core_peak == 0.0:
-        return (pattern - dark).clamp(min=0.0) * continued
     spread = 2.0 * inner_core_sigma_ref_px**2
     # 0 at the edge (depth 0) and outside the core
     inner = torch.exp(-((core_radius - depth) ** 2) / spread) - torch.exp(-(core_radius**2) / spread)

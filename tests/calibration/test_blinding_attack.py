@@ -97,6 +97,7 @@ def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_ra
     assert float(apart(raw_colour=None).pow(2).mean().sqrt()) > 10.0
     # the capture's saturated core continued with the fitted narrower beam at its centre (session 94)
     assert options["inner_core_peak"] == pytest.approx(10 ** fit.params["inner_core_log10_peak"])
+    assert options["inner_core_sigma_ref_px"] == fit.params["inner_core_sigma_ref_px"]
     # (peak 15.3 times the saturated level on this draw; without it the attack is 1.85 grey levels RMS apart, 52.5 at
     # most, in the core)
     assert float(apart(inner_core_peak=0.0).pow(2).mean().sqrt()) > 0.5

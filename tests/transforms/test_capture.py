@@ -228,7 +228,8 @@ def test_a_saturated_core_is_continued_with_the_beams_narrower_core_inside_its_s
     assert np.median(np.abs(np.log(skirt_alone[inner] / light[inner]))) > 1.0
     outside = (depth[0] == 0).numpy()
     assert np.array_equal(with_core[outside], skirt_alone[outside])
+    # without a peak the width is inert: the edge's Gaussian alone, whatever width the inner beam is given
     assert torch.equal(
         core_continued(beam, dark, depth, core_radius, 20.0),
-        core_continued(beam, dark, depth, core_radius, 20.0, 0.0),
+        core_continued(beam, dark, depth, core_radius, 20.0, 0.0, 3.0),
     )

@@ -777,9 +777,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "colour_correction": correction_matrix(p).reshape(-1).tolist()
             if "colour_correction" in effects
             else None,
-            **({"raw_colour": self.raw_laser_colour(p).tolist()} if "colour_correction" in effects else {}),
             **(
                 {
+                    "raw_colour": self.raw_laser_colour(p).tolist(),
                     "inner_core_peak": float(inner_core_peak(p)),
                     "inner_core_sigma_ref_px": float(p["inner_core_sigma_ref_px"]),
                 }
