@@ -35,7 +35,8 @@ capture's spot, added back where the capture measured the laser (its light holds
 took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading with the
 capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``,
 ``k`` the exposure at which its clipped mean reads as the clean frame's on ``physics.meter_pixels``;
-``physics.metered_exposure``), or the divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's
+``physics.metered_exposure``; each pixel's channel mean, or with ``meter_reads="luminance"`` its luminance), or the
+divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's
 laser power is also scaled by ``exp(spread z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure
 an auto-exposing camera gives each scene (``frame_exposure`` in the calibration). With ``colour_correction`` (9
 numbers, a row-major matrix whose rows sum to 1) the camera mixes its clipped raw channels with that matrix: the
@@ -121,6 +122,8 @@ class LaserPhysics:
     # light whose exposure factor is raised to ``meter_power`` (physics.inject_linear_light); at most one
     auto_exposure: float = 0.0
     meter_power: float = 0.0
+    # what the meter reads of each pixel's light (physics.METER_READS): its channel mean or its luminance
+    meter_reads: str = "channel_mean"
     # width (reference pixels) of the Gaussian beam a capture's saturated core is continued as (capture.py's
     # core_continued); None: the core's light held at the full well
     core_sigma_ref_px: float | None = None
@@ -166,6 +169,8 @@ class LaserPhysics:
                 f"inner_core_peak {self.inner_core_peak} continues a capture's saturated core: give core_sigma_ref_px "
                 "too, or inner_core_peak 0"
             )
+        if self.meter_reads not in physics.METER_READS:
+            raise ValueError(f"meter_reads {self.meter_reads!r}; valid: {', '.join(physics.METER_READS)}")
         if self.auto_exposure > 0 and self.meter_power > 0:
             raise ValueError(
                 "auto_exposure (a divisor) and meter_power (a clipped-light meter) are two auto-exposures: give one"
@@ -659,6 +664,7 @@ class LaserBlinding(CameraAttack):
             dark_radius_px=dark_radius_px,
             auto_exposure=p.auto_exposure,
             meter_power=p.meter_power,
+            meter_reads=p.meter_reads,
             gamma=p.tone,
             colour_correction=None
             if p.colour_correction is None

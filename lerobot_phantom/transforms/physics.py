@@ -134,6 +134,7 @@ def inject_linear_light(
     auto_exposure: float | torch.Tensor = 0.0,
     metered_light: torch.Tensor | None = None,
     meter_power: float = 0.0,
+    meter_reads: str = "channel_mean",
     white: float | torch.Tensor = 1.0,
     gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
@@ -143,7 +144,7 @@ def inject_linear_light(
     ``auto_exposure`` a: the camera's gain drops as ``1 / (1 + a * mean(metered_light))`` (default: the injected
     light), darkening the whole frame; ``meter_power`` a, its alternative: the exposure scales by ``k ** a``, ``k``
     the exposure at which the frame's clipped mean level equals the scene's over :func:`meter_pixels`
-    (:func:`metered_exposure`);
+    (:func:`metered_exposure`), each pixel's light read as ``meter_reads`` (:func:`meter_light`);
     ``white``: linear level at which the sensor saturates; ``gamma``: None = the sRGB tone curve, a number = a
     power law (1 = compose the encoded values); ``colour_correction``: a (3, 3) matrix the camera mixes its clipped
     raw channels with (``light`` is then raw light, the scene is taken to the raw channels by its inverse).
@@ -160,7 +161,8 @@ def inject_linear_light(
         flat = (-1, *([1] * (x.ndim - 1)))
         read = meter_pixels(*x.shape[-2:]).to(x.device)
         exposure = metered_exposure(
-            total.mean(-3).flatten(-2)[..., read], scene.mean(-3).flatten(-2)[..., read]
+            meter_light(total, meter_reads, -3).flatten(-2)[..., read],
+            meter_light(scene, meter_reads, -3).flatten(-2)[..., read],
         )
         total = total * exposure.reshape(flat) ** meter_power
     else:
@@ -176,6 +178,29 @@ def inject_linear_light(
 METER_PIXELS = 1024
 """The pixels an auto-exposure meter reads in a frame (:func:`meter_pixels`): the calibration's frame model and the
 physical laser blinding meter the same ones."""
+
+
+METER_READS = ("channel_mean", "luminance")
+"""What an auto-exposure meter reads of a pixel's light (:func:`meter_light`)."""
+
+LUMINANCE_WEIGHTS = (0.2126, 0.7152, 0.0722)
+"""Rec. 709 luminance weights of the red, green and blue channels."""
+
+
+def meter_light(light: torch.Tensor, reads: str, dim: int) -> torch.Tensor:
+    """The light a meter reads at each pixel of ``light``, whose channels lie along ``dim``: their mean
+    (``"channel_mean"``) or their luminance (``"luminance"``, Rec. 709 weights). A camera meters its sensor's raw
+    channels before its ISP's matrix mixes them, weighted as the eye weighs them; on a colour-correcting camera
+    whose raw light the calibration models, the channel mean weighs a narrowband laser's channel wrongly against
+    the scene's, and the matrix's take ran to its bound in its place (docs/bench/session95.md)."""
+    if reads == "channel_mean":
+        return light.mean(dim)
+    if reads != "luminance":
+        raise ValueError(f"meter_reads {reads!r}; valid: {', '.join(METER_READS)}")
+    shape = [1] * light.ndim
+    shape[dim] = 3
+    weights = torch.tensor(LUMINANCE_WEIGHTS, dtype=light.dtype, device=light.device).reshape(shape)
+    return (light * weights).sum(dim)
 
 
 def meter_pixels(height: int, width: int, count: int = METER_PIXELS) -> torch.Tensor:
@@ -377,6 +402,7 @@ def laser_injection(
     dark_radius_px: float = 0.0,
     auto_exposure: float = 0.0,
     meter_power: float = 0.0,
+    meter_reads: str = "channel_mean",
     gamma: Tone = None,
     colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
@@ -415,6 +441,7 @@ def laser_injection(
         auto_exposure=auto_exposure,
         metered_light=metered if meter_power == 0.0 else None,
         meter_power=meter_power,
+        meter_reads=meter_reads,
         gamma=gamma,
         colour_correction=colour_correction,
     )

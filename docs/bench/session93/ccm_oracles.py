@@ -15,6 +15,8 @@ mean: no clean frame holds a channel the matrix pushes below 0 or above white); 
 sampled at every pixel (no Bayer mosaic, no demosaic); ``PROBE_UNSATURATED=1`` the laser captured at the halo case's
 50-90% core fill without its glare (the capture measures the beam's core); ``PROBE_UNIFORM_METER=1`` camsim meters
 the channel mean over every pixel alike (the model's meter form) instead of centre-weighted luminance;
+``PROBE_UNIFORM_LUMA_METER=1`` (session 95) camsim meters luminance over every pixel alike (its weighting replaced);
+``PROBE_CENTRED_MEAN_METER=1`` (session 95) camsim meters the channel mean, centre-weighted (its luminance replaced);
 ``PROBE_CORE_UNSCORED=1`` (session 94) the fit scores no fainter channel inside the laser channel's white core of the
 capture (its predictions there replaced by the frame's values, in fits only; the RMSEs printed score every channel);
 ``PROBE_CORE_PROFILED=1`` (session 94) the fit reads the beam's light at each pixel of that core as the value, on a
@@ -58,6 +60,8 @@ KNOBS = (
     "PROBE_NO_MOSAIC",
     "PROBE_UNSATURATED",
     "PROBE_UNIFORM_METER",
+    "PROBE_UNIFORM_LUMA_METER",
+    "PROBE_CENTRED_MEAN_METER",
     "PROBE_CORE_UNSCORED",
     "PROBE_CORE_PROFILED",
     "PROBE_NO_BLOOM",
@@ -67,17 +71,27 @@ ON = {knob: os.environ.get(knob) == "1" for knob in KNOBS}
 CASE = sim.CASE_BY_NAME["blinding_auto_exposure"]
 
 
-def uniform_meter(irradiance: np.ndarray, cam: cs.Camera) -> float:
-    """camsim's meter with every pixel weighted alike and the channel mean for its luminance."""
-    light = irradiance.mean(-1)
-    low, high = np.log(1e-4), np.log(1e3)
-    for _ in range(40):
-        mid = (low + high) / 2
-        if np.minimum(np.exp(mid) * light, 1.0).mean() < cam.exposure_target:
-            low = mid
-        else:
-            high = mid
-    return float(np.exp((low + high) / 2))
+def meter_form(*, centred: bool, luma: bool):
+    """camsim's meter with its centre weighting (``centred``) and its luminance (``luma``; else the channel mean)
+    each kept or replaced by the model's form."""
+
+    def meter(irradiance: np.ndarray, cam: cs.Camera) -> float:
+        h, w = irradiance.shape[:2]
+        yy, xx = np.mgrid[0:h, 0:w].astype(float)
+        weight = np.exp(-(((yy - h / 2) / (0.6 * h)) ** 2 + ((xx - w / 2) / (0.6 * w)) ** 2))
+        weight /= weight.sum()
+        light = irradiance @ cs.LUMA if luma else irradiance.mean(-1)
+        low, high = np.log(1e-4), np.log(1e3)
+        for _ in range(40):
+            mid = (low + high) / 2
+            clipped = np.minimum(np.exp(mid) * light, 1.0)
+            if ((clipped * weight).sum() if centred else clipped.mean()) < cam.exposure_target:
+                low = mid
+            else:
+                high = mid
+        return float(np.exp((low + high) / 2))
+
+    return meter
 
 
 if ON["PROBE_UNSATURATED"]:
@@ -107,7 +121,11 @@ if ON["PROBE_GREY"]:
     reflectance = cs.scene_reflectance
     cs.scene_reflectance = lambda *a: np.repeat(reflectance(*a).mean(-1, keepdims=True), 3, axis=-1)
 if ON["PROBE_UNIFORM_METER"]:
-    cs.meter = uniform_meter
+    cs.meter = meter_form(centred=False, luma=False)
+if ON["PROBE_UNIFORM_LUMA_METER"]:
+    cs.meter = meter_form(centred=False, luma=True)
+if ON["PROBE_CENTRED_MEAN_METER"]:
+    cs.meter = meter_form(centred=True, luma=False)
 if ON["PROBE_CORE_UNSCORED"] or ON["PROBE_CORE_PROFILED"]:
     # the fits' features carry the frame's values, which only a fit's prediction reads
     stacked_pixels, predict_features = (

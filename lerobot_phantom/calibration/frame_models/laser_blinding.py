@@ -43,9 +43,13 @@ the curve can stretch the light's scale freely, so the laser's gain is no longer
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
 1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
 ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
-average, as centre-weighted meters do when the spot is central). A meter of luminance (Rec. 709 weights), tried in
-sessions 71 and 91, predicts camsim's unseen auto-exposed frames better on its default camera but loses the frames'
-exposures on colour-correcting ones (planted causes named on 1 of 8 draws against 5 of 8; docs/bench/session91.md).
+average, as centre-weighted meters do when the spot is central). A camera meters its raw channels' luminance
+(Rec. 709 weights, ``physics.meter_light``), which the model holds only under ``colour_correction`` (its light is
+then raw): there the meter reads luminance (``meter_reads``), elsewhere the channel mean, the output a matrix mixed,
+which neither form follows (docs/bench/session91.md, section 4). With the channel mean a colour-correcting camera's
+matrix took a channel's light at its bound in the meter's place (docs/bench/session95.md); a luminance meter on every
+camera, tried in sessions 71 and 91 before the saturated core was continued with its narrower beam, lost the frames'
+exposures on colour-correcting cameras (planted causes named on 1 of 8 draws against 5 of 8).
 It builds on ``linear_light_saturation``: a meter reacts to light the laser adds, which the paper's blend does not
 add (its opacity darkens the scene, and a meter would answer by raising the gain).
 
@@ -240,6 +244,12 @@ def exposure_nodes(spread: float) -> torch.Tensor:
     ``exp(spread z)`` at the standard normal's quantile midpoints."""
     shares = (np.arange(EXPOSURE_NODES) + 0.5) / EXPOSURE_NODES
     return torch.from_numpy(np.exp(spread * stats.norm.ppf(shares)))
+
+
+def meter_reads(effects: frozenset[str]) -> str:
+    """What the meter reads of a pixel's light (``physics.METER_READS``): its luminance where the model holds the
+    camera's raw light (``colour_correction``), else the channel mean (module docstring)."""
+    return "luminance" if "colour_correction" in effects else "channel_mean"
 
 
 def inner_core_peak(params: dict):
@@ -574,9 +584,13 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         (``physics.metered_exposure`` on ``physics.meter_pixels``, as the attack meters). ``probes``: the meter's
         pixels, ``meter_count`` per frame in frame order (default: every pair's, in pair order)."""
         f = self.probe_features if probes is None else probes
-        total = self.compose(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
-        scene = self.scene_light(effects, params, f, decode).mean(1).reshape(-1, self.meter_count)
-        return physics.metered_exposure(total, scene) ** params["auto_exposure"]
+        reads = meter_reads(effects)
+        total = physics.meter_light(self.compose(effects, params, f, decode), reads, 1)
+        scene = physics.meter_light(self.scene_light(effects, params, f, decode), reads, 1)
+        return (
+            physics.metered_exposure(total.reshape(-1, self.meter_count), scene.reshape(-1, self.meter_count))
+            ** params["auto_exposure"]
+        )
 
     def predict_features(self, effects, params, f, probes: dict | None = None):
         """Encoded prediction at the features ``f``; ``f["pair"]`` indexes the frames of ``probes`` (the meter's
@@ -779,6 +793,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             else None,
             **(
                 {
+                    "meter_reads": meter_reads(effects),
                     "raw_colour": self.raw_laser_colour(p).tolist(),
                     "inner_core_peak": float(inner_core_peak(p)),
                     "inner_core_sigma_ref_px": float(p["inner_core_sigma_ref_px"]),
