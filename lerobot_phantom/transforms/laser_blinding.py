@@ -169,8 +169,7 @@ class LaserPhysics:
                 f"inner_core_peak {self.inner_core_peak} continues a capture's saturated core: give core_sigma_ref_px "
                 "too, or inner_core_peak 0"
             )
-        if self.meter_reads not in physics.METER_READS:
-            raise ValueError(f"meter_reads {self.meter_reads!r}; valid: {', '.join(physics.METER_READS)}")
+        physics.check_meter_reads(self.meter_reads)
         if self.auto_exposure > 0 and self.meter_power > 0:
             raise ValueError(
                 "auto_exposure (a divisor) and meter_power (a clipped-light meter) are two auto-exposures: give one"

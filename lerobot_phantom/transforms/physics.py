@@ -187,16 +187,21 @@ LUMINANCE_WEIGHTS = (0.2126, 0.7152, 0.0722)
 """Rec. 709 luminance weights of the red, green and blue channels."""
 
 
+def check_meter_reads(reads: str) -> str:
+    """``reads`` if it is one of ``METER_READS``; else a ValueError naming them."""
+    if reads not in METER_READS:
+        raise ValueError(f"meter_reads {reads!r}; valid: {', '.join(METER_READS)}")
+    return reads
+
+
 def meter_light(light: torch.Tensor, reads: str, dim: int) -> torch.Tensor:
     """The light a meter reads at each pixel of ``light``, whose channels lie along ``dim``: their mean
     (``"channel_mean"``) or their luminance (``"luminance"``, Rec. 709 weights). A camera meters its sensor's raw
     channels before its ISP's matrix mixes them, weighted as the eye weighs them; on a colour-correcting camera
     whose raw light the calibration models, the channel mean weighs a narrowband laser's channel wrongly against
     the scene's, and the matrix's take ran to its bound in its place (docs/bench/session95.md)."""
-    if reads == "channel_mean":
+    if check_meter_reads(reads) == "channel_mean":
         return light.mean(dim)
-    if reads != "luminance":
-        raise ValueError(f"meter_reads {reads!r}; valid: {', '.join(METER_READS)}")
     shape = [1] * light.ndim
     shape[dim] = 3
     weights = torch.tensor(LUMINANCE_WEIGHTS, dtype=light.dtype, device=light.device).reshape(shape)

@@ -103,6 +103,35 @@ def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_ra
     assert float(apart(inner_core_peak=0.0).pow(2).mean().sqrt()) > 0.5
 
 
+def test_under_a_colour_correction_the_attack_meters_luminance_as_the_fit_does(tmp_path, monkeypatch):
+    """camsim's auto-exposure case on a colour-correcting camera (``CAMSIM_CCM=1``, case seed 1330563791, a blue
+    laser). The model holds the camera's raw light there, and its meter reads the luminance of it as a camera's does
+    (session 95); the attack, given ``meter_reads``, meters alike and is the fitted model on the held-out frames."""
+    import test_independent_sim as sim
+
+    monkeypatch.setenv("CAMSIM_CCM", "1")
+    problem, fit_items, heldout = sim.drawn_split("blinding_auto_exposure", 1330563791, tmp_path)
+    fit = problem.fit(frozenset({"linear_light_saturation", "auto_exposure", "colour_correction"}), fit_items)
+    options = problem.transform_kwargs(fit)
+    assert options["meter_reads"] == "luminance" and options["meter_power"] > 0.5
+    fitted = [problem.predict_pair(fit, int(i)) for i in heldout]
+
+    def apart(**changes) -> torch.Tensor:
+        differences = []
+        for i, prediction in zip(heldout, fitted, strict=True):
+            pair = problem.pairs[int(i)]
+            attack = LaserBlinding(
+                pair.intensity, pattern=str(tmp_path / f"pattern_{int(i):03d}.png"), **{**options, **changes}
+            )
+            differences.append(attack(pair.clean.unsqueeze(0).float())[0].double() - prediction)
+        return 255 * torch.cat([d.ravel() for d in differences])
+
+    metered_alike = apart()
+    assert float(metered_alike.pow(2).mean().sqrt()) < 0.01 and float(metered_alike.abs().max()) < 0.5
+    # metering the channel mean instead (10.1 grey levels RMS apart in the run that set the bound)
+    assert float(apart(meter_reads="channel_mean").pow(2).mean().sqrt()) > 2.0
+
+
 def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
     """camsim's auto-exposure case (case seed 1758681884: calibrated, it selects the meter and each frame's own
     exposure). The options calibrated.json holds (the meter's power, the glare's colour) must not change when the

@@ -468,3 +468,17 @@ def test_the_meter_darkens_the_frame_by_its_power_and_excludes_the_divisor():
     assert float(full[corner].mean()) < float(half[corner].mean()) < float(plain[corner].mean())
     with pytest.raises(ValueError, match="two auto-exposures"):
         LaserPhysics(auto_exposure=1.0, meter_power=1.0)
+
+
+def test_a_luminance_meter_reaches_the_physical_model_and_is_validated():
+    """``meter_reads="luminance"``: a blue laser weighs a fifth of the channel mean's weight in the meter's reading,
+    so the frame it blinds stays brighter; any other reading is refused, naming the valid ones."""
+    scene = torch.full((1, 3, 32, 32), 0.4)
+    options = {"model": "physical", "gain": 20.0, "color": (0, 0, 255), "meter_power": 1.0}
+    params = LaserBlinding("strong", **options).sample_params(1, 32, 32)
+    channel_mean = LaserBlinding("strong", **options).apply_params(scene, params)
+    luminance = LaserBlinding("strong", **options, meter_reads="luminance").apply_params(scene, params)
+    corner = (0, slice(None), 0, 0)
+    assert float(channel_mean[corner].mean()) < float(luminance[corner].mean()) < 0.4
+    with pytest.raises(ValueError, match="meter_reads 'luma'; valid: channel_mean, luminance"):
+        LaserPhysics(meter_reads="luma")

@@ -127,6 +127,35 @@ def test_the_meter_exposes_the_blinded_frame_to_read_as_the_clean_one():
         physics.inject_linear_light(scene, light, meter_power=1.0, auto_exposure=2.0)
 
 
+def test_a_luminance_meter_weighs_each_channel_as_rec_709():
+    """``meter_light``: the channel mean, or the luminance (0.2126, 0.7152, 0.0722) along any channel axis; a meter
+    of luminance reads a blue laser's light at a fifth of the channel mean's weight against a grey scene, so it
+    darkens the frame less; an unknown reading is refused, naming the valid ones."""
+    generator = torch.Generator().manual_seed(3)
+    light = torch.rand(2, 3, 4, 5, generator=generator, dtype=torch.float64)
+    expected = 0.2126 * light[:, 0] + 0.7152 * light[:, 1] + 0.0722 * light[:, 2]
+    torch.testing.assert_close(physics.meter_light(light, "luminance", -3), expected)
+    torch.testing.assert_close(physics.meter_light(light.movedim(1, -1), "luminance", -1), expected)
+    torch.testing.assert_close(physics.meter_light(light, "channel_mean", 1), light.mean(1))
+    scene = torch.full((1, 3, 32, 32), 0.3, dtype=torch.float64)
+    blue = torch.zeros_like(scene)
+    blue[0, 2, 8:24, 8:24] = 20.0
+
+    def corner(reads: str) -> float:
+        frame = physics.inject_linear_light(scene, blue, meter_power=1.0, meter_reads=reads, gamma=1.0)
+        return float(frame[0, 0, 0, 0])
+
+    assert corner("channel_mean") < corner("luminance") < 0.3
+    # the exposure k (an unlit pixel's 0.3 k) reads the blinded light's clipped luminance as the clean frame's
+    k = corner("luminance") / 0.3
+    luminance = physics.meter_light(scene + blue, "luminance", -3).flatten(-2)[
+        ..., physics.meter_pixels(32, 32)
+    ]
+    assert float((k * luminance).clamp(max=1.0).mean()) == pytest.approx(0.3, abs=1e-9)
+    with pytest.raises(ValueError, match="meter_reads 'luma'; valid: channel_mean, luminance"):
+        physics.inject_linear_light(scene, blue, meter_power=1.0, meter_reads="luma")
+
+
 def test_the_meter_reads_a_regular_sample_of_the_frame():
     """``meter_pixels``: 1024 distinct pixels of a 224 x 224 frame, every row band and column band holding its share
     (within one pixel of it), every pixel of a frame of no more; the attack's meter reads those pixels only, so
