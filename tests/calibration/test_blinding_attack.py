@@ -22,6 +22,17 @@ def heldout_rmse(predictions: list[torch.Tensor], targets: list[torch.Tensor]) -
     return float(torch.cat(errors).pow(2).mean().sqrt())
 
 
+def attack_apart_from_fit(problem, heldout, fitted, options: dict, folder) -> torch.Tensor:
+    """Grey levels by which the attack with ``options``, fed each held-out pair's capture (``pattern_NNN.png`` in
+    ``folder``), stands from the fitted model's predictions ``fitted`` of those pairs, every pixel and channel."""
+    differences = []
+    for i, prediction in zip(heldout, fitted, strict=True):
+        pair = problem.pairs[int(i)]
+        attack = LaserBlinding(pair.intensity, pattern=str(folder / f"pattern_{int(i):03d}.png"), **options)
+        differences.append(attack(pair.clean.unsqueeze(0).float())[0].double() - prediction)
+    return 255 * torch.cat([d.ravel() for d in differences])
+
+
 def test_the_attack_fed_the_cameras_capture_is_the_fitted_frame_model(tmp_path):
     """camsim's glare case (case seed 2074608951; calibrated, it selects linear light, its glare, the meter and a
     tone shoulder). The attack takes the pair's own capture as its pattern and reads it as the fit does
@@ -80,14 +91,7 @@ def test_under_a_colour_correction_the_attack_reads_the_capture_in_the_fitted_ra
     fitted = [problem.predict_pair(fit, int(i)) for i in heldout]
 
     def apart(**changes) -> torch.Tensor:
-        differences = []
-        for i, prediction in zip(heldout, fitted, strict=True):
-            pair = problem.pairs[int(i)]
-            attack = LaserBlinding(
-                pair.intensity, pattern=str(tmp_path / f"pattern_{int(i):03d}.png"), **{**options, **changes}
-            )
-            differences.append(attack(pair.clean.unsqueeze(0).float())[0].double() - prediction)
-        return 255 * torch.cat([d.ravel() for d in differences])
+        return attack_apart_from_fit(problem, heldout, fitted, {**options, **changes}, tmp_path)
 
     # the same light to float32's rounding (3e-5 grey levels RMS); the stored channels as raw light, 51 RMS
     read_in_raw_colour = apart()
@@ -117,14 +121,7 @@ def test_under_a_colour_correction_the_attack_meters_luminance_as_the_fit_does(t
     fitted = [problem.predict_pair(fit, int(i)) for i in heldout]
 
     def apart(**changes) -> torch.Tensor:
-        differences = []
-        for i, prediction in zip(heldout, fitted, strict=True):
-            pair = problem.pairs[int(i)]
-            attack = LaserBlinding(
-                pair.intensity, pattern=str(tmp_path / f"pattern_{int(i):03d}.png"), **{**options, **changes}
-            )
-            differences.append(attack(pair.clean.unsqueeze(0).float())[0].double() - prediction)
-        return 255 * torch.cat([d.ravel() for d in differences])
+        return attack_apart_from_fit(problem, heldout, fitted, {**options, **changes}, tmp_path)
 
     metered_alike = apart()
     assert float(metered_alike.pow(2).mean().sqrt()) < 0.01 and float(metered_alike.abs().max()) < 0.5
