@@ -196,10 +196,11 @@ def check_meter_reads(reads: str) -> str:
 
 def meter_light(light: torch.Tensor, reads: str, dim: int) -> torch.Tensor:
     """The light a meter reads at each pixel of ``light``, whose channels lie along ``dim``: their mean
-    (``"channel_mean"``) or their luminance (``"luminance"``, Rec. 709 weights). A camera meters its sensor's raw
-    channels before its ISP's matrix mixes them, weighted as the eye weighs them; on a colour-correcting camera
-    whose raw light the calibration models, the channel mean weighs a narrowband laser's channel wrongly against
-    the scene's, and the matrix's take ran to its bound in its place (docs/bench/session95.md)."""
+    (``"channel_mean"``) or their luminance (``"luminance"``, Rec. 709 weights). An auto-exposure commonly meters
+    the luminance of its sensor's raw channels, before the ISP's matrix mixes them (camsim's does); on such a
+    colour-correcting camera, whose raw light the calibration models, the channel mean weighed a narrowband
+    laser's channel wrongly against the scene's, and the matrix's take ran to its bound in its place
+    (docs/bench/session95.md)."""
     if check_meter_reads(reads) == "channel_mean":
         return light.mean(dim)
     shape = [1] * light.ndim
