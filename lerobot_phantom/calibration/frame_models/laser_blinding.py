@@ -43,13 +43,14 @@ the curve can stretch the light's scale freely, so the laser's gain is no longer
 *clipped* mean level (what a meter reads from the sensor) equals the clean frame's, ``mean(min(k (scene + light),
 1)) = mean(min(scene, 1))``, solved per frame on a fixed pixel sample; the fitted ``auto_exposure`` ``a`` applies
 ``k ** a`` (0: no reaction; 1: the uniform meter; above 1: a meter weighting the spot's region more than the frame
-average, as centre-weighted meters do when the spot is central). An auto-exposure commonly meters its raw
-channels' luminance (Rec. 709 weights, ``physics.meter_light``; camsim's does), light the model holds only under
-``colour_correction``: there the meter reads luminance (``meter_reads``), elsewhere the channel mean of the output
-a matrix mixed, which neither form follows (docs/bench/session91.md, section 4). With the channel mean a colour-correcting camera's
-matrix took a channel's light at its bound in the meter's place (docs/bench/session95.md); a luminance meter on every
-camera, tried in sessions 71 and 91 before the saturated core was continued with its narrower beam, lost the frames'
-exposures on colour-correcting cameras (planted causes named on 1 of 8 draws against 5 of 8).
+average, as centre-weighted meters do when the spot is central). An auto-exposure commonly meters its raw channels'
+luminance (Rec. 709 weights, ``physics.meter_light``; camsim's does), light the model holds only under
+``colour_correction``: there the meter reads luminance (``meter_reads``), elsewhere the channel mean of the output a
+matrix mixed, which neither form follows (docs/bench/session91.md, section 4). With the channel mean a
+colour-correcting camera's matrix took a channel's light at its bound in the meter's place
+(docs/bench/session95.md); a luminance meter on every camera, tried in sessions 71 and 91 before the saturated core
+was continued with its narrower beam, lost the frames' exposures on colour-correcting cameras (planted causes named
+on 1 of 8 draws against 5 of 8).
 It builds on ``linear_light_saturation``: a meter reacts to light the laser adds, which the paper's blend does not
 add (its opacity darkens the scene, and a meter would answer by raising the gain).
 
