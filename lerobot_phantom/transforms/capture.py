@@ -98,24 +98,82 @@ def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
     return (terms @ coefficients).T.reshape(3, height, width)
 
 
+# the room's gradient is read beyond this share of the largest distance a pixel is mirrored about the spot from:
+# nearer, the beam's steep light turns any error in the spot's centre into a false gradient
+GRADIENT_MIN_RADIUS_SHARE = 0.3
+# fewest mirrored pixels the room's gradient is read from; with fewer (a spot at the frame's edge, a capture mostly
+# saturated) the room is read as one level
+MIN_GRADIENT_PIXELS = 64
+
+
+def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor | None:
+    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): the dark room's linear gradient
+    ``g . (p - c)`` about the spot's centre ``c``, read from a capture alone; None where too few pixels read it.
+
+    A laser's beam, bloom and glare are even under the point reflection ``p -> 2c - p`` about the spot (an
+    elliptical beam too), a room's linear gradient is odd: ``L(p) - L(2c - p) = 2 g . (p - c)`` over pixels whose
+    mirror lies in the frame, beyond ``GRADIENT_MIN_RADIUS_SHARE`` of the largest mirrored distance, neither
+    saturated. The mirror is sampled bilinearly, and an error ``e`` in the spot's centre, which moves the even light
+    by ``e . grad L`` and so reads as odd, is fitted beside ``g`` (its regressors the even light's gradient). The
+    room's even part (a lens's fall-off) cannot be told from the glare and stays in the level."""
+    light = srgb_to_linear(capture)
+    _, height, width = light.shape
+    ys, xs = torch.meshgrid(
+        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
+    )
+    dx, dy = xs - centre[0], ys - centre[1]
+    mirror_x, mirror_y = centre[0] - dx, centre[1] - dy
+    # grid_sample with align_corners=True: -1 and 1 are the border pixels' centres
+    grid = torch.stack([2 * mirror_x / max(width - 1, 1) - 1, 2 * mirror_y / max(height - 1, 1) - 1], dim=-1)[
+        None
+    ]
+    saturated = (capture >= SATURATED).any(0)
+    mirrored, saturated_mirror = (
+        F.grid_sample(image[None], grid, mode="bilinear", padding_mode="border", align_corners=True)[0]
+        for image in (light, saturated[None].double())
+    )
+    inside = (mirror_x >= 0) & (mirror_x <= width - 1) & (mirror_y >= 0) & (mirror_y <= height - 1)
+    radius = torch.hypot(dx, dy)
+    if not bool(inside.any()):
+        return None
+    use = inside & ~saturated & (saturated_mirror[0] == 0)
+    use &= radius >= GRADIENT_MIN_RADIUS_SHARE * float(radius[inside].max())
+    if int(use.sum()) < MIN_GRADIENT_PIXELS:
+        return None
+    grad_y, grad_x = torch.gradient(0.5 * (light + mirrored), dim=(1, 2))
+    gradient = []
+    for channel in range(3):
+        terms = torch.stack([dx[use], dy[use], grad_x[channel][use], grad_y[channel][use]], dim=1)
+        odd = 0.5 * (light[channel] - mirrored[channel])[use]
+        gradient.append(torch.linalg.lstsq(terms, odd[:, None]).solution[:2, 0])
+    g = torch.stack(gradient, dim=1)  # (2, 3): x and y slopes per channel
+    return g[0].reshape(3, 1, 1) * dx + g[1].reshape(3, 1, 1) * dy
+
+
 def dark_field(
     capture: torch.Tensor, dark_frame: torch.Tensor | None, centre: tuple[float, float]
 ) -> torch.Tensor:
-    """(3, H, W) encoded: the capture's dark level at every pixel, :func:`dark_level` where it is read. With a dark
-    frame (the capture repeated with the laser off, as beam profilers record one), the room's light departs from its
-    level as the frame's :func:`dark_surface` departs from its own median there: the capture, that departure taken
-    out, is read as a capture of a uniform room (its median holding the glare at :func:`dark_level_radius`, which
-    the physical model's halo adds back), and the departure put back. Subtracted whole (the surface, no glare added
-    back), the dark frame leaves the capture's faint glare a few noise deviations above it, which the beam then
-    reads pixel by pixel, noise and all, times the gain, where the halo had modelled it: on camsim's glare case the
-    halo was named on fewer draws (docs/bench/session80.md)."""
+    """(3, H, W) encoded: the capture's dark level at every pixel, :func:`dark_level` where it is read. The room's
+    light departs from its level as the dark frame's :func:`dark_surface` (the capture repeated with the laser off,
+    as beam profilers record one) departs from its own median there, or, without one, as the capture's
+    :func:`room_gradient` does: the capture, that departure taken out, is read as a capture of a uniform room (its
+    median holding the glare at :func:`dark_level_radius`, which the physical model's halo adds back), and the
+    departure put back. Read as one level, a room's gradient is laser light at the gain between the frames and the
+    capture (tens to a hundred): it stood in for camsim's glare, which went unnamed on the draws of its halo case
+    without a dark frame, and was named on the same draws with one (docs/bench/session79.md, session96.md).
+    Subtracted whole (the surface, no glare added back), the dark frame leaves the capture's faint glare a few noise
+    deviations above it, which the beam then reads pixel by pixel, noise and all, times the gain, where the halo had
+    modelled it: on camsim's glare case the halo was named on fewer draws (docs/bench/session80.md)."""
     if dark_frame is None:
-        return dark_level(capture, centre).expand_as(capture)
-    if dark_frame.shape != capture.shape:
+        surface = room_gradient(capture, centre)
+        if surface is None:
+            return dark_level(capture, centre).expand_as(capture)
+    elif dark_frame.shape != capture.shape:
         raise ValueError(
             f"a dark frame must have its capture's shape {tuple(capture.shape)}, got {tuple(dark_frame.shape)}"
         )
-    surface = dark_surface(dark_frame)
+    else:
+        surface = dark_surface(dark_frame)
     _, far = dark_region(capture, centre)
     departure = surface - far_median(surface, far)
     # read in linear light: the median commutes with the tone curve, so this is dark_level of the flattened capture

@@ -10,7 +10,10 @@ as laser irradiance instead, which needs three corrections any capture of a lase
   light, lit the frames by up to 0.12 full wells per unit intensity and stood in for glare (on the independent
   simulator's halo case the glare's fit ran to its bound, docs/bench/session79.md). With a dark frame
   (``pattern_dark``: the capture repeated with the laser off, as beam profilers record one), the level varies over
-  the frame as the dark frame's light does (``capture.dark_field``);
+  the frame as the dark frame's light does (``capture.dark_field``); without one, as the room's linear gradient
+  does, read from the capture's part that is odd under the reflection about the spot, where the beam and its glare
+  are even (``capture.room_gradient``; on the simulator's halo case the glare was then named on the three draws
+  that had missed it, docs/bench/session96.md);
 * where the capture itself saturated, the laser's irradiance is unknown (at least the full well): it is
   extrapolated into the saturated core as a Gaussian beam of width ``core_sigma``: a channel saturated out to
   radius ``R`` (from its saturated area) rises at depth ``d = R - r`` inside it by ``exp((2 R d - d^2) / (2
@@ -330,7 +333,9 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         with_frame = sum(p.pattern_dark is not None for p in self.pairs)
         if with_frame == 0:
             source = (
-                "one level per channel: the median of the capture's farthest tenth (no pattern_dark column)"
+                "the median of the capture's farthest tenth, varying over the frame as the room's linear gradient "
+                "read from the capture's part odd about the spot does (one level where too few pixels are "
+                "mirrored in the frame; no pattern_dark column)"
             )
         elif with_frame == len(self.pairs):
             source = (
