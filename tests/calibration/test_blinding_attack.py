@@ -14,6 +14,7 @@ import torch
 os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
+from lerobot_phantom.transforms import capture as capture_module
 from lerobot_phantom.transforms.laser_blinding import LaserBlinding
 
 
@@ -157,12 +158,13 @@ def test_the_attacks_options_are_read_from_the_fit_frames_alone(tmp_path):
     assert read_from_every_frame["color"] != pytest.approx(options["color"])
 
 
-def test_the_attack_reads_a_dark_frame_as_the_fit_does(tmp_path):
+def test_the_attack_reads_a_dark_frame_as_the_fit_does(tmp_path, monkeypatch):
     """A capture over a dark room 15% brighter on one side than its mean (test_blinding_model's glare capture, stored
     in 8 bits) and its dark frame: the fit reads the room's shape from the dark frame (``capture.dark_field``), and
-    so does the attack given it as ``pattern_dark``, so on a black scene the two compose the same light. Read as one
-    level, as the attack read every capture until session 90, the room's slope, scaled by the gain of 100, lights
-    one side of the frame and darkens the other."""
+    so does the attack given it as ``pattern_dark``, so on a black scene the two compose the same light. Without it
+    the attack reads the room's slope from the capture's part odd about the spot (``capture.room_gradient``, since
+    session 96), near the same light. Read as one level, as the attack read every capture until session 90, the
+    room's slope, scaled by the gain of 100, lights one side of the frame and darkens the other."""
     from PIL import Image
     from test_blinding_model import GLARE_REFERENCE_PX, capture_glare, glare_capture
 
@@ -189,11 +191,14 @@ def test_the_attack_reads_a_dark_frame_as_the_fit_does(tmp_path):
     reads_dark_frame = LaserBlinding(1.0, pattern_dark=str(tmp_path / "pattern_dark.png"), **options)
     assert "pattern_dark=" in repr(reads_dark_frame)
     with_frame = reads_dark_frame(black)[0]
+    from_capture = LaserBlinding(1.0, **options)(black)[0]
+    monkeypatch.setattr(capture_module, "room_gradient", lambda capture, centre: None)
     one_level = LaserBlinding(1.0, **options)(black)[0]
-    # with the dark frame the same light to float32's rounding (9e-6 grey levels RMS, 3e-5 at most); read as one
-    # level, 5.2 grey levels RMS and 31 at most
+    # with the dark frame the same light to float32's rounding (9e-6 grey levels RMS, 3e-5 at most); the slope read
+    # from the 8-bit capture, 0.55 grey levels RMS and 5.9 at most; read as one level, 5.2 RMS and 31 at most
     apart = 255 * (with_frame.double() - fitted)
     assert float(apart.pow(2).mean().sqrt()) < 0.01 and float(apart.abs().max()) < 0.05
+    assert 255 * float((from_capture.double() - fitted).pow(2).mean().sqrt()) < 1.0
     assert 255 * float((one_level.double() - fitted).pow(2).mean().sqrt()) > 2.0
 
 
