@@ -4,12 +4,14 @@
 A capture holds the laser's beam plus what is not the laser's: the dark room's light and the sensor's black level
 (:func:`dark_level`), the capture's own noise, and, where the capture itself saturated, a core whose irradiance it
 could not record. The calibration scales a capture to the attack's power by a gain of tens for a beam-profile
-exposure, so each of these would be scaled with it: the dark level is taken out, the beam is read without the
-noise and continued below the noise floor (:func:`beam_profile`), and the saturated core is continued as a Gaussian
-beam (:func:`saturated_depth`, :func:`core_continued`). Module docstring of
-``calibration/frame_models/laser_blinding.py`` for what each reading fixed on the independent simulator. Pure
-torch (the image operations the calibration once took from scipy are written here: medians, a line fit, hole
-filling and a distance transform; the Gaussian filter is ``physics.gaussian_spread``).
+exposure, so each of these would be scaled with it: the dark level is taken out (varying over the frame as a dark
+frame's light does, or, without one, as the room's linear gradient read from the capture does: :func:`dark_field`,
+:func:`room_gradient`), the beam is read without the noise and continued below the noise floor
+(:func:`beam_profile`), and the saturated core is continued as a Gaussian beam (:func:`saturated_depth`,
+:func:`core_continued`). Module docstring of ``calibration/frame_models/laser_blinding.py`` for what each reading
+fixed on the independent simulator. Pure torch (the image operations the calibration once took from scipy are
+written here: medians, a line fit, hole filling and a distance transform; the Gaussian filter is
+``physics.gaussian_spread``).
 """
 
 from __future__ import annotations
@@ -104,17 +106,24 @@ GRADIENT_MIN_RADIUS_SHARE = 0.3
 # fewest mirrored pixels the room's gradient is read from; with fewer (a spot at the frame's edge, a capture mostly
 # saturated) the room is read as one level
 MIN_GRADIENT_PIXELS = 64
+# linear light of half an 8-bit step at black: a channel's light is weighed against at least this much
+DARKEST_LIGHT = 0.5 / 255.0 / 12.92
 
 
 def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor | None:
     """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): the dark room's linear gradient
-    ``g . (p - c)`` about the spot's centre ``c``, read from a capture alone; None where too few pixels read it.
+    about the spot's centre ``c``, read from a capture alone; None where too few pixels read it.
 
     A laser's beam, bloom and glare are even under the point reflection ``p -> 2c - p`` about the spot (an
     elliptical beam too), a room's linear gradient is odd: ``L(p) - L(2c - p) = 2 g . (p - c)`` over pixels whose
     mirror lies in the frame, beyond ``GRADIENT_MIN_RADIUS_SHARE`` of the largest mirrored distance, neither
     saturated. The mirror is sampled bilinearly, and an error ``e`` in the spot's centre, which moves the even light
-    by ``e . grad L`` and so reads as odd, is fitted beside ``g`` (its regressors the even light's gradient). The
+    by ``e . grad L`` and so reads as odd, is fitted beside ``g`` (per channel, its regressors the even light's
+    gradient). The room's light comes from its sources through one fall-off in every channel, so ``g`` is each
+    channel's level times one relative gradient, and each channel's odd light is weighed against the light it holds
+    there: where the laser's glare is bright, its small asymmetries (demosaicing, the mirror's interpolation)
+    outweigh the room's slope, which the fainter channels then read (per channel and unweighted, camsim's glare case
+    read the laser channel's gradient worse than one level on two draws of five, docs/bench/session96.md). The
     room's even part (a lens's fall-off) cannot be told from the glare and stays in the level."""
     light = srgb_to_linear(capture)
     _, height, width = light.shape
@@ -124,30 +133,36 @@ def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.T
     dx, dy = xs - centre[0], ys - centre[1]
     mirror_x, mirror_y = centre[0] - dx, centre[1] - dy
     # grid_sample with align_corners=True: -1 and 1 are the border pixels' centres
-    grid = torch.stack([2 * mirror_x / max(width - 1, 1) - 1, 2 * mirror_y / max(height - 1, 1) - 1], dim=-1)[
-        None
-    ]
+    grid = torch.stack([2 * mirror_x / max(width - 1, 1) - 1, 2 * mirror_y / max(height - 1, 1) - 1], dim=-1)
     saturated = (capture >= SATURATED).any(0)
     mirrored, saturated_mirror = (
-        F.grid_sample(image[None], grid, mode="bilinear", padding_mode="border", align_corners=True)[0]
+        F.grid_sample(image[None], grid[None], mode="bilinear", padding_mode="border", align_corners=True)[0]
         for image in (light, saturated[None].double())
     )
     inside = (mirror_x >= 0) & (mirror_x <= width - 1) & (mirror_y >= 0) & (mirror_y <= height - 1)
-    radius = torch.hypot(dx, dy)
     if not bool(inside.any()):
         return None
+    radius = torch.hypot(dx, dy)
     use = inside & ~saturated & (saturated_mirror[0] == 0)
     use &= radius >= GRADIENT_MIN_RADIUS_SHARE * float(radius[inside].max())
-    if int(use.sum()) < MIN_GRADIENT_PIXELS:
+    count = int(use.sum())
+    if count < MIN_GRADIENT_PIXELS:
         return None
-    grad_y, grad_x = torch.gradient(0.5 * (light + mirrored), dim=(1, 2))
-    gradient = []
+    even = 0.5 * (light + mirrored)
+    grad_y, grad_x = torch.gradient(even, dim=(1, 2))
+    _, far = dark_region(capture, centre)
+    level = far_median(light, far)
+    held = (even - level).clamp(min=0.0) + level + DARKEST_LIGHT
+    design, odd = [], []
     for channel in range(3):
-        terms = torch.stack([dx[use], dy[use], grad_x[channel][use], grad_y[channel][use]], dim=1)
-        odd = 0.5 * (light[channel] - mirrored[channel])[use]
-        gradient.append(torch.linalg.lstsq(terms, odd[:, None]).solution[:2, 0])
-    g = torch.stack(gradient, dim=1)  # (2, 3): x and y slopes per channel
-    return g[0].reshape(3, 1, 1) * dx + g[1].reshape(3, 1, 1) * dy
+        weight = 1.0 / held[channel][use]
+        columns = torch.zeros((count, 8), dtype=torch.float64)
+        columns[:, 0], columns[:, 1] = level[channel, 0, 0] * dx[use], level[channel, 0, 0] * dy[use]
+        columns[:, 2 + 2 * channel], columns[:, 3 + 2 * channel] = grad_x[channel][use], grad_y[channel][use]
+        design.append(columns * weight[:, None])
+        odd.append(0.5 * (light[channel] - mirrored[channel])[use] * weight)
+    relative = torch.linalg.lstsq(torch.cat(design), torch.cat(odd)[:, None]).solution[:2, 0]
+    return level * (relative[0] * dx + relative[1] * dy)
 
 
 def dark_field(

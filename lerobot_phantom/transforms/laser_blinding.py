@@ -28,23 +28,24 @@ position are random; the pattern is fixed per instance.
 capture of the laser alone, read as the calibration reads its captures (``capture.read_capture``): its dark level
 (the dark room and the black level) is no laser light and is taken out before the light is scaled by the gain (read
 over the frame as a dark frame's light varies where ``pattern_dark=PATH`` gives the capture repeated with the laser
-off, the calibration's ``pattern_dark`` column), its noise is smoothed away and its beam continued below the noise
-floor, its saturated core is continued as a Gaussian beam of width ``core_sigma_ref_px`` (with a narrower beam at
-its centre where ``inner_core_peak`` is above 0: ``capture.core_continued``), and the glare is centred on the
-capture's spot, added back where the capture measured the laser (its light holds the glare, less what the dark level
-took out) and taken as the larger of glare and continued beam elsewhere; ``position`` moves the reading with the
-capture. The auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``, ``k``
-the exposure at which its clipped mean reads as the clean frame's on ``physics.meter_pixels``;
-``physics.metered_exposure``; each pixel's channel mean, or with ``meter_reads="luminance"`` its luminance), or the
-divisor ``auto_exposure``. With ``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread
-z)``, ``z`` standard normal drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene
-(``frame_exposure`` in the calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to
-1) the camera mixes its clipped raw channels with that matrix: the pattern's light and the glare's colour are raw
-light, the scene goes to the raw channels by the matrix's inverse, and the clipped laser channel's full well, not
-its light, is taken out of the others (``colour_correction`` in the calibration). A capture through such a matrix
-stores the laser's fainter channels at 0; with ``raw_colour`` (the laser's raw light in each channel over its own
-channel's, the calibration's ``laser_colour_*``) its laser channel is read alone and spread over the raw channels in
-that colour, which the glare takes too, as the calibration reads its pairs' captures.
+off, the calibration's ``pattern_dark`` column, and otherwise as the room's linear gradient read from the capture,
+``capture.room_gradient``), its noise is smoothed away and its beam continued below the noise floor, its saturated
+core is continued as a Gaussian beam of width ``core_sigma_ref_px`` (with a narrower beam at its centre where
+``inner_core_peak`` is above 0: ``capture.core_continued``), and the glare is centred on the capture's spot, added
+back where the capture measured the laser (its light holds the glare, less what the dark level took out) and taken
+as the larger of glare and continued beam elsewhere; ``position`` moves the reading with the capture. The
+auto-exposure is the calibration's meter with ``meter_power`` (the frame scaled by ``k ** a``, ``k`` the exposure at
+which its clipped mean reads as the clean frame's on ``physics.meter_pixels``; ``physics.metered_exposure``; each
+pixel's channel mean, or with ``meter_reads="luminance"`` its luminance), or the divisor ``auto_exposure``. With
+``exposure_spread`` above 0 each sample's laser power is also scaled by ``exp(spread z)``, ``z`` standard normal
+drawn per sample: the frame-to-frame exposure an auto-exposing camera gives each scene (``frame_exposure`` in the
+calibration). With ``colour_correction`` (9 numbers, a row-major matrix whose rows sum to 1) the camera mixes its
+clipped raw channels with that matrix: the pattern's light and the glare's colour are raw light, the scene goes to
+the raw channels by the matrix's inverse, and the clipped laser channel's full well, not its light, is taken out of
+the others (``colour_correction`` in the calibration). A capture through such a matrix stores the laser's fainter
+channels at 0; with ``raw_colour`` (the laser's raw light in each channel over its own channel's, the calibration's
+``laser_colour_*``) its laser channel is read alone and spread over the raw channels in that colour, which the glare
+takes too, as the calibration reads its pairs' captures.
 
 Deviations from the paper's code: the pattern is generated (or loaded) once and cached per image size instead of
 being re-read from disk on every call; randomness comes from the attack's seeded ``torch.Generator``, never the

