@@ -110,21 +110,21 @@ MIN_GRADIENT_PIXELS = 64
 DARKEST_LIGHT = 0.5 / 255.0 / 12.92
 
 
-def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor | None:
-    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): the dark room's linear gradient
-    about the spot's centre ``c``, read from a capture alone; None where too few pixels read it.
+class MirroredPairs(NamedTuple):
+    light: torch.Tensor  # (3, H, W) the capture in linear light (sRGB)
+    mirrored: torch.Tensor  # (3, H, W) its light at each pixel's mirror about the spot, sampled bilinearly
+    dx: torch.Tensor  # (H, W) each pixel's offset from the spot's centre, x
+    dy: torch.Tensor  # (H, W) and y
+    usable: (
+        torch.Tensor
+    )  # (H, W) bool: mirror in the frame, neither saturated, beyond the share of the distance
 
-    A laser's beam, bloom and glare are even under the point reflection ``p -> 2c - p`` about the spot (an
-    elliptical beam too), a room's linear gradient is odd: ``L(p) - L(2c - p) = 2 g . (p - c)`` over pixels whose
-    mirror lies in the frame, beyond ``GRADIENT_MIN_RADIUS_SHARE`` of the largest mirrored distance, neither
-    saturated. The mirror is sampled bilinearly, and an error ``e`` in the spot's centre, which moves the even light
-    by ``e . grad L`` and so reads as odd, is fitted beside ``g`` (per channel, its regressors the even light's
-    gradient). The room's light comes from its sources through one fall-off in every channel, so ``g`` is each
-    channel's level times one relative gradient, and each channel's odd light is weighed against the light it holds
-    there: where the laser's glare is bright, its small asymmetries (demosaicing, the mirror's interpolation)
-    outweigh the room's slope, which the fainter channels then read (per channel and unweighted, camsim's glare case
-    read the laser channel's gradient worse than one level on two draws of five, docs/bench/session96.md). The
-    room's even part (a lens's fall-off) cannot be told from the glare and stays in the level."""
+
+def mirrored_pairs(capture: torch.Tensor, centre: tuple[float, float]) -> MirroredPairs | None:
+    """The capture's pixels and their mirrors under the point reflection ``p -> 2c - p`` about the spot's centre
+    ``c`` (:func:`room_gradient` reads the room's gradient from their difference); None where fewer than
+    ``MIN_GRADIENT_PIXELS`` are usable: mirror in the frame, beyond ``GRADIENT_MIN_RADIUS_SHARE`` of the largest
+    mirrored distance, neither saturated."""
     light = srgb_to_linear(capture)
     _, height, width = light.shape
     ys, xs = torch.meshgrid(
@@ -143,11 +143,33 @@ def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.T
     if not bool(inside.any()):
         return None
     radius = torch.hypot(dx, dy)
-    use = inside & ~saturated & (saturated_mirror[0] == 0)
-    use &= radius >= GRADIENT_MIN_RADIUS_SHARE * float(radius[inside].max())
-    count = int(use.sum())
-    if count < MIN_GRADIENT_PIXELS:
+    usable = inside & ~saturated & (saturated_mirror[0] == 0)
+    usable &= radius >= GRADIENT_MIN_RADIUS_SHARE * float(radius[inside].max())
+    if int(usable.sum()) < MIN_GRADIENT_PIXELS:
         return None
+    return MirroredPairs(light, mirrored, dx, dy, usable)
+
+
+def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.Tensor | None:
+    """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): the dark room's linear gradient
+    about the spot's centre ``c``, read from a capture alone; None where too few pixels read it.
+
+    A laser's beam, bloom and glare are even under the point reflection ``p -> 2c - p`` about the spot (an
+    elliptical beam too), a room's linear gradient is odd: ``L(p) - L(2c - p) = 2 g . (p - c)`` over pixels whose
+    mirror lies in the frame, beyond ``GRADIENT_MIN_RADIUS_SHARE`` of the largest mirrored distance, neither
+    saturated. The mirror is sampled bilinearly, and an error ``e`` in the spot's centre, which moves the even light
+    by ``e . grad L`` and so reads as odd, is fitted beside ``g`` (per channel, its regressors the even light's
+    gradient). The room's light comes from its sources through one fall-off in every channel, so ``g`` is each
+    channel's level times one relative gradient, and each channel's odd light is weighed against the light it holds
+    there: where the laser's glare is bright, its small asymmetries (demosaicing, the mirror's interpolation)
+    outweigh the room's slope, which the fainter channels then read (per channel and unweighted, camsim's glare case
+    read the laser channel's gradient worse than one level on two draws of five, docs/bench/session96.md). The
+    room's even part (a lens's fall-off) cannot be told from the glare and stays in the level."""
+    pairs = mirrored_pairs(capture, centre)
+    if pairs is None:
+        return None
+    light, mirrored, dx, dy, use = pairs
+    count = int(use.sum())
     even = 0.5 * (light + mirrored)
     grad_y, grad_x = torch.gradient(even, dim=(1, 2))
     _, far = dark_region(capture, centre)

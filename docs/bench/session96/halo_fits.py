@@ -18,11 +18,15 @@ from lerobot_phantom.calibration.frame_models.common import load_pairs
 from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
 
 
-def main() -> None:
-    folder, seed = Path(sys.argv[1]), int(sys.argv[2])
+def case_problem(folder: Path, seed: int) -> tuple[BlindingFrames, np.ndarray, np.ndarray]:
+    """A case's pairs as the CLI reads them, and its fit and held-out items under split seed ``seed``."""
     defaults = CalibrateConfig()
     problem = BlindingFrames(load_pairs(folder, max_side=defaults.max_side), seed)
-    fit_items, held = seeded_split(problem.n_items, defaults.heldout, seed)
+    return problem, *seeded_split(problem.n_items, defaults.heldout, seed)
+
+
+def main() -> None:
+    problem, fit_items, held = case_problem(Path(sys.argv[1]), int(sys.argv[2]))
     for group in sys.argv[3:]:
         effects = frozenset(group.split("+"))
         fit = problem.fit(effects, fit_items)

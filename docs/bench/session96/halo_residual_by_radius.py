@@ -13,19 +13,15 @@ from pathlib import Path
 
 import numpy as np
 
-from lerobot_phantom.calibration.cli import CalibrateConfig
-from lerobot_phantom.calibration.core import seeded_split
-from lerobot_phantom.calibration.frame_models.common import load_pairs
-from lerobot_phantom.calibration.frame_models.laser_blinding import BlindingFrames
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from halo_fits import case_problem
 
 EDGES_REF_PX = (0, 20, 40, 60, 80, 100, 120, 150, 200, 400)
 
 
 def main() -> None:
-    folder, seed = Path(sys.argv[1]), int(sys.argv[2])
-    defaults = CalibrateConfig()
-    problem = BlindingFrames(load_pairs(folder, max_side=defaults.max_side), seed)
-    fit_items, _ = seeded_split(problem.n_items, defaults.heldout, seed)
+    problem, fit_items, _ = case_problem(Path(sys.argv[1]), int(sys.argv[2]))
     for group in sys.argv[3:]:
         fit = problem.fit(frozenset(group.split("+")), fit_items)
         residual, radius, unmeasured = [], [], []

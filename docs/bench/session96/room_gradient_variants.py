@@ -17,11 +17,9 @@ from pathlib import Path
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 from PIL import Image
 
 from lerobot_phantom.transforms import capture as C
-from lerobot_phantom.transforms.physics import srgb_to_linear
 
 
 def load(path: Path) -> torch.Tensor:
@@ -29,23 +27,7 @@ def load(path: Path) -> torch.Tensor:
 
 
 def per_channel(capture: torch.Tensor, centre: tuple[float, float], weighed: bool) -> torch.Tensor:
-    light = srgb_to_linear(capture)
-    _, height, width = light.shape
-    ys, xs = torch.meshgrid(
-        torch.arange(height, dtype=torch.float64), torch.arange(width, dtype=torch.float64), indexing="ij"
-    )
-    dx, dy = xs - centre[0], ys - centre[1]
-    mirror_x, mirror_y = centre[0] - dx, centre[1] - dy
-    grid = torch.stack([2 * mirror_x / (width - 1) - 1, 2 * mirror_y / (height - 1) - 1], dim=-1)[None]
-    saturated = (capture >= C.SATURATED).any(0)
-    mirrored, saturated_mirror = (
-        F.grid_sample(image[None], grid, mode="bilinear", padding_mode="border", align_corners=True)[0]
-        for image in (light, saturated[None].double())
-    )
-    inside = (mirror_x >= 0) & (mirror_x <= width - 1) & (mirror_y >= 0) & (mirror_y <= height - 1)
-    radius = torch.hypot(dx, dy)
-    use = inside & ~saturated & (saturated_mirror[0] == 0)
-    use &= radius >= C.GRADIENT_MIN_RADIUS_SHARE * float(radius[inside].max())
+    light, mirrored, dx, dy, use = C.mirrored_pairs(capture, centre)
     even = 0.5 * (light + mirrored)
     grad_y, grad_x = torch.gradient(even, dim=(1, 2))
     _, far = C.dark_region(capture, centre)
