@@ -225,18 +225,22 @@ def metered_exposure(total: torch.Tensor, scene: torch.Tensor, steps: int = 12) 
     frame as it read the clean one, ``mean(min(k total, 1)) = mean(min(scene, 1))``, over the pixels of ``(n, P)``
     light (a channel's mean per pixel). The reading is concave and piecewise linear in ``k``: Newton steps from
     ``k = 1`` (differentiable through the iterations) until they move ``k`` by rounding only, at most ``steps``;
-    ``k`` kept in [1e-4, 10]."""
+    ``k`` kept in [1e-4, 10]. Each frame stops at its own last step, so its ``k`` does not depend on the frames
+    metered beside it: stopped together, a frame took the steps another needed, its last bits moved by rounding, and
+    a calibration's fit moved when only held-out frames changed (``test_heldout_invariance.py``, session 96)."""
     target = scene.clamp(max=1.0).mean(1)
     k = torch.ones(len(total), dtype=total.dtype, device=total.device)
+    settled = torch.zeros(len(total), dtype=torch.bool, device=total.device)
     for _ in range(steps):
         lit = (k[:, None] * total < 1.0).to(total.dtype)
         reading = torch.minimum(k[:, None] * total, torch.ones_like(total)).mean(1)
         slope = (total * lit).mean(1).clamp(min=1e-9)
         stepped = (k - (reading - target) / slope).clamp(1e-4, 10.0)
         # on a linear piece Newton lands on the root: later steps move it by rounding only
-        settled = bool(((stepped - k).abs() <= 8 * torch.finfo(k.dtype).eps * k).all())
-        k = stepped
-        if settled:
+        moved_by_rounding = (stepped - k).abs() <= 8 * torch.finfo(k.dtype).eps * k
+        k = torch.where(settled, k, stepped)
+        settled = settled | moved_by_rounding
+        if bool(settled.all()):
             break
     return k
 
