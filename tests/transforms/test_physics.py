@@ -696,3 +696,20 @@ def test_a_shoulder_exponent_without_a_shoulder_is_refused():
         physics.tone_options(2.2, None, 2.0, owner="attack")
     assert physics.tone_options(2.2, None, 1.0, owner="attack") == 2.2
     assert physics.tone_options(None, 3.0, 0.5, owner="attack") == physics.ShoulderCurve(3.0, 0.5, 1.0)
+
+
+def test_a_frame_meters_alike_alone_and_beside_frames_that_need_more_steps():
+    """Each frame's Newton steps stop at its own last step: a faint light (one linear piece, settled at once) metered
+    beside a clipping laser (several steps) keeps the bits it has alone. Stopped together (until session 96), it took
+    the laser frame's steps and moved by rounding (2.2e-16 on this draw), and a calibration's fit moved when only
+    held-out frames changed."""
+    g = torch.Generator().manual_seed(3)
+    for _ in range(2):  # the second draw is the one whose rounding moved
+        scene = torch.rand(2, 256, generator=g, dtype=torch.float64) * 0.6
+        total = scene.clone()
+        total[1, :40] += torch.rand(40, generator=g, dtype=torch.float64) * 30
+        total[0] += 0.05 * torch.rand(256, generator=g, dtype=torch.float64)
+    alone = physics.metered_exposure(total[:1], scene[:1])
+    beside = physics.metered_exposure(total, scene)
+    assert torch.equal(alone[0], beside[0])
+    assert beside[1] < 0.9 * beside[0]  # the laser frame is exposed down, over more steps
