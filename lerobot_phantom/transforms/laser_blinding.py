@@ -76,6 +76,7 @@ from lerobot_phantom.transforms.intensity import IntensitySpec, RandomParameter,
 from lerobot_phantom.transforms.patterns import (
     LASER_COLORS,
     check_levels,
+    exact_float64,
     laser_glare,
     laser_spot,
     load_pattern_image,
@@ -401,7 +402,7 @@ class LaserBlinding(CameraAttack):
         # under raw_colour a capture is read in its laser channel alone: the one holding most of its light
         self._laser_channel = None
         if model == "physical" and self._user_pattern is not None and self.physics.raw_colour is not None:
-            self._laser_channel = int(capture_colour(self._user_pattern.double()).argmax())
+            self._laser_channel = int(capture_colour(exact_float64(self._user_pattern)).argmax())
             if self.physics.raw_colour[self._laser_channel] != 1.0:
                 raise ValueError(
                     f"raw_colour {self.physics.raw_colour} is the laser's light over its own channel's, which must "
@@ -464,9 +465,11 @@ class LaserBlinding(CameraAttack):
 
         def make() -> CaptureLight:
             p = self.physics
-            capture = self._resized_user_pattern(height, width, torch.device("cpu")).double()
+            capture = exact_float64(self._resized_user_pattern(height, width, torch.device("cpu")))
             dark_frame = (
-                None if self._user_dark is None else resize_pattern(self._user_dark, height, width).double()
+                None
+                if self._user_dark is None
+                else exact_float64(resize_pattern(self._user_dark, height, width))
             )
             reading = read_capture(capture, dark_frame)
             beam, dark = physics.decode(reading.beam, p.tone), physics.decode(reading.dark, p.tone)

@@ -252,6 +252,16 @@ def resize_pattern(pattern: torch.Tensor, height: int, width: int) -> torch.Tens
     return out.clamp_(0.0, 1.0).to(pattern.dtype)
 
 
+def exact_float64(pattern: torch.Tensor) -> torch.Tensor:
+    """A pattern in float64 with its values on the 8-bit grid exactly ``k / 255``, as the calibration reads an 8-bit
+    image (``frame_models.common.load_rgb``). float32's ``k / 255`` widened differs in its last bits, and a capture's
+    reading thresholds them (its spot's centre, and the room's gradient read about it: a pixel's flip moved the
+    centre 0.14 px, session 96). Values off the grid are widened as they are."""
+    wide = pattern.double()
+    levels = (wide * 255.0).round()
+    return torch.where((wide * 255.0 - levels).abs() < 1e-3, levels / 255.0, wide)
+
+
 def fit_size(pattern_height: int, pattern_width: int, box: int) -> tuple[int, int]:
     """Size of a pattern scaled so its longer side is ``box`` pixels, aspect kept, at least 1x1."""
     scale = box / max(pattern_height, pattern_width)

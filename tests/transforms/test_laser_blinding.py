@@ -16,8 +16,10 @@ from lerobot_phantom.transforms.laser_blinding import (
 )
 from lerobot_phantom.transforms.patterns import (
     LASER_COLORS,
+    exact_float64,
     laser_glare,
     laser_spot,
+    load_pattern_image,
     parse_color,
     resize_pattern,
 )
@@ -284,6 +286,21 @@ def test_resize_pattern_is_pil_lanczos():
     assert np.array_equal(_hwc(torch.round(as_float * 255).to(torch.uint8)), expected)
     smooth = torch.rand(3, 9, 13, generator=torch.Generator().manual_seed(1))  # off the 8-bit grid
     assert resize_pattern(smooth, 20, 31).shape == (3, 20, 31)
+
+
+def test_a_loaded_capture_widens_to_the_calibrations_float64_values_bit_for_bit(tmp_path):
+    # the attack reads a capture as the fit reads it (read_capture's thresholds see the last bits: session 97)
+    from PIL import Image
+
+    from lerobot_phantom.calibration.frame_models.common import load_rgb
+
+    Image.fromarray(_random_uint8((9, 13, 3), seed=7).numpy()).save(tmp_path / "capture.png")
+    loaded = load_pattern_image(tmp_path / "capture.png", keep_alpha=False)
+    calibration_reads = load_rgb(tmp_path / "capture.png")
+    assert not torch.equal(loaded.double(), calibration_reads)
+    assert torch.equal(exact_float64(loaded), calibration_reads)
+    off_grid = torch.tensor([0.3, 0.5 / 255], dtype=torch.float32)
+    assert torch.equal(exact_float64(off_grid), off_grid.double())
 
 
 def test_exposure_spread_scales_each_samples_laser_power_by_a_lognormal_factor():
