@@ -43,8 +43,11 @@ from lerobot_phantom.calibration.core import (
 )
 from lerobot_phantom.calibration.structure import NeighbourPairs, ResidualSample
 from lerobot_phantom.calibration.tone import (
+    CORRECTION_NULLS,
+    CORRECTION_PARAMS,
     GAMMA_PARAM,
     SHOULDER_PARAMS,
+    correction_matrix,
     implied_gamma_statistic,
     shoulder_curve,
     shoulder_kwargs,
@@ -110,7 +113,17 @@ LIGHT_SPREAD = Effect(
     "the clean frame",
     requires=("additive_light",),
 )
-FRAME_EFFECTS = (*EFFECTS, LIGHT_SPREAD)
+# frame pairs only, as measured (docs/bench/session97.md): a colour-triple table could show a matrix too
+COLOUR_CORRECTION = Effect(
+    "colour_correction",
+    "the camera's ISP mixes its raw channels with a colour correction matrix after the sensor: the projected light "
+    "meets the surface's reflectance and the sensor's clip in the raw channels, and the matrix (negative "
+    "off-diagonals) then mixes them, so a clipped or strongly coloured addition takes light out of the other "
+    "stored channels. Where light only adds, the matrix is a change of basis the cross-talk absorbs: it shows "
+    "through the reflectance's product and the clip",
+    requires=("additive_light",),
+)
+FRAME_EFFECTS = (*EFFECTS, LIGHT_SPREAD, COLOUR_CORRECTION)
 # the widest spread a fit considers, standard deviation in pixels at the 256-pixel reference (3% of the frame's
 # longer side): wider than defocus and lens blur that leave a pattern recognisable, and the fit's kernel grows with it
 SPREAD_HIGH_REF_PX = 8.0
@@ -179,6 +192,8 @@ def projection_specs(effects: frozenset[str], pattern_record: str) -> list[Param
         specs += list(SHOULDER_PARAMS)
     if "light_spread" in effects:
         specs.append(Param("spread_ref_px", 2.0, 0.0, SPREAD_HIGH_REF_PX, scale=1.0))
+    if "colour_correction" in effects:
+        specs += list(CORRECTION_PARAMS)
     return specs
 
 
@@ -190,6 +205,8 @@ def projection_nulls(effect: str) -> dict[str, float]:
         return {"white": 1.0}
     if effect == "light_spread":
         return {"spread_ref_px": 0.0}
+    if effect == "colour_correction":
+        return dict(CORRECTION_NULLS)
     return tone_nulls(effect)
 
 
@@ -230,6 +247,12 @@ def projection_predict(
     decode, encode = tone_curve(effects, params)
     surface_lin = decode(surface) if surface_light is None else surface_light
     light = projected_decode(effects, params)(projected) if projected_light is None else projected_light
+    correction = correction_matrix(params) if "colour_correction" in effects else None
+    if correction is not None:  # to the raw channels, where the light meets the reflectance and the clip
+        to_raw = torch.linalg.inv(correction).T.to(surface_lin.dtype)
+        surface_lin = surface_lin @ to_raw
+        if "projector_gamma" not in params:  # a captured pattern is this camera's stored light
+            light = light @ to_raw
     if "channel_crosstalk" in effects:
         matrix = torch.stack(
             [torch.as_tensor(params[n], dtype=surface.dtype) for n in CROSSTALK_NAMES]
@@ -245,6 +268,8 @@ def projection_predict(
         total = (1.0 - opacity) * surface_lin + opacity * light
     if "clipping" in effects:
         total = torch.minimum(total, torch.as_tensor(params["white"], dtype=total.dtype))
+    if correction is not None:
+        total = (total.clamp(min=0.0) @ correction.T.to(total.dtype)).clamp(0.0, 1.0)
     return encode(total).clamp(0.0, 1.0)
 
 
@@ -294,6 +319,8 @@ def projection_kwargs(fit: Fit) -> dict:
         kwargs["white"] = p["white"]
     if "light_spread" in effects:
         kwargs["spread"] = p["spread_ref_px"]
+    if "colour_correction" in effects:
+        kwargs["colour_correction"] = correction_matrix(p).reshape(-1).tolist()
     return kwargs
 
 

@@ -44,6 +44,33 @@ SHOULDER_PARAMS = (
 # wants less bends something other than a tone curve (camsim's white balance answering a projected cast fitted
 # 0.657, docs/bench/session83.md). 4 is beyond any encoding in use
 GAMMA_PARAM = Param("gamma", 2.2, 1.0, 4.0, scale=1.0)
+
+# A camera's ISP mixes its raw channels with a colour correction matrix after the sensor (consumer cameras' undo their
+# colour filters' overlap: negative off-diagonals, rows summing to 1). One parameter per raw channel, ``ccm_<channel>``:
+# that channel's light taken out of each of the other two (``physics.correction_matrix``); with the six off-diagonals
+# free, a laser blinding calibration ran one to its bound and withdrew the term (docs/bench/session69/)
+CHANNELS = ("red", "green", "blue")
+CORRECTION_PARAMS = tuple(
+    Param(
+        f"ccm_{c}",
+        0.1,
+        0.0,
+        1.0,
+        scale=0.1,
+        low_limit=f"the matrix takes none of the {c} channel's light out of the others",
+    )
+    for c in CHANNELS
+)
+CORRECTION_NULLS = {f"ccm_{c}": 0.0 for c in CHANNELS}
+
+
+def correction_matrix(params: dict) -> torch.Tensor:
+    """(3, 3) colour correction matrix of the takes ``params`` holds (``CORRECTION_PARAMS``)."""
+    return physics.correction_matrix(
+        torch.stack([torch.as_tensor(params[f"ccm_{c}"], dtype=torch.float64) for c in CHANNELS])
+    )
+
+
 # every parameter a fitted tone curve may have: ``sensor_gamma``'s power and the shoulder's two
 TONE_PARAMS = ("gamma", *(p.name for p in SHOULDER_PARAMS))
 

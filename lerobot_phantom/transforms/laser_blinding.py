@@ -177,16 +177,11 @@ class LaserPhysics:
             )
         tone = physics.tone_options(self.gamma, self.shoulder, self.shoulder_exponent, owner="LaserBlinding")
         object.__setattr__(self, "_tone", tone)
-        if self.colour_correction is not None:
-            matrix = torch.tensor(self.colour_correction, dtype=torch.float64)
-            if matrix.numel() != 9 or not torch.allclose(
-                matrix.reshape(3, 3).sum(1), torch.ones(3, dtype=torch.float64), atol=1e-6
-            ):
-                raise ValueError(
-                    f"colour_correction {self.colour_correction}; valid: None or 9 numbers, a row-major 3x3 matrix "
-                    "whose rows sum to 1"
-                )
-            object.__setattr__(self, "colour_correction", tuple(float(v) for v in self.colour_correction))
+        object.__setattr__(
+            self,
+            "colour_correction",
+            physics.check_colour_correction(self.colour_correction, "LaserBlinding"),
+        )
         if self.raw_colour is not None:
             colour = tuple(float(v) for v in self.raw_colour)
             if self.colour_correction is None or len(colour) != 3 or min(colour) < 0 or max(colour) != 1.0:

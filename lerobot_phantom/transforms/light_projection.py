@@ -171,6 +171,7 @@ class LightProjection(CameraAttack):
         shoulder_exponent: float = 1.0,
         projector_gamma: float | None = None,
         spread: float = 0.0,
+        colour_correction: Sequence[float] | None = None,
         seed: int | None = None,
         generator: torch.Generator | None = None,
     ) -> None:
@@ -179,7 +180,9 @@ class LightProjection(CameraAttack):
         # model="additive"/"blend" (lerobot-phantom-calibrate): projector light at strength x intensity through
         # physics.project_light (albedo, 3x3 cross-talk, white level, tone curve -- a power law or one with a
         # highlight shoulder, physics.ShoulderCurve --, the projector's own display transfer, spread over ``spread``
-        # pixels at the 256-pixel reference, scaled by max(H, W) / 256)
+        # pixels at the 256-pixel reference, scaled by max(H, W) / 256; with ``colour_correction``, 9 numbers whose
+        # rows sum to 1, the light meets the reflectance and the clip in the camera's raw channels, which that matrix
+        # then mixes)
         if model not in ("paper", "additive", "blend"):
             raise ValueError(f"unknown light projection model {model!r}; valid: 'paper', 'additive', 'blend'")
         if spread < 0.0 or (spread > 0.0 and model == "paper"):
@@ -198,6 +201,12 @@ class LightProjection(CameraAttack):
                 f"shoulder={shoulder!r} bends the tone curve the physical models (model='additive' or 'blend') "
                 "compose light in; the paper's watermark blends the encoded values"
             )
+        correction = physics.check_colour_correction(colour_correction, "LightProjection")
+        if correction is not None and model != "additive":
+            raise ValueError(
+                f"colour_correction mixes the raw channels the projected light adds in: model='additive', not "
+                f"{model!r}"
+            )
         # kept as fitted: the light model casts it to each image's dtype
         matrix = None if crosstalk is None else torch.tensor(crosstalk, dtype=torch.float64)
         if matrix is not None and matrix.shape != (3, 3):
@@ -214,6 +223,9 @@ class LightProjection(CameraAttack):
             ),
             "projector_gamma": None if projector_gamma is None else float(projector_gamma),
             "spread": float(spread),
+            "colour_correction": None
+            if correction is None
+            else torch.tensor(correction, dtype=torch.float64),
         }
         if size is None or size == "native":
             size = None
@@ -315,6 +327,9 @@ class LightProjection(CameraAttack):
             projector_gamma=p["projector_gamma"],
             spread_px=p["spread"] * max(x.shape[-2:]) / REFERENCE_SIZE,
             blend=self.model == "blend",
+            colour_correction=None
+            if p["colour_correction"] is None
+            else p["colour_correction"].reshape(3, 3),
         )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:

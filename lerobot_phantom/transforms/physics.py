@@ -256,6 +256,29 @@ def raw_light_per_stored(
     return raw_colour / stored_share.clamp(min=1e-6)
 
 
+def correction_matrix(takes: torch.Tensor) -> torch.Tensor:
+    """(3, 3) colour correction matrix from ``takes`` (3,): raw channel j's light taken out of each other channel by
+    ``takes[j]``, each row summing to 1 (white stays white). Consumer cameras' matrices undo their colour filters'
+    overlap: a diagonal above 1, negative off-diagonals."""
+    takes = takes.to(torch.float64)
+    return torch.diag(takes.sum() - takes + 1.0) - (1.0 - torch.eye(3, dtype=torch.float64)) * takes
+
+
+def check_colour_correction(values, owner: str) -> tuple[float, ...] | None:
+    """``values`` as a colour correction matrix (9 numbers, row-major, each row summing to 1), or None."""
+    if values is None:
+        return None
+    matrix = torch.tensor(values, dtype=torch.float64)
+    if matrix.numel() != 9 or not torch.allclose(
+        matrix.reshape(3, 3).sum(1), torch.ones(3, dtype=torch.float64), atol=1e-6
+    ):
+        raise ValueError(
+            f"{owner}: colour_correction {values}; valid: None or 9 numbers, a row-major 3x3 matrix whose rows "
+            "sum to 1"
+        )
+    return tuple(float(v) for v in matrix.reshape(-1))
+
+
 def mix_channels(matrix: torch.Tensor, image: torch.Tensor) -> torch.Tensor:
     """``matrix`` (3, 3) applied to every pixel of a ``(..., 3, H, W)`` image, in the image's dtype."""
     return torch.einsum("ij,...jhw->...ihw", matrix.to(image.dtype), image)
@@ -368,6 +391,7 @@ def project_light(
     projector_gamma: float | torch.Tensor | None = None,
     spread_px: float | torch.Tensor = 0.0,
     blend: bool = False,
+    colour_correction: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Projector light on a surface seen by a camera: light adds, it never blends (``blend=True`` keeps the
     paper's blend, ``(1 - strength) * scene + strength * light``, with the other terms).
@@ -379,10 +403,18 @@ def project_light(
     (``scene + reflectance_floor``). The sum clips at ``white`` and is re-encoded; ``gamma`` as in ``decode``
     (1 = compose the encoded values). ``projector_gamma``: the pattern is the frame the projector is sent, turned
     into light by the projector's display transfer ``pattern ** projector_gamma``; None: the pattern is decoded
-    like the scene, a capture of the projected light through this camera.
+    like the scene, a capture of the projected light through this camera. ``colour_correction``: a (3, 3) matrix
+    the camera mixes its raw channels with after the sensor: the light meets the surface's reflectance and the clip
+    in the raw channels (the scene, and a captured pattern, taken there by the matrix's inverse; ``crosstalk`` is
+    then the camera's raw response to the primaries), and the matrix mixes the sum before the tone curve.
     """
     scene = decode(x, gamma)
     light = decode(pattern, gamma if projector_gamma is None else projector_gamma)
+    if colour_correction is not None:
+        to_raw = torch.linalg.inv(colour_correction.to(torch.float64))
+        scene = mix_channels(to_raw, scene)
+        if projector_gamma is None:
+            light = mix_channels(to_raw, light)
     if isinstance(spread_px, torch.Tensor) or spread_px > 0.0:
         light = gaussian_spread(light, spread_px)
     if crosstalk is not None:
@@ -391,11 +423,14 @@ def project_light(
         )
     light = _as(strength, light) * light
     if albedo:
-        light = light * (scene + _as(reflectance_floor, scene))
+        # a negative floor (the clean frame's veiling glare) returns no light below 0, as the calibration fits it
+        light = light * (scene + _as(reflectance_floor, scene)).clamp(min=0.0)
     if blend:
         scene = (1.0 - _as(strength, scene)) * scene
-    total = torch.minimum(scene + light, _as(white, scene))
-    return encode(total.clamp(min=0.0), gamma)
+    total = torch.minimum(scene + light, _as(white, scene)).clamp(min=0.0)
+    if colour_correction is not None:
+        total = mix_channels(colour_correction.to(torch.float64), total).clamp(0.0, 1.0)
+    return encode(total, gamma)
 
 
 def laser_injection(

@@ -539,15 +539,12 @@ def run_case(name: str, root: str, seed: int | None = None) -> dict:
 def tolerated(case: Case, camera: cs.Camera) -> frozenset:
     """The effects a case may name besides its planted ones: the case's own, the tone curve's shoulder when the
     camera's curve has one and the case composes light in linear irradiance (the same cases as sensor_gamma), and
-    a colour correction where the camera has one and a laser's light adds in its raw channels."""
+    a colour correction where the camera has one and a laser's or a projector's light adds in its raw channels."""
     allowed = case.tolerated
     if camera.tone in SHOULDERED_TONES and "sensor_gamma" in case.tolerated:
         allowed = allowed | {"tone_shoulder"}
-    if (
-        camera.ccm is not None
-        and case.attack == "laser_blinding"
-        and "linear_light_saturation" in case.planted
-    ):
+    adds_raw_light = {"linear_light_saturation", "additive_light"} & case.planted
+    if camera.ccm is not None and case.attack in ("laser_blinding", "light_projection") and adds_raw_light:
         allowed = allowed | {"colour_correction"}
     return allowed
 

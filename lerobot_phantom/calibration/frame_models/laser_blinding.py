@@ -128,9 +128,13 @@ from lerobot_phantom.calibration.frame_models.common import (
     parameter_values,
 )
 from lerobot_phantom.calibration.tone import (
+    CHANNELS,
+    CORRECTION_NULLS,
+    CORRECTION_PARAMS,
     GAMMA_PARAM,
     SHOULDER_PARAMS,
     TONE_PARAMS,
+    correction_matrix,
     decode_encode,
     shoulder_kwargs,
 )
@@ -221,16 +225,6 @@ LIT_STORED = 128 / 255
 UNCLIPPED_STORED = 250 / 255
 STORED_AT_ZERO = 2.5 / 255
 MIN_MIXED_SHARE = 0.05
-
-
-CHANNELS = ("red", "green", "blue")
-
-
-def correction_matrix(params: dict) -> torch.Tensor:
-    """(3, 3) colour correction matrix: channel j's raw light taken out of each other channel by ``ccm_<j>``, each
-    row summing to 1 (white stays white)."""
-    take = torch.stack([torch.as_tensor(params[f"ccm_{c}"], dtype=torch.float64) for c in CHANNELS])
-    return torch.diag(take.sum() - take + 1.0) - (1.0 - torch.eye(3, dtype=torch.float64)) * take
 
 
 def faint_channels_at_zero(pattern: torch.Tensor, channel: int) -> tuple[int, int]:
@@ -420,17 +414,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
         if "tone_shoulder" in effects:
             specs += list(SHOULDER_PARAMS)
         if "colour_correction" in effects:
-            specs += [
-                Param(
-                    f"ccm_{c}",
-                    0.1,
-                    0.0,
-                    1.0,
-                    scale=0.1,
-                    low_limit=f"the matrix takes none of the {c} channel's light out of the others",
-                )
-                for c in CHANNELS
-            ]
+            specs += list(CORRECTION_PARAMS)
             # the laser's raw light in each other channel over its own: the capture stores none of it (the matrix
             # pushed those channels below 0), so it is fitted; a narrowband laser holds a few to tens of percent
             specs += [
@@ -471,7 +455,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "halo_power_law": {"halo_level": 0.0},
             "auto_exposure": {"auto_exposure": 0.0},
             "frame_exposure": {"exposure_spread": 0.0},
-            "colour_correction": {f"ccm_{c}": 0.0 for c in CHANNELS},
+            "colour_correction": CORRECTION_NULLS,
         }.get(effect, {})
 
     @staticmethod

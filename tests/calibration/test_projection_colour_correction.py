@@ -1,0 +1,113 @@
+"""Light projection on a camera whose ISP mixes its raw channels with a colour correction matrix (session 97): the
+frame model composes the projected light in the raw channels (``projection_predict``), the attack does the same
+(``physics.project_light``), and the matrix only shows where the light composes other than by adding."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import torch
+
+from lerobot_phantom.calibration.core import Fit
+from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
+from lerobot_phantom.calibration.projection import (
+    EFFECTS,
+    projection_kwargs,
+    projection_nulls,
+    projection_predict,
+)
+from lerobot_phantom.calibration.tone import correction_matrix
+from lerobot_phantom.transforms import physics
+from lerobot_phantom.transforms.light_projection import LightProjection
+
+TAKES = {"ccm_red": 0.35, "ccm_green": 0.2, "ccm_blue": 0.25}
+RAW_CROSSTALK = {f"crosstalk_{i}{j}": (0.8 if i == j else 0.15) for i in range(3) for j in range(3)}
+
+
+def colours(n: int, seed: int) -> tuple[torch.Tensor, torch.Tensor, torch.Tensor]:
+    rng = np.random.default_rng(seed)
+    surface, projected = (torch.from_numpy(rng.uniform(0, 1, (n, 3))) for _ in range(2))
+    return surface, projected, torch.ones(n, 1, dtype=torch.float64)
+
+
+def attack_light(options: dict, surface: torch.Tensor, projected: torch.Tensor) -> torch.Tensor:
+    light = LightProjection(**options).project(
+        surface.T.reshape(1, 3, -1, 1), projected.T.reshape(1, 3, -1, 1), torch.ones(1, dtype=torch.float64)
+    )
+    return light.reshape(3, -1).T
+
+
+@pytest.mark.parametrize("emitted", [True, False])
+def test_the_attack_composes_light_in_the_fitted_raw_channels_as_the_fit_does(emitted):
+    """calibrated.json hands ``LightProjection`` the fitted matrix: its light reproduces the fit's prediction to
+    rounding, with the reflectance, the clip, the cross-talk and a gamma, for a pattern the projector was sent and
+    for one this camera captured (its stored light taken back to raw too); without the matrix it misses."""
+    params = {"gamma": 2.2, "reflectance_floor": 0.02, "white": 0.8, **RAW_CROSSTALK, **TAKES}
+    if emitted:
+        params["projector_gamma"] = 2.0
+    effects = frozenset(
+        {
+            "additive_light",
+            "albedo_modulation",
+            "channel_crosstalk",
+            "clipping",
+            "sensor_gamma",
+            "colour_correction",
+        }
+    )
+    surface, projected, strength = colours(400, seed=11)
+    predicted = projection_predict(surface, projected, strength, effects, params)
+    kwargs = projection_kwargs(Fit(effects, params))
+    assert np.allclose(np.reshape(kwargs["colour_correction"], (3, 3)), correction_matrix(params).numpy())
+    assert torch.allclose(attack_light(kwargs, surface, projected), predicted, atol=1e-12)
+    unmixed = {k: v for k, v in kwargs.items() if k != "colour_correction"}
+    assert 255 * float((attack_light(unmixed, surface, projected) - predicted).abs().max()) > 20.0
+
+
+def test_where_light_only_adds_the_matrix_is_a_change_of_basis_the_cross_talk_absorbs():
+    """Without the reflectance's product or a clip, C (s_raw + M p) = s + (C M) p: the frames cannot tell the matrix
+    from the cross-talk, which is why the term is said to show only through those two (its Effect text)."""
+    effects = frozenset({"additive_light", "channel_crosstalk", "sensor_gamma"})
+    params = {"gamma": 2.2, "projector_gamma": 2.2, **RAW_CROSSTALK}
+    surface, projected, strength = colours(300, seed=5)
+    surface = 0.2 + 0.3 * surface  # the sum stays inside the stored range, where nothing clips
+    mixed = projection_predict(
+        surface, projected, strength, effects | {"colour_correction"}, {**params, **TAKES}
+    )
+    raw = torch.tensor(
+        [[RAW_CROSSTALK[f"crosstalk_{i}{j}"] for j in range(3)] for i in range(3)], dtype=torch.float64
+    )
+    stored = correction_matrix(TAKES) @ raw
+    absorbed = {**params, **{f"crosstalk_{i}{j}": float(stored[i, j]) for i in range(3) for j in range(3)}}
+    assert torch.allclose(
+        mixed, projection_predict(surface, projected, strength, effects, absorbed), atol=1e-12
+    )
+    with_reflectance = effects | {"albedo_modulation", "colour_correction"}
+    reflected = {**params, **TAKES, "reflectance_floor": 0.0}
+    absorbed_reflected = {**absorbed, "reflectance_floor": 0.0}
+    apart = projection_predict(
+        surface, projected, strength, with_reflectance, reflected
+    ) - projection_predict(
+        surface, projected, strength, with_reflectance - {"colour_correction"}, absorbed_reflected
+    )
+    assert 255 * float(apart.abs().max()) > 5.0
+
+
+def test_the_matrix_is_offered_to_frame_pairs_only_with_its_null_the_identity():
+    assert "colour_correction" in {e.name for e in ProjectionFrames.candidates}
+    assert "colour_correction" not in {e.name for e in EFFECTS}
+    assert torch.equal(
+        correction_matrix(projection_nulls("colour_correction")), torch.eye(3, dtype=torch.float64)
+    )
+    matrix = correction_matrix(TAKES)
+    assert torch.allclose(matrix.sum(1), torch.ones(3, dtype=torch.float64))
+    assert float(matrix[1, 0]) == -TAKES["ccm_red"] and float(matrix[0, 2]) == -TAKES["ccm_blue"]
+
+
+def test_a_colour_correction_that_is_not_a_matrix_whose_rows_sum_to_one_is_refused():
+    with pytest.raises(ValueError, match="rows sum to 1"):
+        LightProjection(model="additive", colour_correction=[1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 2.0])
+    with pytest.raises(ValueError, match="model='additive'"):
+        LightProjection(
+            model="blend", colour_correction=physics.correction_matrix(torch.zeros(3)).ravel().tolist()
+        )
