@@ -275,10 +275,15 @@ def projection_predict(
 
 def projection_warm(start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
     """Start values from a nested fit, mapped to the new model's parameters (a blend's opacity becomes the
-    additive strength; a scalar strength seeds the diagonal of a cross-talk matrix)."""
+    additive strength; a scalar strength seeds the diagonal of a cross-talk matrix; a new colour correction starts
+    as the identity, where the model is the nested fit: from the default takes a cross-talk fitted in the stored
+    channels no longer fitted, and camsim's clipping draw 400433080 scored 15.78 grey levels with the matrix against
+    11.83 without, docs/bench/session97.md)."""
     if start is None:
         return None
     warm = dict(start.params)
+    if "colour_correction" in effects and "colour_correction" not in start.effects:
+        warm.update(CORRECTION_NULLS)
     if "additive_light" in effects and "additive_light" not in start.effects:
         opacity = warm.pop("opacity")
         warm["strength"] = opacity
