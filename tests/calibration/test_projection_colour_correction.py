@@ -9,6 +9,7 @@ import pytest
 import torch
 
 from lerobot_phantom.calibration.core import Fit
+from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.projection import (
     EFFECTS,
@@ -111,3 +112,31 @@ def test_a_colour_correction_that_is_not_a_matrix_whose_rows_sum_to_one_is_refus
         LightProjection(
             model="blend", colour_correction=physics.correction_matrix(torch.zeros(3)).ravel().tolist()
         )
+
+
+def test_the_matrix_is_offered_only_where_added_light_took_a_channel_down():
+    """Light only adds: without a matrix no lit pixel loses light in a channel, and the term is not tried; where the
+    pairs show such a fall (a matrix's negative off-diagonal taking a lit raw channel's light out of another) it is."""
+    generator = torch.Generator().manual_seed(3)
+    clean = torch.rand(3, 24, 32, generator=generator, dtype=torch.float64).mul(200).round().div(255)
+    pattern = torch.zeros(3, 24, 32, dtype=torch.float64)
+    pattern[0, 6:18, 8:24] = 1.0  # a red rectangle
+    lit = pattern[0] > 0
+    added = clean.clone()
+    added[0][lit] = (added[0][lit] + 40 / 255).clamp(max=1.0)
+    mixed = added.clone()
+    mixed[1][lit] = (mixed[1][lit] - 20 / 255).clamp(
+        min=0.0
+    )  # green loses what red gained, as under a matrix
+
+    def frames(attacked: torch.Tensor) -> ProjectionFrames:
+        pairs = [
+            Pair(f"pair{k}", clean, attacked, pattern, 1.0, {"pattern_record": "emitted"}, (32, 24))
+            for k in range(4)
+        ]
+        return ProjectionFrames(pairs, seed=0)
+
+    items = np.arange(4)
+    reason = frames(added).unoffered(items)["colour_correction"]
+    assert reason.startswith("0 of the 768 pixels")
+    assert frames(mixed).unoffered(items) == {}
