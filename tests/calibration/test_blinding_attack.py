@@ -63,10 +63,10 @@ def test_the_attack_fed_the_cameras_capture_is_the_fitted_frame_model(tmp_path):
 
     attacks = [attacked(int(i)) for i in heldout]
     apart = torch.cat([(a - f).ravel() for a, f in zip(attacks, fitted, strict=True)])
-    # the same light to float32's rounding (1.3e-5 grey levels RMS, 5.8e-5 at most) since session 97, which reads the
-    # capture's 8-bit values exactly as the fit does (``patterns.exact_float64``): the float32 values widened had
-    # flipped a pixel at pattern_centre's threshold and moved the spot's centre by 0.14 px, which the room's gradient,
-    # read about that centre, followed (0.052 RMS and 5.75 at most in session 96; 0.022 and under 3 before it)
+    # the same light to float32's rounding since session 97 (1.2e-5 grey levels RMS, 4.9e-5 at most; float32's values
+    # widened 0.052 and 5.75: docs/bench/session97/blinding_parity_c2923f9.txt): the attack reads the capture's 8-bit
+    # values exactly as the fit does (``patterns.exact_float64``); widened, a pixel at pattern_centre's threshold
+    # flipped and moved the spot's centre by 0.14 px, which the room's gradient, read about that centre, followed
     assert 255 * float(apart.pow(2).mean().sqrt()) < 0.01 and 255 * float(apart.abs().max()) < 0.05
     assert heldout_rmse(attacks, targets) < 1.02 * heldout_rmse(fitted, targets)
     per_intensity = {"glare_amplitude": options["glare_amplitude"] * options["gain"]}
