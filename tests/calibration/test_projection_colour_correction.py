@@ -140,3 +140,17 @@ def test_the_matrix_is_offered_only_where_added_light_took_a_channel_down():
     reason = frames(added).unoffered(items)["colour_correction"]
     assert reason.startswith("0 of the 768 pixels")
     assert frames(mixed).unoffered(items) == {}
+
+
+def test_a_negative_reflectance_floor_returns_no_light_below_zero_in_the_attack_as_in_the_fit():
+    """A floor under 0 (the clean frame's veiling glare and black offset) leaves the darkest surfaces' reflectance
+    below 0; the fit returns no light there (clamped at 0) and so must the attack, or it darkens them."""
+    params = {"gamma": 2.2, "projector_gamma": 2.2, "strength": 2.0, "reflectance_floor": -0.05}
+    effects = frozenset({"additive_light", "albedo_modulation", "sensor_gamma"})
+    surface, projected, strength = colours(300, seed=7)
+    surface = 0.3 * surface  # dark: many channels decode under 0.05 of white
+    predicted = projection_predict(surface, projected, strength, effects, params)
+    assert bool((surface**2.2 < 0.05).any())
+    assert torch.allclose(
+        attack_light(projection_kwargs(Fit(effects, params)), surface, projected), predicted, atol=1e-12
+    )
