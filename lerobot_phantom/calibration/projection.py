@@ -276,9 +276,8 @@ def projection_predict(
 def projection_warm(start: Fit | None, effects: frozenset[str]) -> dict[str, float] | None:
     """Start values from a nested fit, mapped to the new model's parameters (a blend's opacity becomes the
     additive strength; a scalar strength seeds the diagonal of a cross-talk matrix; a new colour correction starts
-    as the identity, where the model is the nested fit: from the default takes a cross-talk fitted in the stored
-    channels no longer fitted, and camsim's clipping draw 400433080 scored 15.78 grey levels with the matrix against
-    11.83 without, docs/bench/session97.md)."""
+    as the identity, where the model is the nested fit, so the search starts at its optimum: from the default takes a
+    cross-talk fitted in the stored channels starts far from it)."""
     if start is None:
         return None
     warm = dict(start.params)
