@@ -45,10 +45,11 @@ SHOULDER_PARAMS = (
 # 0.657, docs/bench/session83.md). 4 is beyond any encoding in use
 GAMMA_PARAM = Param("gamma", 2.2, 1.0, 4.0, scale=1.0)
 
-# A camera's ISP mixes its raw channels with a colour correction matrix after the sensor (consumer cameras' undo their
-# colour filters' overlap: negative off-diagonals, rows summing to 1). One parameter per raw channel, ``ccm_<channel>``:
-# that channel's light taken out of each of the other two (``physics.correction_matrix``); with the six off-diagonals
-# free, a laser blinding calibration ran one to its bound and withdrew the term (docs/bench/session69/)
+# A camera's ISP mixes its raw channels with a colour correction matrix after the sensor (consumer cameras'
+# matrices undo their colour filters' overlap: negative off-diagonals, rows summing to 1). One parameter per raw
+# channel, ``ccm_<channel>``: that channel's light taken out of each of the other two (``physics.correction_matrix``);
+# with the six off-diagonals free, a laser blinding calibration ran one to its bound and withdrew the term
+# (docs/bench/session69/)
 CHANNELS = ("red", "green", "blue")
 CORRECTION_PARAMS = tuple(
     Param(

@@ -225,7 +225,7 @@ class LightProjection(CameraAttack):
             "spread": float(spread),
             "colour_correction": None
             if correction is None
-            else torch.tensor(correction, dtype=torch.float64),
+            else torch.tensor(correction, dtype=torch.float64).reshape(3, 3),
         }
         if size is None or size == "native":
             size = None
@@ -327,9 +327,7 @@ class LightProjection(CameraAttack):
             projector_gamma=p["projector_gamma"],
             spread_px=p["spread"] * max(x.shape[-2:]) / REFERENCE_SIZE,
             blend=self.model == "blend",
-            colour_correction=None
-            if p["colour_correction"] is None
-            else p["colour_correction"].reshape(3, 3),
+            colour_correction=p["colour_correction"],
         )
 
     def _apply_uint8(self, x: torch.Tensor, params: dict[str, torch.Tensor]) -> torch.Tensor:

@@ -16,6 +16,7 @@ from lerobot_phantom.calibration.projection import (
     projection_kwargs,
     projection_nulls,
     projection_predict,
+    projection_warm,
 )
 from lerobot_phantom.calibration.tone import correction_matrix
 from lerobot_phantom.transforms import physics
@@ -154,3 +155,25 @@ def test_a_negative_reflectance_floor_returns_no_light_below_zero_in_the_attack_
     assert torch.allclose(
         attack_light(projection_kwargs(Fit(effects, params)), surface, projected), predicted, atol=1e-12
     )
+
+
+def test_a_matrix_added_to_a_nested_fit_starts_where_the_model_is_that_fit():
+    """``projection_warm`` starts a new colour correction at the identity: the warm start predicts what the nested
+    fit predicts, so the search begins at its optimum (the default takes start elsewhere)."""
+    nested = Fit(
+        frozenset({"additive_light", "albedo_modulation", "channel_crosstalk", "clipping", "sensor_gamma"}),
+        {"gamma": 2.2, "projector_gamma": 2.0, "reflectance_floor": 0.02, "white": 0.8, **RAW_CROSSTALK},
+    )
+    extended = nested.effects | {"colour_correction"}
+    warm = projection_warm(nested, extended)
+    assert all(warm[name] == 0.0 for name in TAKES)
+    surface, projected, strength = colours(200, seed=9)
+    assert torch.equal(
+        projection_predict(surface, projected, strength, extended, warm),
+        projection_predict(surface, projected, strength, nested.effects, nested.params),
+    )
+    defaults = {**warm, **{name: 0.1 for name in TAKES}}
+    apart = projection_predict(surface, projected, strength, extended, defaults) - projection_predict(
+        surface, projected, strength, nested.effects, nested.params
+    )
+    assert 255 * float(apart.abs().max()) > 1.0

@@ -455,7 +455,7 @@ class BlindingFrames(LatentFrameProblem, PixelProblem):
             "halo_power_law": {"halo_level": 0.0},
             "auto_exposure": {"auto_exposure": 0.0},
             "frame_exposure": {"exposure_spread": 0.0},
-            "colour_correction": CORRECTION_NULLS,
+            "colour_correction": dict(CORRECTION_NULLS),
         }.get(effect, {})
 
     @staticmethod
