@@ -3,39 +3,21 @@ fit pairs, from the defaults), with the members a fold fit pins at a bound, and 
 held-out RMSE (grey levels), and the reflectance floor and the shoulder's knee exponent. Usage:
 ``CAMSIM_SEED=1 PYTHONPATH=.:tests/calibration:tests python docs/bench/session97/crosstalk_structures.py CASE_SEED
 SET...`` (a set: effect names joined by ``+``; CAMSIM_SEED only lets the test module import: the case seed is
-given)."""
+given). Since session 98 it runs ``session98/structures.py``, the same for any case, with this case (which prints a
+fitted gamma too)."""
 
 from __future__ import annotations
 
 import sys
-import tempfile
 from pathlib import Path
 
-import test_independent_sim as sim
-
-from lerobot_phantom.calibration import core
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "session98"))
+import structures
 
 
 def main() -> None:
-    seed, sets = int(sys.argv[1]), [frozenset(s.split("+")) for s in sys.argv[2:]]
-    with tempfile.TemporaryDirectory() as folder:
-        problem, fit_items, heldout = sim.drawn_split("projection_crosstalk", seed, Path(folder))
-        splits = core.selection_folds(fit_items, 4, seed % 2**31, 2500)
-        print(f"projection_crosstalk, case seed {seed}")
-        for effects in sets:
-            score, fold_fits, _ = core.cross_validated(problem, effects, splits, None)
-            pinned = core.pinned_members(problem, effects, effects, fold_fits)
-            fit = problem.fit(effects, fit_items)
-            shown = {
-                k: round(fit.params[k], 3)
-                for k in ("reflectance_floor", "shoulder_exponent")
-                if k in fit.params
-            }
-            print(
-                f"  {'+'.join(sorted(effects))}: cross-validated {score:.3f}, fit {problem.rmse(fit, fit_items):.3f}, "
-                f"held-out {problem.rmse(fit, heldout):.3f}; pinned {pinned or 'none'}; {shown}",
-                flush=True,
-            )
+    sys.argv[1:1] = ["projection_crosstalk"]
+    structures.main()
 
 
 if __name__ == "__main__":

@@ -1,6 +1,6 @@
 """One camsim case draw: effect sets scored as selection scores them (the 4 inner folds of the
 fit pairs, from the defaults), with the members a fold fit pins at a bound, and fitted on all fit pairs: fit and
-held-out RMSE (grey levels), and the reflectance floor and the shoulder's knee exponent. Usage:
+held-out RMSE (grey levels), and the reflectance floor, the shoulder's knee exponent and the gamma. Usage:
 ``[CAMSIM_CCM=1] CAMSIM_SEED=1 PYTHONPATH=.:tests/calibration:tests python docs/bench/session98/structures.py CASE
 CASE_SEED SET...`` (a set: effect names joined by ``+``; CAMSIM_SEED only lets the test module import: the case seed is
 given)."""
