@@ -1,12 +1,11 @@
-"""The dwell read on the frames' difference low-passed: per camsim blur case and master seed, the resonance
-(``sinusoidal_motion``) fitted on the calibration's fit pairs, then the dwell share read as the package reads it
-(``BlurFrames.dwell_share``) and again with each pair's residual (the clean frame blurred along the path, minus the
-attacked frame; ``BlurFrames.dwell_residuals`` per pair) smoothed by a Gaussian of ``SIGMAS`` pixels of the frame
-(``physics.gaussian_spread``, edges repeated; ``DWELL_SIGMAS``: a comma list, default 0.7,1,1.5) before it is
-squared: the clean frame carries the camera's demosaic and JPEG error at its finest scale, which the model blurs
-along with the scene, while the attacked frame's was made after the blur.
+"""The dwell read pixel by pixel and over a few smoothing scales: per camsim blur case and master seed, the
+resonance (``sinusoidal_motion``) fitted on the calibration's fit pairs, then ``BlurFrames.dwell_share`` with
+``DWELL_LOWPASS_PX`` set to 0 (``as read``: each pair's residual compared pixel by pixel, the package's read before
+d53b9b7) and to each of ``DWELL_SIGMAS`` (a comma list of pixels of the frame, default 0.7,1,1.5; 1 is the
+package's since d53b9b7): the clean frame carries the camera's demosaic and JPEG error at its finest scale, which
+the model blurs along with the scene, while the attacked frame's was made after the blur.
 
-Usage: ``PYTHONPATH=. python docs/bench/session98/dwell_lowpass.py CASE[,CASE...] SEED...``
+Usage: ``[DWELL_SIGMAS=...] PYTHONPATH=. python docs/bench/session98/dwell_lowpass.py CASE[,CASE...] SEED...``
 """
 
 from __future__ import annotations
@@ -16,31 +15,23 @@ import sys
 import tempfile
 from pathlib import Path
 
-import torch
-
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from camsim_case_cameras import case_draws
 
-from lerobot_phantom.calibration.frame_models.ultrasound_blur import fit_dwell_share
-from lerobot_phantom.transforms import physics
+from lerobot_phantom.calibration.frame_models import ultrasound_blur
 
 MODEL = frozenset({"sinusoidal_motion"})
 SIGMAS = tuple(float(v) for v in os.environ.get("DWELL_SIGMAS", "0.7,1,1.5").split(","))
 
 
-def lowpass_residuals(problem, items, params, sigma: float) -> torch.Tensor:
-    share = params["dwell_share"]
-    uniform = physics.blur_path_offsets("uniform", problem.taps, dtype=torch.float64)
-    arcsine = physics.blur_path_offsets("sinusoidal", problem.taps, dtype=torch.float64)
-    offsets = (1 - share) * uniform + share * arcsine
-    parts = []
-    for i in items:
-        pair = problem.pairs[int(i)]
-        difference = (
-            problem.path_blur(params, int(i), offsets, params["gamma"], shoulder=True) - pair.attacked
-        )
-        parts.append(physics.gaussian_spread(difference[None], sigma)[0].ravel())
-    return torch.cat(parts)
+def dwell_over(problem, fit, items, sigma: float) -> float:
+    """``problem.dwell_share`` with the residual smoothed over ``sigma`` pixels (0: pixel by pixel)."""
+    package = ultrasound_blur.DWELL_LOWPASS_PX
+    ultrasound_blur.DWELL_LOWPASS_PX = sigma
+    try:
+        return problem.dwell_share(fit, items)
+    finally:
+        ultrasound_blur.DWELL_LOWPASS_PX = package
 
 
 def main() -> None:
@@ -50,14 +41,8 @@ def main() -> None:
             with tempfile.TemporaryDirectory() as folder:
                 problem, items = sim.drawn_problem(name, case_seed, Path(folder))
                 fit = problem.fit(MODEL, items)
-                reads = [f"as read {problem.dwell_share(fit, items):.3f}"]
-                for sigma in SIGMAS:
-                    share = fit_dwell_share(
-                        problem.dwell_specs(),
-                        lambda p, s=sigma, pr=problem, it=items: lowpass_residuals(pr, it, p, s),
-                        problem.dwell_start(fit),
-                    )
-                    reads.append(f"low-passed {sigma:g} px {share:.3f}")
+                reads = [f"as read {dwell_over(problem, fit, items, 0.0):.3f}"]
+                reads += [f"low-passed {s:g} px {dwell_over(problem, fit, items, s):.3f}" for s in SIGMAS]
             print(f"{name} master {master} ({camera.tone}): dwell share {'; '.join(reads)}", flush=True)
 
 
