@@ -53,6 +53,7 @@ from lerobot_phantom.calibration.tone import (
     shoulder_kwargs,
     tone_nulls,
 )
+from lerobot_phantom.transforms.physics import captured_light_to_raw
 
 TRIPLE_COLUMNS = tuple(f"{k}_{c}" for k in ("origin", "addition", "outcome") for c in "rgb")
 
@@ -222,12 +223,18 @@ def tone_curve(effects, params: dict):
     return (lambda v: v), (lambda v: v)
 
 
-def projected_decode(effects, params: dict):
-    """Projected colour -> linear light: the projector's display transfer where the model has one (an emitted
-    pattern, ``PATTERN_RECORDS``), else the camera's own tone curve."""
+def projected_decode(effects, params: dict, channel_dim: int = -1):
+    """Projected colour -> the linear light it adds, in the channels it meets the surface in: the projector's
+    display transfer where the model has one (an emitted pattern, ``PATTERN_RECORDS``), else the camera's own tone
+    curve, and under ``colour_correction`` a captured pattern's light taken to the raw channels
+    (``physics.captured_light_to_raw``; ``channel_dim``: the colours' channel dimension)."""
     if "projector_gamma" in params:
         return lambda v: v.clamp(min=0) ** params["projector_gamma"]
-    return tone_curve(effects, params)[0]
+    decode = tone_curve(effects, params)[0]
+    if "colour_correction" not in effects:
+        return decode
+    correction = correction_matrix(params)
+    return lambda v: captured_light_to_raw(decode(v), v, correction, channel_dim=channel_dim)
 
 
 def projection_predict(
@@ -241,18 +248,15 @@ def projection_predict(
     projected_light: torch.Tensor | None = None,
 ) -> torch.Tensor:
     """Captured colour (N, 3) in [0, 1] from surface colour, projected colour (N, 3) and strength (N, 1).
-    ``projected_light``: the projected colour already decoded to linear light (and spread over its neighbours, which
-    the caller sees and this function does not), in place of decoding ``projected``; ``surface_light`` likewise the
-    surface colour decoded under this model's tone curve."""
+    ``projected_light``: the projected colour already decoded to the light it adds (``projected_decode``, and spread
+    over its neighbours, which the caller sees and this function does not), in place of decoding ``projected``;
+    ``surface_light`` likewise the surface colour decoded under this model's tone curve."""
     decode, encode = tone_curve(effects, params)
     surface_lin = decode(surface) if surface_light is None else surface_light
     light = projected_decode(effects, params)(projected) if projected_light is None else projected_light
     correction = correction_matrix(params) if "colour_correction" in effects else None
     if correction is not None:  # to the raw channels, where the light meets the reflectance and the clip
-        to_raw = torch.linalg.inv(correction).T.to(surface_lin.dtype)
-        surface_lin = surface_lin @ to_raw
-        if "projector_gamma" not in params:  # a captured pattern is this camera's stored light
-            light = light @ to_raw
+        surface_lin = surface_lin @ torch.linalg.inv(correction).T.to(surface_lin.dtype)
     if "channel_crosstalk" in effects:
         matrix = torch.stack(
             [torch.as_tensor(params[n], dtype=surface.dtype) for n in CROSSTALK_NAMES]

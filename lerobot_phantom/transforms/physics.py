@@ -279,6 +279,41 @@ def check_colour_correction(values, owner: str) -> tuple[float, ...] | None:
     return tuple(float(v) for v in matrix.reshape(-1))
 
 
+# the stored level at or below which a captured pattern's channel reads as black. A colour-correcting camera's matrix
+# pushes a primary's fainter channels below 0, stored at 0, and the sensor's read noise lifts them: a 12-bit sensor's
+# black noise of ~5e-4 of white reaches 8 grey levels under a 2.2 power law (2 under sRGB's linear toe). A channel
+# truly just above black after the matrix is a coincidence of its raw light and the matrix's leak, so a wide black
+# level costs little (docs/bench/session99.md)
+PATTERN_BLACK_LEVEL = 8 / 255
+
+
+def captured_light_to_raw(
+    light: torch.Tensor, pattern: torch.Tensor, colour_correction: torch.Tensor, *, channel_dim: int = -3
+) -> torch.Tensor:
+    """A projector pattern captured through a camera's (3, 3) ``colour_correction``, ``light`` (decoded to linear
+    light in the stored channels) -> the light in the raw channels; ``pattern``: its encoded values, same shape.
+
+    A channel the capture stores at black (``PATTERN_BLACK_LEVEL``) is read as no light of its own, the others
+    through the inverse of the matrix's block for them: the least light the capture allows, exact for a primary
+    that only its own colour filter sees. The whole matrix's inverse reads such a channel as just at 0 after the
+    matrix, so it puts back the light the negative off-diagonals took out of it: a red primary comes back with
+    green and blue light it never had."""
+    correction = colour_correction.to(torch.float64)
+    blocks = []
+    for code in range(8):  # bit c set: channel c at black
+        keep = torch.tensor([c for c in range(3) if not code >> c & 1], dtype=torch.long)
+        block = torch.zeros(3, 3, dtype=torch.float64)
+        if len(keep):
+            rows, cols = torch.meshgrid(keep, keep, indexing="ij")
+            block = block.index_put((rows, cols), torch.linalg.inv(correction[keep][:, keep]))
+        blocks.append(block)
+    at_black = (pattern <= PATTERN_BLACK_LEVEL).movedim(channel_dim, -1)
+    code = (at_black.long() * torch.tensor([1, 2, 4], device=pattern.device)).sum(-1)
+    matrices = torch.stack(blocks).to(light.dtype).to(light.device)[code]
+    raw = (matrices @ light.movedim(channel_dim, -1)[..., None])[..., 0]
+    return raw.movedim(-1, channel_dim)
+
+
 def mix_channels(matrix: torch.Tensor, image: torch.Tensor) -> torch.Tensor:
     """``matrix`` (3, 3) applied to every pixel of a ``(..., 3, H, W)`` image, in the image's dtype."""
     return torch.einsum("ij,...jhw->...ihw", matrix.to(image.dtype), image)
@@ -405,16 +440,16 @@ def project_light(
     into light by the projector's display transfer ``pattern ** projector_gamma``; None: the pattern is decoded
     like the scene, a capture of the projected light through this camera. ``colour_correction``: a (3, 3) matrix
     the camera mixes its raw channels with after the sensor: the light meets the surface's reflectance and the clip
-    in the raw channels (the scene, and a captured pattern, taken there by the matrix's inverse; ``crosstalk`` is
-    then the camera's raw response to the primaries), and the matrix mixes the sum before the tone curve.
+    in the raw channels (the scene taken there by the matrix's inverse, a captured pattern by
+    ``captured_light_to_raw``; ``crosstalk`` is then the camera's raw response to the primaries), and the matrix
+    mixes the sum before the tone curve.
     """
     scene = decode(x, gamma)
     light = decode(pattern, gamma if projector_gamma is None else projector_gamma)
     if colour_correction is not None:
-        to_raw = torch.linalg.inv(colour_correction.to(torch.float64))
-        scene = mix_channels(to_raw, scene)
+        scene = mix_channels(torch.linalg.inv(colour_correction.to(torch.float64)), scene)
         if projector_gamma is None:
-            light = mix_channels(to_raw, light)
+            light = captured_light_to_raw(light, pattern, colour_correction)
     if isinstance(spread_px, torch.Tensor) or spread_px > 0.0:
         light = gaussian_spread(light, spread_px)
     if crosstalk is not None:

@@ -49,10 +49,18 @@ def test_colour_triple_tables_are_not_offered_light_spread():
 def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
     """The decoded and spread light a fit reuses between the columns of a finite-difference Jacobian
     (``ProjectionFrames.memoised_light``) must equal the light computed afresh for every parameter step, including
-    steps of the tone curve and of the spread, which change it."""
+    steps of the tone curve, of the spread and of the colour correction (which takes a captured pattern to the raw
+    channels, ``physics.captured_light_to_raw``), which change it."""
     pairs = projection_pairs_with_spread_light(1.0, seed=5)
     effects = frozenset(
-        {"additive_light", "channel_crosstalk", "tone_shoulder", "sensor_gamma", "light_spread"}
+        {
+            "additive_light",
+            "channel_crosstalk",
+            "tone_shoulder",
+            "sensor_gamma",
+            "light_spread",
+            "colour_correction",
+        }
     )
     kept, fresh = (
         ProjectionFrames(pairs, seed=5, pattern_record="captured"),

@@ -7,12 +7,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import torch
+from calibration_testkit import projection_pairs_with_spread_light
 
 from lerobot_phantom.calibration.core import Fit
 from lerobot_phantom.calibration.frame_models.common import Pair
 from lerobot_phantom.calibration.frame_models.light_projection import ProjectionFrames
 from lerobot_phantom.calibration.projection import (
     EFFECTS,
+    SPREAD_HIGH_REF_PX,
     projection_kwargs,
     projection_nulls,
     projection_predict,
@@ -43,7 +45,8 @@ def attack_light(options: dict, surface: torch.Tensor, projected: torch.Tensor) 
 def test_the_attack_composes_light_in_the_fitted_raw_channels_as_the_fit_does(emitted):
     """calibrated.json hands ``LightProjection`` the fitted matrix: its light reproduces the fit's prediction to
     rounding, with the reflectance, the clip, the cross-talk and a gamma, for a pattern the projector was sent and
-    for one this camera captured (its stored light taken back to raw too); without the matrix it misses."""
+    for one this camera captured (its stored light taken back to raw too, its channels at black among them); without
+    the matrix it misses."""
     params = {"gamma": 2.2, "reflectance_floor": 0.02, "white": 0.8, **RAW_CROSSTALK, **TAKES}
     if emitted:
         params["projector_gamma"] = 2.0
@@ -58,12 +61,97 @@ def test_the_attack_composes_light_in_the_fitted_raw_channels_as_the_fit_does(em
         }
     )
     surface, projected, strength = colours(400, seed=11)
+    projected[::3, 1] = projected[1::3, 2] = 0.0  # channels a captured pattern stores at black
     predicted = projection_predict(surface, projected, strength, effects, params)
     kwargs = projection_kwargs(Fit(effects, params))
     assert np.allclose(np.reshape(kwargs["colour_correction"], (3, 3)), correction_matrix(params).numpy())
     assert torch.allclose(attack_light(kwargs, surface, projected), predicted, atol=1e-12)
     unmixed = {k: v for k, v in kwargs.items() if k != "colour_correction"}
     assert 255 * float((attack_light(unmixed, surface, projected) - predicted).abs().max()) > 20.0
+
+
+def captured_through(correction: torch.Tensor, raw: torch.Tensor, gamma: float = 2.2) -> torch.Tensor:
+    """``raw`` light (N, 3) as a board capture through ``correction`` stores it: mixed, clipped, 8-bit power law."""
+    return torch.round((raw @ correction.T).clamp(0.0, 1.0) ** (1 / gamma) * 255) / 255
+
+
+def test_a_captured_primary_stored_at_black_comes_back_as_its_own_raw_light_alone():
+    """A board capture through the matrix stores a primary's fainter channels at 0 (the negative off-diagonals push
+    them below it): read back, a primary's raw light is its own channels' alone, to the 8-bit file's rounding,
+    where the whole matrix's inverse puts back into a red primary the green and blue the matrix took out. Colours
+    with no channel at black read as the inverse reads them; rows and images read alike."""
+    correction = correction_matrix(TAKES)
+    primaries = torch.tensor(
+        [[0.6, 0, 0], [0, 0.5, 0], [0, 0, 0.6], [0.5, 0.4, 0], [0, 0.3, 0.6], [0.5, 0, 0.5]],
+        dtype=torch.float64,
+    )
+    pattern = captured_through(correction, primaries)
+    assert bool((pattern <= physics.PATTERN_BLACK_LEVEL).any(1).all())
+    light = pattern**2.2
+    back = physics.captured_light_to_raw(light, pattern, correction, channel_dim=-1)
+    assert torch.allclose(back, primaries, atol=0.01)
+    inverse = light @ torch.linalg.inv(correction).T
+    assert float((inverse - primaries).abs().max()) > 0.1
+    assert float(inverse[0, 1:].min()) > 0.05  # the red primary's green and blue
+
+    rng = np.random.default_rng(3)
+    greys = torch.from_numpy(rng.uniform(0.3, 0.6, (50, 1)) + rng.uniform(0.0, 0.1, (50, 3)))
+    pattern = captured_through(correction, greys)
+    assert bool((pattern > physics.PATTERN_BLACK_LEVEL).all())
+    light = pattern**2.2
+    assert torch.allclose(
+        physics.captured_light_to_raw(light, pattern, correction, channel_dim=-1),
+        light @ torch.linalg.inv(correction).T,
+        atol=1e-12,
+    )
+
+    mixed = torch.cat([primaries, greys])
+    pattern = captured_through(correction, mixed)
+    rows = physics.captured_light_to_raw(pattern**2.2, pattern, correction, channel_dim=-1)
+    image = pattern.T.reshape(1, 3, 8, 7)
+    assert torch.equal(physics.captured_light_to_raw(image**2.2, image, correction).reshape(3, -1).T, rows)
+
+
+def test_a_captured_patterns_raw_light_differentiates_in_the_matrix():
+    """The fit takes a torch Jacobian through the matrix's takes: the read-back's derivative matches a central
+    difference, channels at black included."""
+    raw = torch.tensor([[0.6, 0, 0], [0.5, 0.4, 0], [0.3, 0.35, 0.4]], dtype=torch.float64)
+    pattern = captured_through(correction_matrix(TAKES), raw)
+    takes = torch.tensor([TAKES[f"ccm_{c}"] for c in ("red", "green", "blue")], dtype=torch.float64)
+    weights = torch.linspace(0.5, 1.5, 9, dtype=torch.float64).reshape(3, 3)
+
+    def read(t: torch.Tensor) -> torch.Tensor:
+        return (
+            physics.captured_light_to_raw(pattern**2.2, pattern, physics.correction_matrix(t), channel_dim=-1)
+            * weights
+        ).sum()
+
+    assert torch.autograd.gradcheck(read, (takes.clone().requires_grad_(True),))
+
+
+def test_a_captured_pattern_is_taken_to_raw_before_it_spreads_in_the_fit_as_in_the_attack():
+    """With ``light_spread`` the frame model spreads whole patterns (``ProjectionFrames.spread_light``): a captured
+    pattern's light reaches the raw channels pixel by pixel first, as in the attack, whose frame it reproduces."""
+    pairs = projection_pairs_with_spread_light(1.0, seed=2)
+    problem = ProjectionFrames(pairs, seed=2, pattern_record="captured")
+    effects = frozenset(
+        {"additive_light", "albedo_modulation", "sensor_gamma", "light_spread", "colour_correction"}
+    )
+    # the widest spread: the fit's kernel radius (kept for it) is then the attack's
+    params = {
+        "strength": 0.4,
+        "reflectance_floor": 0.05,
+        "gamma": 2.2,
+        "spread_ref_px": SPREAD_HIGH_REF_PX,
+        **TAKES,
+    }
+    kwargs = projection_kwargs(Fit(effects, params))
+    pair = pairs[0]
+    fitted = problem.predict_features(effects, params, problem.features(0, None))
+    attacked = LightProjection(**kwargs).project(
+        pair.clean[None], pair.pattern[None], torch.tensor([pair.intensity], dtype=torch.float64)
+    )
+    assert torch.allclose(fitted, attacked[0].flatten(1).T, atol=1e-12)
 
 
 def test_where_light_only_adds_the_matrix_is_a_change_of_basis_the_cross_talk_absorbs():

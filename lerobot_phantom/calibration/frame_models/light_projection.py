@@ -28,11 +28,11 @@ from lerobot_phantom.calibration.projection import (
     projection_warm,
     tone_curve,
 )
-from lerobot_phantom.calibration.tone import TONE_PARAMS
+from lerobot_phantom.calibration.tone import CORRECTION_PARAMS, TONE_PARAMS
 from lerobot_phantom.transforms.physics import gaussian_spread
 
 # the parameters the projected light's decoding depends on, and its spreading
-PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma")
+PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma", *(p.name for p in CORRECTION_PARAMS))
 SPREAD_PARAMS = (*PROJECTED_PARAMS, "spread_ref_px")
 # a finite-difference Jacobian moves one parameter at a time, so every column but the light's own repeats the
 # decoded and spread light of the point it is taken at (decoding and spreading took 75 of a 101 s calibration,
@@ -124,8 +124,8 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
         }
 
     def spread_light(self, effects, params, feats) -> torch.Tensor:
-        """Each row's projected light in linear light, spread over its neighbours (``light_spread``)."""
-        decode = projected_decode(effects, params)
+        """Each row's projected light (``projected_decode``), spread over its neighbours (``light_spread``)."""
+        decode = projected_decode(effects, params, channel_dim=-3)
         pairs = feats["pair"].tolist()
         rows = torch.split(feats["pixel"], feats["pixel_count"].tolist())
         light = [None] * len(pairs)
