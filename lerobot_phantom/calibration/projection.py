@@ -121,7 +121,8 @@ COLOUR_CORRECTION = Effect(
     "meets the surface's reflectance and the sensor's clip in the raw channels, and the matrix (negative "
     "off-diagonals) then mixes them, so a clipped or strongly coloured addition takes light out of the other "
     "stored channels. Where light only adds, the matrix is a change of basis the cross-talk absorbs: it shows "
-    "through the reflectance's product and the clip",
+    "through the reflectance's product and the clip. A pattern captured through the same matrix stores a "
+    "primary's fainter channels at black: they hold no raw light of their own (physics.captured_light_to_raw)",
     requires=("additive_light",),
 )
 FRAME_EFFECTS = (*EFFECTS, LIGHT_SPREAD, COLOUR_CORRECTION)
