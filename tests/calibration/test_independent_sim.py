@@ -695,20 +695,27 @@ def test_em_truncation_draws_that_failed(name, seed, root):
     assert attack.free_band_position == ("free_band_position" in case.planted)
 
 
+def assert_named_with_the_matrix(monkeypatch, root: str, name: str, seed: int) -> dict:
+    """The case at case seed ``seed`` on a colour-correcting camera (``CAMSIM_CCM=1``) names its planted causes and
+    the matrix, and no cause it does not tolerate. Its ``run_case`` result."""
+    monkeypatch.setenv("CAMSIM_CCM", "1")
+    case = CASE_BY_NAME[name]
+    result = run_case(name, root, seed=seed)
+    assert result["camera"].ccm is not None
+    named = named_causes(result["report"])
+    where = replay(case, result)
+    assert case.planted | {"colour_correction"} <= named, where
+    assert not named - case.planted - tolerated(case, result["camera"]), where
+    return result
+
+
 @pytest.mark.slow
 def test_a_colour_correcting_cameras_blinding_halo_names_the_matrix(monkeypatch, root):
     # session 69: camsim's halo case on a camera mixing its clipped raw channels (CAMSIM_CCM=1, master seed
     # 1834494070, session 66's matrix) named linear light alone, the glare missed and 41 grey levels left over all
     # pairs; the laser's light clips in the raw channels and the matrix takes the clipped channel's excess out of the
     # others, whose capture stores 0 (docs/bench/session69.md)
-    monkeypatch.setenv("CAMSIM_CCM", "1")
-    case = CASE_BY_NAME["blinding_halo"]
-    result = run_case("blinding_halo", root, seed=1835569645)
-    assert result["camera"].ccm is not None
-    named = named_causes(result["report"])
-    where = replay(case, result)
-    assert case.planted | {"colour_correction"} <= named, where
-    assert len(named - case.planted - tolerated(case, result["camera"])) == 0, where
+    result = assert_named_with_the_matrix(monkeypatch, root, "blinding_halo", 1835569645)
     params = result["report"]["extended"]["params"]
     attack = make_attack("laser_blinding", calibration=str(result["out"]))
     matrix = np.reshape(attack.physics.colour_correction, (3, 3))
@@ -729,14 +736,7 @@ def test_a_colour_correcting_cameras_captured_pattern_names_the_planted_gamma_be
     # 2446689515, session 98's matrix) named cross-talk and a shoulder beside the matrix: the pattern, captured on a
     # board through the matrix, stores a primary's fainter channels at black, which the matrix's inverse read back as
     # light the primary never had (physics.captured_light_to_raw; docs/bench/session99.md)
-    monkeypatch.setenv("CAMSIM_CCM", "1")
-    case = CASE_BY_NAME["projection_sensor_gamma"]
-    result = run_case("projection_sensor_gamma", root, seed=2237660868)
-    assert result["camera"].ccm is not None
-    named = named_causes(result["report"])
-    where = replay(case, result)
-    assert case.planted | {"colour_correction"} <= named, where
-    assert not named - case.planted - tolerated(case, result["camera"]), where
+    assert_named_with_the_matrix(monkeypatch, root, "projection_sensor_gamma", 2237660868)
 
 
 @pytest.mark.slow
