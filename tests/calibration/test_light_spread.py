@@ -10,8 +10,8 @@ from calibration_testkit import assert_kept_values_change_no_prediction, project
 
 from lerobot_phantom.calibration.frame_models.light_projection import (
     LIGHT_MEMO_SIZE,
-    SPREAD_PARAMS,
     ProjectionFrames,
+    projected_light_params,
 )
 from lerobot_phantom.calibration.identify import select_and_identify
 from lerobot_phantom.calibration.projection import TripleProblem
@@ -46,11 +46,13 @@ def test_colour_triple_tables_are_not_offered_light_spread():
     assert "light_spread" in {e.name for e in ProjectionFrames.candidates}
 
 
-def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
+@pytest.mark.parametrize("record", ["captured", "emitted"])
+def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian(record):
     """The decoded and spread light a fit reuses between the columns of a finite-difference Jacobian
     (``ProjectionFrames.memoised_light``) must equal the light computed afresh for every parameter step, including
-    steps of the tone curve, of the spread and of the colour correction (which takes a captured pattern to the raw
-    channels, ``physics.captured_light_to_raw``), which change it."""
+    steps of the tone curve, of the spread and, for a captured pattern, of the colour correction (which takes it to
+    the raw channels, ``physics.captured_light_to_raw``), which change it; an emitted pattern is not spread again
+    for a step of the matrix."""
     pairs = projection_pairs_with_spread_light(1.0, seed=5)
     effects = frozenset(
         {
@@ -63,8 +65,8 @@ def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
         }
     )
     kept, fresh = (
-        ProjectionFrames(pairs, seed=5, pattern_record="captured"),
-        ProjectionFrames(pairs, seed=5, pattern_record="captured"),
+        ProjectionFrames(pairs, seed=5, pattern_record=record),
+        ProjectionFrames(pairs, seed=5, pattern_record=record),
     )
     # the features of all pairs stacked, as a fit stacks them
     per_pair = [kept.features(i, kept.samples[i]) for i in range(len(pairs))]
@@ -73,9 +75,11 @@ def test_kept_light_changes_no_prediction_along_a_finite_difference_jacobian():
     spread_light = kept.spread_light
     kept.spread_light = lambda *args: spreads.append(args) or spread_light(*args)
     steps = assert_kept_values_change_no_prediction(kept, fresh, "light_memo", effects, feats)
-    # the light was spread anew only for the steps that move the tone curve or the spread (and the first point),
+    # the light was spread anew only for the steps that move the light's own parameters (and the first point),
     # and the memo stays bounded while the steps run through every parameter
-    moving = sum(name in SPREAD_PARAMS for name in steps[0])
+    light_params = projected_light_params(steps[0], spread=True)
+    assert ("ccm_red" in light_params) == (record == "captured")
+    moving = sum(name in light_params for name in steps[0])
     assert len(spreads) == 1 + moving < len(steps)
     assert len(kept.light_memo) <= LIGHT_MEMO_SIZE
 

@@ -32,13 +32,22 @@ from lerobot_phantom.calibration.tone import CORRECTION_PARAMS, TONE_PARAMS
 from lerobot_phantom.transforms.physics import gaussian_spread
 
 # the parameters the projected light's decoding depends on, and its spreading
-PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma", *(p.name for p in CORRECTION_PARAMS))
+PROJECTED_PARAMS = (*TONE_PARAMS, "projector_gamma")
 SPREAD_PARAMS = (*PROJECTED_PARAMS, "spread_ref_px")
+# a captured pattern reaches the raw channels through the fitted matrix (projected_decode); an emitted one is raw
+# light already, and a step of the matrix must not decode and spread it again
+CORRECTION_NAMES = tuple(p.name for p in CORRECTION_PARAMS)
 # a finite-difference Jacobian moves one parameter at a time, so every column but the light's own repeats the
 # decoded and spread light of the point it is taken at (decoding and spreading took 75 of a 101 s calibration,
 # hidden-effects projection case, docs/bench/session37.md): kept for the point and a step of each light parameter,
 # the surface's and the projected light each
-LIGHT_MEMO_SIZE = 2 * (1 + len(SPREAD_PARAMS))
+LIGHT_MEMO_SIZE = 2 * (1 + len(SPREAD_PARAMS) + len(CORRECTION_NAMES))
+
+
+def projected_light_params(params: dict, spread: bool) -> tuple[str, ...]:
+    """The parameters the projected light of a model with ``params`` depends on (``light_spread`` when ``spread``)."""
+    names = SPREAD_PARAMS if spread else PROJECTED_PARAMS
+    return names if "projector_gamma" in params else (*names, *CORRECTION_NAMES)
 
 
 # colour_correction's sign in the pairs: light only adds, so where no matrix mixes the raw channels no channel of a
@@ -158,7 +167,7 @@ class ProjectionFrames(ProjectionTerms, PixelProblem):
                 "surface", feats, effects, params, TONE_PARAMS, partial(decode, feats["surface"])
             ),
             projected_light=self.memoised_light(
-                "projected", feats, effects, params, SPREAD_PARAMS if spread else PROJECTED_PARAMS, projected
+                "projected", feats, effects, params, projected_light_params(params, spread), projected
             ),
         )
 
