@@ -14,7 +14,9 @@ The rule (:func:`identify`): an extension is a named cause only if
    is compared with them: the model without it cannot have them either, so its gain is what it brings together
    with those of its dependants that pass 2-5 on their own (an effect of no use alone is still not named unless
    what it makes possible is); the effects of a group selection took in one step are judged together, so each
-   member is compared with what any member of the group hosts. And where no other selected effect builds on it,
+   member is compared with what any member of the group hosts, and a member with no parameter of its own (a
+   change of form, which rule 4 cannot judge) must also gain over the others, as the step scored them without it
+   (:func:`form_gains_in_groups`). And where no other selected effect builds on it,
    it is not shown redundant once every later step is in: the interval of the error ratio of the selected model
    without it to the selected model, on the same folds (``core.forward_select``'s ``Step.without``), does not lie
    wholly under 1 + half the selection margin (:class:`Redundancy`). A step never revisits an earlier one, so an
@@ -582,10 +584,11 @@ def identify_selection(
     draws: int,
     rng: np.random.Generator,
     redundancy: Redundancy | None = None,
+    group_gains: Mapping[str, GroupGain] | None = None,
 ) -> Selection:
     """Judge every extension forward selection kept by the module's rule; refit without those that fail.
     ``redundancy``: :func:`redundancy` of the steps (None: rule 2's test of the selected model without each effect is
-    not made)."""
+    not made); ``group_gains``: :func:`form_gains_in_groups` of the steps (None: not made)."""
     selected_fit = chain[-1]
     samples = parameter_draws(problem, selected_fit, fit_items, draws=draws, rng=rng)
     intervals = draw_intervals(problem, selected_fit, fit_items, samples)
@@ -600,6 +603,7 @@ def identify_selection(
         samples=samples,
         rng=rng,
         redundancy=redundancy,
+        group_gains=group_gains,
     )
     # taken before the passes below add collateral reasons (an effect it builds on, or a refit without one, failed)
     rejected = sorted(
@@ -655,6 +659,59 @@ def redundancy(problem: Problem, steps: list[Step], *, margin: float, rng: np.ra
     return Redundancy(ratios, margin)
 
 
+@dataclass(frozen=True)
+class GroupGain:
+    """What a change of form taken in one step with other effects brings beside them (:func:`form_gains_in_groups`):
+    the step's scored group of the others, and the paired bootstrap interval of its inner cross-validated error
+    ratio to the whole group."""
+
+    others: str  # the group of the others, by its label in the step's ``tried``
+    ratio: Interval
+
+    def reason(self) -> str:
+        ratio = self.ratio
+        return (
+            f"a change of form taken in one step with {self.others}, with no parameter of its own to show a null "
+            f"excluded: those alone score an inner cross-validated error ratio of {ratio.estimate:.3f} "
+            f"({100 * ratio.level:.0f}% interval {ratio.low:.3f}-{ratio.high:.3f}) to the group with it, which does "
+            "not exclude 1 (no gain of its own)"
+        )
+
+
+def form_gains_in_groups(
+    problem: Problem, steps: list[Step], *, rng: np.random.Generator
+) -> dict[str, GroupGain]:
+    """Per effect with no parameter of its own that a selection step took in a group with others, where the step
+    scored (and did not set aside) the group of the others without it and without what builds on it: its
+    :class:`GroupGain`. A group is judged by what its members bring together (rule 2), and a member with a
+    parameter shows its own part by rule 4; a change of form has no parameter, so the group's gain would name it
+    on the others' evidence. Rule 2 asks this of it, as of an effect taken in a step of its own: the second
+    camera's placement table of STRIPES_SEED=2369029544 took the drift's start at the stripes' entry with the
+    exposure overlap and the drift in one step, 6.54 rows against the pair's 6.93 (interval 0.906-1.278), and
+    the entry start ran a recording's drift to a whole period (held-out 30.51 rows, the pair's 23.31:
+    docs/bench/session100.md)."""
+    requires = requirements(problem)
+    gains = {}
+    for effect, before, after in selection_entries(steps):
+        chosen = frozenset(steps[before].effects)
+        model = frozenset(steps[after].effects)
+        group = model - chosen
+        if len(group) < 2 or own_params(problem, model, effect) or problem.null_values(effect):
+            continue
+        others = group - {effect} - dependants(problem, model, effect)
+        label = "+".join(group_label(others, chosen, requires))
+        if not others or label not in steps[before].tried_item_errors or label in steps[before].set_aside:
+            continue
+        ratio = error_ratio(
+            steps[before].tried_item_errors[label],
+            steps[after].item_errors,
+            rng=rng,
+            score=problem.selection_score,
+        )
+        gains[effect] = GroupGain(label, ratio)
+    return gains
+
+
 def own_evidence_results(
     problem: Problem,
     steps: list[Step],
@@ -666,12 +723,14 @@ def own_evidence_results(
     samples: Sequence[Mapping[str, float]],
     rng: np.random.Generator,
     redundancy: Redundancy | None,
+    group_gains: Mapping[str, GroupGain] | None = None,
 ) -> dict[str, dict]:
     """Each selected effect's result by the rule on its own evidence: its validation ratio, the ratio of the
-    selected model without it (``redundancy``; ``redundant`` when that alone fails) and its own parameters
-    in the selected model (``samples``: the bootstrap refits ``intervals`` come from). Leaves first: an effect that
-    hosts others (the form their parameters live in) is judged with those of them that pass on their own, because
-    the model without it cannot have them either; so is every other member of a group taken with it in one step."""
+    selected model without it (``redundancy``; ``redundant`` when that alone fails), what a change of form taken in
+    a group brings beside the others (``group_gains``) and its own parameters in the selected model (``samples``:
+    the bootstrap refits ``intervals`` come from). Leaves first: an effect that hosts others (the form their
+    parameters live in) is judged with those of them that pass on their own, because the model without it cannot
+    have them either; so is every other member of a group taken with it in one step."""
     own: dict[str, dict] = {}
     for effect, before, after in reversed(entries):
         hosted = {d for d in dependants(problem, selected_fit.effects, effect) if own[d]["identified"]}
@@ -716,12 +775,19 @@ def own_evidence_results(
         result = outcome.as_dict()
         without = None if redundancy is None else redundancy.ratios.get(effect)
         result["redundant"] = outcome.redundant
+        failed = []
+        group_gain = (group_gains or {}).get(effect)
+        if group_gain is not None:
+            result["gain_in_group"] = {"others": group_gain.others, **group_gain.ratio.as_dict()}
+            if not group_gain.ratio.low > 1.0:
+                failed.append(group_gain.reason())
         # problem-specific adequacy checks of the effect's physics (e.g. a blur path must be one path for the
         # whole frame); each failed check is a reason
         checks = getattr(problem, "identification_checks", None)
-        failed = checks(effect, selected_fit, fit_items) if checks is not None and outcome.identified else []
+        if checks is not None and outcome.identified:
+            failed += checks(effect, selected_fit, fit_items)
         if failed:
-            result.update(identified=False, status="not identified")
+            result.update(identified=False, status="not identified", redundant=False)
             result["reasons"].extend(failed)
         result.update(
             validation_ratio=None if ratio is None else ratio.as_dict(),
@@ -939,6 +1005,7 @@ def select_and_identify(
             rng=np.random.default_rng([seed, 1]),
             # a stream of their own: the intervals of before are drawn as they were
             redundancy=redundancy(problem, steps, margin=margin, rng=np.random.default_rng([seed, 6])),
+            group_gains=form_gains_in_groups(problem, steps, rng=np.random.default_rng([seed, 7])),
         )
         selection.form_passes = form_passes
         selection.unoffered = unoffered

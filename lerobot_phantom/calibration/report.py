@@ -27,7 +27,9 @@ identify.draw_intervals):
   notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
   compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
   includes), ratio_without (interval of the selected model without it to the selected model, where no other
-  selected effect builds on it; else null), redundant (that is all it fails), params, intervals, nulls} (rule:
+  selected effect builds on it; else null), redundant (that is all it fails), gain_in_group (a change of form taken
+  in one step with others: {others, interval} of the others alone to the group, identify.form_gains_in_groups),
+  params, intervals, nulls} (rule:
   ``calibration/identify.py``); a cause implied by an identified effect's form (``Effect.implies``) has
   ``implied_by`` and its statistic as ``params`` (identify.implied_results); the simpler form of a term judged in
   place of a richer one that is not identified has ``in_place_of`` and ``scored`` {group, validation_error}
@@ -197,6 +199,12 @@ def finding(problem: Problem, result: dict, steps: list[Step], base: Fit, extend
         + f"(ratio {interval['estimate']:.3f}, {100 * interval['level']:.0f}% interval "
         f"{interval['low']:.3f}-{interval['high']:.3f}, fit items only)"
     )
+    in_group = result.get("gain_in_group")
+    if in_group:
+        evidence += (
+            f"; beside {in_group['others']}, taken with it: ratio {in_group['estimate']:.3f} "
+            f"({in_group['low']:.3f}-{in_group['high']:.3f})"
+        )
     without = result.get("ratio_without")
     if without:
         evidence += (
@@ -249,7 +257,8 @@ def selection_section(
         "extension must pass the identification rule "
         "(calibration/identify.py): cross-validated error ratio interval above 1, and, where no other kept "
         "extension builds on it, that of the selected model without it to the selected model not wholly under "
-        f"{1 + margin / 2:g} (half the gain a step must bring); no own parameter at a bound, an interval excluding "
+        f"{1 + margin / 2:g} (half the gain a step must bring), and for a change of form a step took with others, "
+        "that of the others alone to the group above 1; no own parameter at a bound, an interval excluding "
         "its null value; a richer form that fails gives way to the simpler form "
         "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
         "when the interval of its statistic excludes the null value; an extension a pass selected and "

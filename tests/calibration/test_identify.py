@@ -40,6 +40,7 @@ from lerobot_phantom.calibration.identify import (
     draw_intervals,
     error_ratio,
     excludes_null,
+    form_gains_in_groups,
     identify,
     identify_selection,
     joint_null_interval,
@@ -708,6 +709,94 @@ def test_a_member_of_a_group_is_judged_with_what_its_partner_hosts():
     assert results["partner"]["identified"], results["partner"]["reasons"]
     assert results["partner"]["validation_ratio"]["low"] > 5  # an RMSE ratio: sqrt(1 / 0.01)
     assert sorted(selection.identified) == ["child", "host", "partner"]
+
+
+class OverlapDriftAndStart(MeasuredEverywhere):
+    """A stripe model's exposure overlap, a drift on it and where the drift starts (a change of form, no parameter
+    of its own), as the laser strip's table offers them."""
+
+    candidates = (
+        Effect("overlap", "the exposure overlap"),
+        Effect("drift", "a phase drift", requires=("overlap",)),
+        Effect("start", "the drift starts at the stripes' entry", requires=("drift",)),
+    )
+
+    def param_specs(self, effects):
+        return [Param(f"p_{name}", 0.0, -10.0, 10.0) for name in sorted(effects - {"start"})]
+
+    def fit(self, effects, items, start=None) -> Fit:
+        return Fit(effects, {p.name: 1.0 + 0.01 * float(np.mean(items)) for p in self.param_specs(effects)})
+
+
+def overlap_drift_and_start_steps(pair_terms: np.ndarray, set_aside: dict[str, str]) -> list[Step]:
+    """A step that took the three in one group, scoring the overlap with the drift (``pair_terms``) beside it."""
+    group_terms = PER_ITEM
+    before = Step(
+        [],
+        4.0,
+        {"overlap": 2.0, "overlap+drift": float(np.sqrt(pair_terms.mean())), "overlap+drift+start": 1.0},
+        16.0 * PER_ITEM,
+        tried_item_errors={
+            "overlap": 4.0 * PER_ITEM,
+            "overlap+drift": pair_terms,
+            "overlap+drift+start": group_terms,
+        },
+        set_aside=set_aside,
+    )
+    return [
+        before,
+        Step(["overlap"], 2.0, {}, 4.0 * PER_ITEM, paired=True),
+        Step(["drift", "overlap"], 1.0, {}, pair_terms, paired=True),
+        Step(["drift", "overlap", "start"], 1.0, {}, group_terms),
+    ]
+
+
+@pytest.mark.parametrize(
+    ("pair_share", "set_aside", "start_named"),
+    [
+        pytest.param("noisy", {}, False, id="no gain beside the others"),
+        pytest.param("quarter", {}, True, id="a gain beside the others"),
+        pytest.param("noisy", {"overlap+drift": "pinned"}, True, id="the others set aside"),
+    ],
+)
+def test_a_change_of_form_taken_in_a_group_must_gain_beside_the_others(pair_share, set_aside, start_named):
+    """The second camera's placement table of STRIPES_SEED=2369029544: one step took the overlap, the drift and
+    the drift's start at the entry, the start 6.54 rows against the pair's 6.93 (interval 0.906-1.278), judged on
+    the group's gain over the step before (14.0). A change of form has no parameter to show a null excluded, so it
+    must gain over the group of the others the step scored; a member with a parameter is left to rule 4, and a
+    group of the others the step set aside is no model to compare with."""
+    noise = np.random.default_rng(2).uniform(0.6, 1.6, 20)
+    pair_terms = PER_ITEM * (noise if pair_share == "noisy" else 4.0)
+    steps = overlap_drift_and_start_steps(pair_terms, set_aside)
+    problem = OverlapDriftAndStart()
+    gains = form_gains_in_groups(problem, steps, rng=np.random.default_rng(0))
+    assert set(gains) == ({"start"} if not set_aside else set())
+    items = np.arange(20)
+    chain = [problem.fit(frozenset(s.effects), items) for s in steps]
+    selection = identify_selection(
+        problem, steps, chain, items, draws=20, rng=np.random.default_rng(1), group_gains=gains
+    )
+    results = {r["effect"]: r for r in selection.results}
+    assert results["overlap"]["identified"] and results["drift"]["identified"]
+    assert "gain_in_group" not in results["drift"]
+    assert results["start"]["identified"] is start_named, results["start"]["reasons"]
+    if set_aside:
+        return
+    gain = results["start"]["gain_in_group"]
+    assert gain["others"] == "overlap+drift"
+    assert gain["estimate"] == pytest.approx(np.sqrt(pair_terms.mean() / PER_ITEM.mean()))
+    assert selection.rejected == ([] if start_named else ["start"])
+    if not start_named:
+        assert gain["low"] < 1.0 < gain["high"]
+        assert any("no gain of its own" in r for r in results["start"]["reasons"])
+    else:
+        report = report_on_twenty_items(problem, selection, steps)
+        evidence = {f["effect"]: f["evidence"] for f in report["findings"]}
+        assert "beside overlap+drift, taken with it: ratio 2.000 (2.000-2.000)" in evidence["start"]
+        assert "for a change of form a step took with others" in report["selection"]["criterion"]
+    # judged without the test, the group's gain over the step before names the start whatever it brings
+    plain = identify_selection(problem, steps, chain, items, draws=20, rng=np.random.default_rng(1))
+    assert "start" in plain.identified
 
 
 class MeterBalancingAGlare(MeasuredEverywhere):
