@@ -687,7 +687,7 @@ def form_gains_in_groups(
     parameter shows its own part by rule 4; a change of form has no parameter, so the group's gain would name it
     on the others' evidence. Rule 2 asks this of it, as of an effect taken in a step of its own: the second
     camera's placement table of STRIPES_SEED=2369029544 took the drift's start at the stripes' entry with the
-    exposure overlap and the drift in one step, 6.54 rows against the pair's 6.93 (interval 0.906-1.278), and
+    exposure overlap and the drift in one step, 6.54 rows against the pair's 6.93 (ratio 1.060, 0.902-1.287), and
     the entry start ran a recording's drift to a whole period (held-out 30.51 rows, the pair's 23.31:
     docs/bench/session100.md)."""
     requires = requirements(problem)
