@@ -24,24 +24,30 @@ from lerobot_phantom.calibration.core import seeded_split
 from lerobot_phantom.calibration.stripes import DRIFT_EFFECTS, StripeProblem
 
 
+def calibrate_drift_table(where: Path, seed: int, start: str) -> tuple[dict, dict, np.ndarray, Path]:
+    """(report.json, camera, drifts, table) of the drift test's calibration of ``seed``'s table from ``start``,
+    written under ``where`` (split seed ``seed % 1000``, 10 bootstrap draws, as ``drift_reports``)."""
+    rng, camera, drifts = ts.drifting_draw(seed, drifting=True)
+    where.mkdir(parents=True, exist_ok=True)
+    table = where / "drifting.csv"
+    ts.drifting_table(table, camera, rng, drifts, start_at=start)
+    config = CalibrateConfig(
+        attack="laser_color_strip",
+        measured=str(table),
+        out=str(where / "out"),
+        image_height=camera["height"],
+        seed=seed % 1000,
+        bootstrap=10,
+    )
+    return calibrate(config), camera, drifts, table
+
+
 def main(out: Path, seeds: list[int]) -> None:
     print("# package:", Path(lerobot_phantom.__file__).resolve().parent, flush=True)
     for seed in seeds:
         for start in os.environ.get("DRIFT_STARTS", "placement,entry").split(","):
-            rng, camera, drifts = ts.drifting_draw(seed, drifting=True)
             where = out / f"{seed}_{start}"
-            where.mkdir(parents=True, exist_ok=True)
-            table = where / "drifting.csv"
-            ts.drifting_table(table, camera, rng, drifts, start_at=start)
-            config = CalibrateConfig(
-                attack="laser_color_strip",
-                measured=str(table),
-                out=str(where / "out"),
-                image_height=camera["height"],
-                seed=seed % 1000,
-                bootstrap=10,
-            )
-            report = calibrate(config)
+            report, camera, drifts, table = calibrate_drift_table(where, seed, start)
             problem = StripeProblem(table, image_height=camera["height"], exposure_unit_s=None)
             fit_items, heldout = seeded_split(problem.n_items, 0.2, seed % 1000)
             locked = problem.fit(frozenset(report["extended"]["effects"]) - set(DRIFT_EFFECTS), fit_items)

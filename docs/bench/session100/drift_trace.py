@@ -14,9 +14,9 @@ os.environ.setdefault("HF_HUB_OFFLINE", "1")
 
 import numpy as np
 import test_stripes as ts
+from drift_groups import calibrate_drift_table
 
 import lerobot_phantom
-from lerobot_phantom.calibration.cli import CalibrateConfig, calibrate
 from lerobot_phantom.calibration.core import seeded_split
 from lerobot_phantom.calibration.stripes import StripeProblem
 
@@ -27,19 +27,7 @@ def interval(value: dict | None) -> str:
 
 def main(out: Path, seed: int) -> None:
     print("# package:", Path(lerobot_phantom.__file__).resolve().parent)
-    rng, camera, drifts = ts.drifting_draw(seed, drifting=True)
-    out.mkdir(parents=True, exist_ok=True)
-    table = out / "drifting.csv"
-    ts.drifting_table(table, camera, rng, drifts, start_at="placement")
-    config = CalibrateConfig(
-        attack="laser_color_strip",
-        measured=str(table),
-        out=str(out / "out"),
-        image_height=camera["height"],
-        seed=seed % 1000,
-        bootstrap=10,
-    )
-    report = calibrate(config)
+    report, camera, drifts, table = calibrate_drift_table(out, seed, "placement")
     print(ts.camera_summary(camera), "drifts", np.round(drifts, 3).tolist())
     for k, step in enumerate(report["selection"]["steps"]):
         print(f"step {k}: {step['effects']} {step['validation_error']:.2f}")
