@@ -696,7 +696,7 @@ def form_gains_in_groups(
         chosen = frozenset(steps[before].effects)
         model = frozenset(steps[after].effects)
         group = model - chosen
-        if len(group) < 2 or own_params(problem, model, effect) or problem.null_values(effect):
+        if len(group) < 2 or own_params(problem, model, effect):
             continue
         others = group - {effect} - dependants(problem, model, effect)
         label = "+".join(group_label(others, chosen, requires))
