@@ -816,14 +816,14 @@ def joint_group_taken(
 ) -> tuple[frozenset[str] | None, list[frozenset[str]]]:
     """The group of two or more new effects a step takes, or None, and the groups its score tied with
     (:func:`lowest_scoring`): of the groups under what they need, the one with the lowest score. A group needs
-    ``margin`` under the best smaller eligible group but those ``not_compared`` with it (:func:`stand_ins`) and,
-    over the ``current`` score, the margin once per member that stands on its own (one that builds on another member
-    only carries it).
+    ``margin`` under the best smaller eligible group nested in it or earning a step itself (:func:`group_needs`), but
+    those ``not_compared`` with it (:func:`stand_ins`), and, over the ``current`` score, the margin once per member
+    that stands on its own (one that builds on another member only carries it).
 
     Lowest score, not furthest under its need: a pair far under its need can be the first step of a worse model
     (camsim projection_additive on filmic cameras: additive light + a power-law gamma, then the reflectance term
     pinned on the power law's curve, where additive light + shoulder + reflectance beat that pair by 19%), and a
-    larger group under its need has already beaten every smaller one by the margin."""
+    larger group under its need has already beaten by the margin every smaller one the step could take."""
     needed = group_needs(requirements(problem), eligible, current, margin, not_compared)
     return lowest_scoring(problem, {g: eligible[g] for g in needed if eligible[g] <= needed[g]})
 
@@ -859,17 +859,31 @@ def group_needs(
     not_compared: dict[frozenset[str], set[frozenset[str]]],
 ) -> dict[frozenset[str], float]:
     """The score each eligible group of two or more new effects must reach to earn a step
-    (:func:`joint_group_taken`)."""
+    (:func:`joint_group_taken`), by size.
+
+    A group is measured against the smaller groups nested in it, so that each member earns its place beside the
+    others, and against the smaller rivals that earn a step themselves: a single ``margin`` under ``current``, a
+    group under its own need. A rival that earns no step is no model the step could take, and measuring against it
+    made the step take something worse than both (camsim projection_additive 2446689515 on a filmic camera with a
+    colour correction matrix, docs/bench/session99.md: additive light + matrix, 4.0% under light alone, kept
+    light + reflectance + shoulder, 7.5% under light alone and 3.6% under that pair, from the step, and light alone
+    was taken)."""
+    earning = {g for g, v in eligible.items() if len(g) == 1 and v <= (1.0 - margin) * current}
     needed = {}
-    for group in eligible:
-        if len(group) < 2:
-            continue
+    for group in sorted((g for g in eligible if len(g) >= 2), key=len):
         skipped = not_compared.get(group, set())
         smaller = min(
-            (v for g, v in eligible.items() if len(g) < len(group) and g not in skipped), default=math.inf
+            (
+                v
+                for g, v in eligible.items()
+                if len(g) < len(group) and g not in skipped and (g < group or g in earning)
+            ),
+            default=math.inf,
         )
         standing = max(1, sum(1 for e in group if not requires[e] & group))
         needed[group] = min((1.0 - margin) * smaller, (1.0 - standing * margin) * current)
+        if eligible[group] <= needed[group]:
+            earning.add(group)
     return needed
 
 

@@ -567,3 +567,60 @@ class ClipOrShoulder(ToneFormErrors):
 def test_a_richer_form_that_does_not_pay_beside_a_group_does_not_stand_in_for_it(errors, expected):
     chosen, steps = forward_select(ClipOrShoulder(errors), np.arange(20), seed=0, margin=0.05)
     assert chosen == expected, (steps[0].tried, steps[0].set_aside)
+
+
+class LightMatrixAndShoulder(FixedErrors):
+    """camsim's projection_additive on a filmic camera with a colour correction matrix (master seed 2446689515,
+    step 0's validation RMSE, docs/bench/session99.md): light adds (``light``), read through a matrix (``matrix``) or
+    scaled by reflectance (``reflect``), under a shouldered tone curve (``shoulder``), with a clip (``clip``). A model
+    not listed scores as the best listed model nested in it (the effects it adds bring nothing)."""
+
+    joint_effects = 3
+    candidates = (
+        Effect("light", "light adds in linear irradiance"),
+        Effect("matrix", "a colour correction matrix", requires=("light",)),
+        Effect("reflect", "reflectance scales the added light", requires=("light",)),
+        Effect("shoulder", "a tone curve with a shoulder"),
+        Effect("clip", "the sensor clips"),
+    )
+
+    def __init__(self, errors: dict[str, float]) -> None:
+        self.errors = {frozenset(k.split("+")) if k else frozenset(): v for k, v in errors.items()}
+
+    def error(self, effects: frozenset[str]) -> float:
+        return min(v for k, v in self.errors.items() if k <= effects)
+
+
+MATRIX_RIVAL = {
+    "": 8.245,
+    "light": 7.038,
+    "clip": 8.244,
+    "shoulder": 9.876,
+    "light+matrix": 6.754,
+    "light+clip": 6.921,
+    "light+reflect": 7.073,
+    "light+shoulder": 7.544,
+    "clip+shoulder": 9.873,
+    "light+reflect+shoulder": 6.514,
+    "light+matrix+reflect": 6.771,
+    "light+clip+matrix": 6.960,
+    "light+clip+reflect": 6.943,
+}
+
+
+@pytest.mark.parametrize(
+    ("errors", "expected"),
+    [
+        # light + matrix is 4.0% under light alone and earns no step: it does not keep the triple, 7.5% under light
+        # alone, from the step
+        (MATRIX_RIVAL, {"light", "reflect", "shoulder"}),
+        # a pair nested in the triple is measured against whether or not it earns a step: light + reflect, 4.8%
+        # under light alone, and the shoulder 1.6% under that pair bring nothing beside it
+        ({**MATRIX_RIVAL, "light+reflect": 6.70, "light+reflect+shoulder": 6.594}, {"light"}),
+        # a rival that earns its own step keeps the triple, 3.6% under it, from the step
+        ({**MATRIX_RIVAL, "light+matrix": 6.68}, {"light", "matrix"}),
+    ],
+)
+def test_a_group_is_measured_against_the_smaller_groups_nested_in_it_or_earning_a_step(errors, expected):
+    chosen, steps = forward_select(LightMatrixAndShoulder(errors), np.arange(20), seed=0, margin=0.05)
+    assert chosen == expected, (steps[0].tried, steps[0].set_aside)
