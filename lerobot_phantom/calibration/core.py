@@ -27,7 +27,9 @@ from threadpoolctl import threadpool_limits
 @contextmanager
 def single_threaded() -> Iterator[None]:
     """Run fits on one thread: the many small dense products of least squares slow down badly when BLAS and
-    torch spread them over cores that other processes also use (measured: 6x on a loaded 2-core machine)."""
+    torch spread them over cores that other processes also use (measured: 6x on a loaded 2-core machine), and a fit
+    ends where its reductions' order leads it, which the thread count sets (a camsim projection draw's gamma 1.914 on
+    one thread, 1.959 on two: docs/bench/session101/structures_threads_e38c879.txt)."""
     torch_threads = torch.get_num_threads()
     torch.set_num_threads(1)
     try:

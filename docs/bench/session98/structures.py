@@ -3,7 +3,8 @@ fit pairs, from the defaults), with the members a fold fit pins at a bound, and 
 held-out RMSE (grey levels), and the reflectance floor, the shoulder's knee exponent and the gamma. Usage:
 ``[CAMSIM_CCM=1] CAMSIM_SEED=1 PYTHONPATH=.:tests/calibration:tests python docs/bench/session98/structures.py CASE
 CASE_SEED SET...`` (a set: effect names joined by ``+``; CAMSIM_SEED only lets the test module import: the case seed is
-given)."""
+given). The fits run on one thread, as ``calibrate`` runs them: on two they end elsewhere (12.168 for 12.125,
+docs/bench/session101/structures_threads_e38c879.txt)."""
 
 from __future__ import annotations
 
@@ -39,4 +40,5 @@ def main() -> None:
 
 
 if __name__ == "__main__":
-    main()
+    with core.single_threaded():
+        main()
