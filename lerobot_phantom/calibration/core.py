@@ -440,6 +440,9 @@ class Step:
     # every later step is in (identify.py, rule 2)
     without: dict[str, float] = field(default_factory=dict)
     without_item_errors: dict[str, np.ndarray] = field(default_factory=dict)
+    # per effect in ``without``: the other selected effects whose own parameter sits at a bound in most fold fits of
+    # the selected model without it (pinned_members), with why
+    without_pinned: dict[str, dict[str, str]] = field(default_factory=dict)
 
 
 def at_bound(value: float, low: float, high: float, tolerance: float = BOUND_TOLERANCE) -> str | None:
@@ -641,7 +644,8 @@ def forward_select(
 
     A step never revisits an earlier one, so an effect taken as the best of its step can stand in for one that
     only a later step could take: on the same folds, the selected model is scored without each effect no other
-    selected effect builds on (``Step.without`` of the last step), for identification's rule 2."""
+    selected effect builds on (``Step.without`` of the last step), for identification's rule 2, with the other
+    effects a bound pins in that model's fold fits (``Step.without_pinned``)."""
     splits = selection_folds(fit_items, folds, seed, max_train_items)
 
     def aligned(per_item: dict[int, float]) -> np.ndarray:
@@ -693,12 +697,15 @@ def forward_select(
             (k for k, s in enumerate(steps) if set(s.effects) <= rest), key=lambda k: len(steps[k].effects)
         )
         if set(steps[nested].effects) == rest:
-            score, terms = steps[nested].validation_error, steps[nested].item_errors
+            score, fits, terms = steps[nested].validation_error, fold_fits[nested], steps[nested].item_errors
         else:
-            score, _, without = cross_validated(problem, rest, splits, fold_fits[nested])
+            score, fits, without = cross_validated(problem, rest, splits, fold_fits[nested])
             terms = aligned(without)
         steps[-1].without[effect] = score
         steps[-1].without_item_errors[effect] = terms
+        pinned = pinned_members(problem, rest, rest, fits)
+        if pinned:
+            steps[-1].without_pinned[effect] = pinned
     return chosen, steps
 
 

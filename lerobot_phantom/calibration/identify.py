@@ -16,13 +16,13 @@ The rule (:func:`identify`): an extension is a named cause only if
    what it makes possible is); the effects of a group selection took in one step are judged together, so each
    member is compared with what any member of the group hosts, and a member with no parameter of its own (a
    change of form, which rule 4 cannot judge) must also gain over the others, as the step scored them without it
-   (:func:`form_gains_in_groups`). And where no other selected effect builds on it,
-   it is not shown redundant once every later step is in: the interval of the error ratio of the selected model
-   without it to the selected model, on the same folds (``core.forward_select``'s ``Step.without``), does not lie
-   wholly under 1 + half the selection margin (:class:`Redundancy`). A step never revisits an earlier one, so an
-   effect taken as its step's best can stand in for a form a later step brings (camsim's filmic light projection
-   took a sub-white clip while the shoulder's knee ran to its bound, then the shoulder, light spread and
-   reflectance, beside which the clip gained nothing: docs/bench/session77.md);
+   (:func:`form_gains_in_groups`). And where no other selected effect builds on it, it is not shown redundant once
+   every later step is in: the interval of the error ratio of the selected model without it to the selected model, on
+   the same folds (``core.forward_select``'s ``Step.without``), does not lie wholly under 1 + half the selection
+   margin, or without it another selected effect's own parameter sits at a bound in most folds (:class:`Redundancy`).
+   A step never revisits an earlier one, so an effect taken as its step's best can stand in for a form a later step
+   brings (camsim's filmic light projection took a sub-white clip while the shoulder's knee ran to its bound, then the
+   shoulder, light spread and reflectance, beside which the clip gained nothing: docs/bench/session77.md);
 3. none of its own parameters sits at a bound of its search range (a parameter pinned at a bound measures the
    range, not the camera), unless that bound is the form's declared physical limit (``Param.low_limit``: a glare
    whose inner scale lies far inside the clipped core is a pure power law where the frames show it;
@@ -282,6 +282,8 @@ def identify(
         reasons.append(redundancy.reason(effect))
     parameter_reasons, notes = parameter_checks(params, bounds, intervals, nulls, limits, joint_null)
     reasons += parameter_reasons
+    if redundancy is not None and redundancy.holds(effect):
+        notes.append(redundancy.holds(effect))
     return Identification(
         effect, not reasons, tuple(reasons), tuple(notes), redundant=shown_redundant and len(reasons) == 1
     )
@@ -299,12 +301,23 @@ class Redundancy:
     alternate: at the whole margin a planted reflectance that gained 1.1% (0.98-1.04) was withdrawn after the clip
     beside it, and the repeat without both ran the shoulder's knee to its bound and named a power law
     (master seed 913236811; the clips this test withdraws gain -0.9% to +0.3%, interval ends under 0.7%:
-    docs/bench/session77.md)."""
+    docs/bench/session77.md).
+
+    Nor is an effect shown redundant when, without it, another selected effect's own parameter sits at a bound in
+    most fold fits (``pinned_without``, ``core.Step.without_pinned``): the model without it is one selection sets
+    aside (``core.pinned_members``), and the effect is what keeps the other identified. camsim projection_crosstalk
+    (filmic, master seed 3585595729): without the planted reflectance the shoulder's exponent ran to its bound in 4
+    of 4 folds at a ratio of 1.007; the reflectance was withdrawn, and the repeat set every shoulder aside and wrote
+    a power law (held-out 2.22 -> 3.06, docs/bench/session101.md)."""
 
     ratios: Mapping[str, Interval]
     margin: float
+    pinned_without: Mapping[str, Mapping[str, str]] = field(default_factory=dict)
 
     def shown(self, effect: str) -> bool:
+        return self.under_bound(effect) and not self.pinned_without.get(effect)
+
+    def under_bound(self, effect: str) -> bool:
         return effect in self.ratios and self.ratios[effect].high < self.bound
 
     @property
@@ -317,6 +330,19 @@ class Redundancy:
             f"the selected model without it scores an inner cross-validated error ratio of {ratio.estimate:.4f} "
             f"({100 * ratio.level:.0f}% interval {ratio.low:.4f}-{ratio.high:.4f}) to the selected model, under "
             f"{self.bound:g} (half the selection margin): the effects selected after it hold what it brought"
+        )
+
+    def holds(self, effect: str) -> str:
+        """Why ``effect``, under the bound, is not shown redundant (empty when it is, or is not under it)."""
+        pinned = self.pinned_without.get(effect)
+        if not pinned or not self.under_bound(effect):
+            return ""
+        ratio = self.ratios[effect]
+        return (
+            f"not shown redundant: the selected model without it scores an error ratio of {ratio.estimate:.4f} "
+            f"({ratio.low:.4f}-{ratio.high:.4f}), under {self.bound:g}, but without it "
+            + "; ".join(f"{e}: {why}" for e, why in sorted(pinned.items()))
+            + " (a model selection sets aside)"
         )
 
 
@@ -656,7 +682,7 @@ def redundancy(problem: Problem, steps: list[Step], *, margin: float, rng: np.ra
         effect: error_ratio(terms, last.item_errors, rng=rng, score=problem.selection_score)
         for effect, terms in sorted(last.without_item_errors.items())
     }
-    return Redundancy(ratios, margin)
+    return Redundancy(ratios, margin, last.without_pinned)
 
 
 @dataclass(frozen=True)

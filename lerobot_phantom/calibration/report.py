@@ -14,7 +14,8 @@ identify.draw_intervals):
 - ``gain`` {rmse_ratio, rmse_ratio_interval (paired over held-out items), rmse_reduction, selection_margin
   [, noise_scale_ratio]};
 - ``selection`` {score, criterion, selected (forward selection on fit items), steps (validation_error: the score; the
-  last step's without: the score without each effect no other builds on), rejected, not_offered {effect: reason}:
+  last step's without: the score without each effect no other builds on, without_pinned: per such effect the other
+  selected effects a bound pins without it), rejected, not_offered {effect: reason}:
   candidates the fit items show no sign of, never tried (``Problem.unoffered``), set_aside_ahead [{group,
   validation_error, kept_validation_error, reason}]: groups the last step set aside though they scored the margin
   under the selected model (:func:`set_aside_ahead`), withdrawn [{effect, pass, reasons}]: effects an earlier pass
@@ -23,12 +24,13 @@ identify.draw_intervals):
   withdrawn, steps}] those of each pass that withdrew one, form_passes [{without, selected, validation_error,
   first_selected, first_validation_error, taken, other_steps}] the last pass repeated without a simpler form of a term
   it took (core.select_forms; ``other_steps``: the steps of the pass not written)};
-- ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons,
-  notes (parameters at their physical limit, not reasons), compared_steps (the two selection steps the ratio
-  compares), validation_ratio (interval, fit items only), judged_with (the hosted effects whose gain the ratio
-  includes), ratio_without (interval of the selected model without it to the selected model, where no other
-  selected effect builds on it; else null), redundant (that is all it fails), gain_in_group (a change of form taken
-  in one step with others: {others, interval} of the others alone to the group, identify.form_gains_in_groups),
+- ``identification``: per selected effect {effect, status "identified"/"not identified", identified, reasons, notes
+  (parameters at their physical limit, and what keeps it from being shown redundant: not reasons), compared_steps (the
+  two selection steps the ratio compares), validation_ratio (interval, fit items only), judged_with (the hosted
+  effects whose gain the ratio includes), ratio_without (interval of the selected model without it to the selected
+  model, where no other selected effect builds on it; else null), redundant (that is all it fails), gain_in_group (a
+  change of form taken in one step with others: {others, interval} of the others alone to the group,
+  identify.form_gains_in_groups),
   params, intervals, nulls} (rule:
   ``calibration/identify.py``); a cause implied by an identified effect's form (``Effect.implies``) has
   ``implied_by`` and its statistic as ``params`` (identify.implied_results); the simpler form of a term judged in
@@ -258,7 +260,8 @@ def selection_section(
         "extension must pass the identification rule "
         "(calibration/identify.py): cross-validated error ratio interval above 1, and, where no other kept "
         "extension builds on it, that of the selected model without it to the selected model not wholly under "
-        f"{1 + margin / 2:g} (half the gain a step must bring), and for a change of form a step took with others, "
+        f"{1 + margin / 2:g} (half the gain a step must bring) unless without it another kept extension's own "
+        "parameter sits at a bound in most folds, and for a change of form a step took with others, "
         "that of the others alone to the group above 1; no own parameter at a bound, an interval excluding "
         "its null value; a richer form that fails gives way to the simpler form "
         "scored beside it in the same step, judged by the same rule, and a cause a kept form implies is named "
@@ -327,6 +330,7 @@ def step_entry(step: Step) -> dict:
         "tied": step.tied,
         # the last step's: the selected model's score without each effect no other builds on (identify.Redundancy)
         "without": step.without,
+        "without_pinned": step.without_pinned,
     }
 
 
