@@ -87,7 +87,9 @@ def dark_level_radius(pattern: torch.Tensor, centre: tuple[float, float]) -> flo
 def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
     """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): a quadratic surface per channel
     fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
-    towards the corners), a capture's noise from pixel to pixel."""
+    towards the corners), a capture's noise from pixel to pixel. Fitted by :func:`summed_least_squares`: LAPACK's
+    lstsq read one dark frame to three different surfaces in 40 calls on one thread, and a calibration of camsim's
+    halo case with dark frames moved in its sixth digit from run to run (docs/bench/session101.md)."""
     light = srgb_to_linear(dark_frame)
     _, height, width = light.shape
     ys, xs = torch.meshgrid(
@@ -96,7 +98,9 @@ def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
         indexing="ij",
     )
     terms = torch.stack([torch.ones_like(xs), xs, ys, xs * xs, xs * ys, ys * ys]).reshape(6, -1).T
-    coefficients = torch.linalg.lstsq(terms, light.reshape(3, -1).T).solution
+    coefficients = torch.stack(
+        [summed_least_squares(terms, channel) for channel in light.reshape(3, -1)], dim=1
+    )
     return (terms @ coefficients).T.reshape(3, height, width)
 
 
@@ -188,9 +192,9 @@ def room_gradient(capture: torch.Tensor, centre: tuple[float, float]) -> torch.T
 
 def summed_least_squares(design: torch.Tensor, target: torch.Tensor) -> torch.Tensor:
     """(k,) least-squares solution of ``design @ x = target`` by its normal equations, their sums taken by torch's
-    reductions. LAPACK's lstsq sums in an order that follows the BLAS's threads, so the same capture read twice
-    differed in its last bits, and a calibration reading it in its fit moved by 5e-7 relative when only held-out
-    captures changed (``test_heldout_invariance.py``)."""
+    reductions. LAPACK's lstsq sums in an order that follows the BLAS's threads (and, on one thread, the memory it
+    is given), so the same capture read twice differed in its last bits, and a calibration reading it in its fit
+    moved by 5e-7 relative when only held-out captures changed (``test_heldout_invariance.py``)."""
     columns = design.shape[1]
     normal = torch.empty((columns, columns), dtype=design.dtype)
     for i in range(columns):

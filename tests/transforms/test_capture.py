@@ -23,6 +23,7 @@ from lerobot_phantom.transforms.capture import (
     core_continued,
     dark_field,
     dark_level,
+    dark_surface,
     pattern_centre,
     read_capture,
     room_gradient,
@@ -291,3 +292,14 @@ def test_the_same_capture_reads_the_same_gradient_every_time():
     centre = pattern_centre(pattern)
     first = room_gradient(pattern, centre)
     assert all(torch.equal(first, room_gradient(pattern.clone(), centre)) for _ in range(8))
+
+
+def test_the_same_dark_frame_reads_the_same_surface_every_time():
+    """The dark frame's surface likewise: LAPACK's lstsq read one dark frame to three different surfaces in 40 calls
+    on one thread, with other tensors allocated between them (docs/bench/session101/dark_surface_repeats.py), and a
+    calibration of camsim's halo case with dark frames moved in its sixth digit from run to run."""
+    dark = torch.rand(3, HEIGHT, WIDTH, generator=torch.Generator().manual_seed(0), dtype=torch.float64) * 0.1
+    first, held = dark_surface(dark), []
+    for k in range(40):
+        held.append(torch.empty(7 * k + 1, dtype=torch.float64))
+        assert torch.equal(first, dark_surface(dark.clone())), k
