@@ -88,8 +88,9 @@ def dark_surface(dark_frame: torch.Tensor) -> torch.Tensor:
     """(3, H, W) linear light (sRGB, as :func:`beam_profile` reads a capture): a quadratic surface per channel
     fitted to a dark frame. A dark room's light varies on the scale of the frame (a gradient, the lens's fall-off
     towards the corners), a capture's noise from pixel to pixel. Fitted by :func:`summed_least_squares`: LAPACK's
-    lstsq read one dark frame to three different surfaces in 40 calls on one thread, and a calibration of camsim's
-    halo case with dark frames moved in its sixth digit from run to run (docs/bench/session101.md)."""
+    lstsq read one dark frame to four different surfaces in 40 calls on one thread, and a calibration of camsim's
+    halo case with dark frames fitted its halo exponent anywhere from 2.0483 to 2.0485 from run to run
+    (docs/bench/session101/halo_repeatability.txt)."""
     light = srgb_to_linear(dark_frame)
     _, height, width = light.shape
     ys, xs = torch.meshgrid(
