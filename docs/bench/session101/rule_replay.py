@@ -47,11 +47,8 @@ margin = 0.05
 def taken(module, problem, step: dict):
     scored = {frozenset(label.split("+")): v for label, v in step["tried"].items()}
     aside = step.get("set_aside", {})
-    eligible = {
-        g: v
-        for g, v in scored.items()
-        if "+".join(sorted(g)) not in {"+".join(sorted(a.split("+"))) for a in aside}
-    }
+    set_aside = {frozenset(label.split("+")) for label in aside}
+    eligible = {g: v for g, v in scored.items() if g not in set_aside}
     outscored = {}
     for label, why in aside.items():
         simpler = SIMPLER.fullmatch(why)
@@ -68,7 +65,14 @@ def taken(module, problem, step: dict):
     return single, eligible[single]
 
 
-n_reports = n_steps = 0
+def recorded(steps: list[dict], k: int) -> frozenset[str]:
+    """What the pass took at step ``k``: the effects of the next step that scored groups (the steps inside a group
+    taken at once score none), or of the last step, beyond step ``k``'s."""
+    j = next((j for j in range(k + 1, len(steps)) if steps[j]["tried"]), len(steps) - 1)
+    return frozenset(steps[j]["effects"]) - frozenset(steps[k]["effects"])
+
+
+n_reports = n_steps = n_reproduced = 0
 for root in sys.argv[2:]:
     for path in sorted(Path(root).rglob("report.json")):
         report = json.loads(path.read_text())
@@ -84,11 +88,12 @@ for root in sys.argv[2:]:
         selection = report["selection"]
         passes = [selection["steps"]] + [p.get("steps", []) for p in selection.get("earlier_passes", [])]
         for steps in passes:
-            for step in steps:
+            for k, step in enumerate(steps):
                 if not step["tried"]:
                     continue
                 n_steps += 1
                 new, old = taken(core, problem, step), taken(old_core, problem, step)
+                n_reproduced += old[0] == recorded(steps, k)
                 if new[0] != old[0]:
                     name = lambda g: "+".join(sorted(g)) or "(nothing)"  # noqa: E731
                     print(
@@ -97,4 +102,7 @@ for root in sys.argv[2:]:
                         f"old {name(old[0])} {old[1]:.4g}  {path.parent}"
                     )
                     break
-print(f"{n_reports} reports, {n_steps} steps replayed")
+print(
+    f"{n_reports} reports, {n_steps} steps replayed; the older rule takes what the report recorded in "
+    f"{n_reproduced} of them"
+)
