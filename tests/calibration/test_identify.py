@@ -1232,9 +1232,12 @@ def test_a_colour_channel_that_sees_none_of_the_laser_leaves_the_stripe_identifi
 
 class FixedErrorsOnTwentyItems(MeasuredEverywhere):
     """A problem whose error is fixed per model (``errors``, by the effects' names joined with "+") and the same on
-    each of its 20 items."""
+    each of its 20 items; an effect's own parameter, where it has one, in ``effect_params`` and its null value in
+    ``nulls``."""
 
     errors: typing.ClassVar[dict[str, float]] = {}
+    effect_params: typing.ClassVar[dict[str, Param]] = {}
+    nulls: typing.ClassVar[dict[str, dict[str, float]]] = {}
 
     @property
     def n_items(self) -> int:
@@ -1242,6 +1245,16 @@ class FixedErrorsOnTwentyItems(MeasuredEverywhere):
 
     def model_squared_errors(self, effects: frozenset[str], items: np.ndarray) -> tuple[float, int]:
         return self.errors["+".join(sorted(effects))] ** 2 * len(items), len(items)
+
+    def param_specs(self, effects):
+        return [self.effect_params[e] for e in sorted(effects) if e in self.effect_params]
+
+    def null_values(self, effect):
+        return self.nulls.get(effect, {})
+
+    def fitted(self, effects, values: dict[str, float]) -> Fit:
+        """The fit of ``effects`` with each of its parameters at ``values``."""
+        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
 
 
 class GreedyPowerLaw(FixedErrorsOnTwentyItems):
@@ -1425,21 +1438,16 @@ class ClipBeforeShoulder(FixedErrorsOnTwentyItems):
         "clip+shoulder+spread": 6.0,
     }
 
-    def param_specs(self, effects):
-        specs = {
-            "clip": Param("white", 0.95, 0.2, 1.0),
-            "shoulder": Param("knee", 1.0, 0.25, 4.0),
-            "spread": Param("sigma", 2.0, 0.0, 8.0),
-        }
-        return [specs[e] for e in sorted(effects)]
-
-    def null_values(self, effect):
-        return {"clip": {"white": 1.0}, "spread": {"sigma": 0.0}}.get(effect, {})
+    effect_params: typing.ClassVar[dict[str, Param]] = {
+        "clip": Param("white", 0.95, 0.2, 1.0),
+        "shoulder": Param("knee", 1.0, 0.25, 4.0),
+        "spread": Param("sigma", 2.0, 0.0, 8.0),
+    }
+    nulls: typing.ClassVar[dict[str, dict[str, float]]] = {"clip": {"white": 1.0}, "spread": {"sigma": 0.0}}
 
     def fit(self, effects, items, start=None) -> Fit:
         knee = 4.0 if not effects & {"clip", "spread"} else 1.0
-        values = {"white": 0.7, "knee": knee, "sigma": 2.0}
-        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+        return self.fitted(effects, {"white": 0.7, "knee": knee, "sigma": 2.0})
 
 
 def test_an_effect_the_later_steps_make_redundant_is_withdrawn(tmp_path):
@@ -1509,21 +1517,21 @@ class ReflectanceHoldsTheShoulder(FixedErrorsOnTwentyItems):
         "cross+reflect+shoulder": 6.0,
     }
 
-    def param_specs(self, effects):
-        specs = {
-            "reflect": Param("floor", 0.5, -0.05, 2.0),
-            "power": Param("gamma", 2.0, 0.3, 4.0),
-            "shoulder": Param("knee", 1.0, 0.25, 4.0),
-            "cross": Param("leak", 0.1, 0.0, 0.5),
-        }
-        return [specs[e] for e in sorted(effects)]
-
-    def null_values(self, effect):
-        return {"reflect": {"floor": 1.0}, "power": {"gamma": 1.0}, "cross": {"leak": 0.0}}.get(effect, {})
+    effect_params: typing.ClassVar[dict[str, Param]] = {
+        "reflect": Param("floor", 0.5, -0.05, 2.0),
+        "power": Param("gamma", 2.0, 0.3, 4.0),
+        "shoulder": Param("knee", 1.0, 0.25, 4.0),
+        "cross": Param("leak", 0.1, 0.0, 0.5),
+    }
+    nulls: typing.ClassVar[dict[str, dict[str, float]]] = {
+        "reflect": {"floor": 1.0},
+        "power": {"gamma": 1.0},
+        "cross": {"leak": 0.0},
+    }
 
     def fit(self, effects, items, start=None) -> Fit:
-        values = {"floor": 0.1, "gamma": 2.2, "knee": 1.2 if "reflect" in effects else 4.0, "leak": 0.3}
-        return Fit(effects, {p.name: values[p.name] for p in self.param_specs(effects)})
+        knee = 1.2 if "reflect" in effects else 4.0
+        return self.fitted(effects, {"floor": 0.1, "gamma": 2.2, "knee": knee, "leak": 0.3})
 
 
 def test_an_effect_without_which_a_bound_pins_another_is_not_shown_redundant():
