@@ -2,7 +2,8 @@
 named in >= 90% of effect cases, at most one unplanted named cause in any case, null cases keep the base model, and
 (the independent simulator's own rule) the cases with an effect the library lacks name nothing and report the
 structure left. Judged by ``camsim_named_causes.case_results`` (the test's rules, cases whose report.json is
-missing skipped); the named share carries a Clopper-Pearson 90% interval over the pooled cases.
+missing skipped); the named share carries a Clopper-Pearson 90% interval over the pooled cases and the p-value of
+``test_planted_effects_are_named``'s rule (session 102).
 
 Usage: ``CAMSIM_CASES=all PYTHONPATH=. python docs/bench/session56/camsim_acceptance.py OUTDIR...`` from the
 repository root (the same ``CAMSIM_CASES`` as the batch).
@@ -35,6 +36,12 @@ def main() -> None:
     print(
         f"effect cases with every planted effect named: {named} of {len(effect)} "
         f"({named / len(effect):.1%}, 90% interval {interval.low:.1%}-{interval.high:.1%})"
+    )
+    sim = sys.modules["test_independent_sim"]  # loaded by case_results, with the run's case matrix
+    p_value = sim.named_share_p_value(named, len(effect))
+    print(
+        f"  so few named at a rate of {sim.NAMED_SHARE:.0%}: p = {p_value:.4f} "
+        f"(test_planted_effects_are_named fails at p <= {sim.NAMED_SHARE_ALPHA})"
     )
     for seed, name, judged in effect:
         if not judged["passed"]:
