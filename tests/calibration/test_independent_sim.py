@@ -492,7 +492,7 @@ def named_causes(report: dict) -> set[str]:
 
 def named_share_p_value(named: int, cases: int) -> float:
     """The chance of ``named`` or fewer of ``cases`` effect cases named, were each named at the bar's share
-    ``NAMED_SHARE`` (a one-sided exact binomial test): a run whose cases had that chance under
+    ``NAMED_SHARE`` (a one-sided exact binomial test): a run whose cases had that chance at most
     ``NAMED_SHARE_ALPHA`` is evidence the naming rate is under the bar."""
     return float(binomtest(named, cases, NAMED_SHARE, alternative="less").pvalue)
 
