@@ -1,7 +1,8 @@
 """A drawn second camera's stripe table, its rows in order of the pulse's light against the camera's detection
 threshold (on-time / threshold, the simulator's own): each row's split (fit or held-out by the calibration's seed), its
-window against the laser period (exposure + the camera's offset) and the rows measured. The cases above the 30-row
-bar put their largest held-out error on the table's weakest pulse (docs/bench/session48/heldout_rows_probe.py).
+window against the laser period (exposure + the camera's offset) and the rows measured. The four drawn cases above
+the 30-row bar put their largest held-out error on a pulse at or under the threshold, the table's weakest on three
+of them (docs/bench/session48/heldout_rows_probe.py, session102/heldout_rows_*_ef803e9.txt).
 
 Usage: ``PYTHONPATH=. python docs/bench/session102/stripe_regimes.py SEED lit|interior [ROWS]`` (the first ROWS rows,
 default 8)."""

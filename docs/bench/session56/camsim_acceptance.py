@@ -11,6 +11,7 @@ repository root (the same ``CAMSIM_CASES`` as the batch).
 
 from __future__ import annotations
 
+import importlib
 import sys
 from collections import defaultdict
 from pathlib import Path
@@ -37,7 +38,7 @@ def main() -> None:
         f"effect cases with every planted effect named: {named} of {len(effect)} "
         f"({named / len(effect):.1%}, 90% interval {interval.low:.1%}-{interval.high:.1%})"
     )
-    sim = sys.modules["test_independent_sim"]  # loaded by case_results, with the run's case matrix
+    sim = importlib.import_module("test_independent_sim")  # as case_results last loaded it
     p_value = sim.named_share_p_value(named, len(effect))
     print(
         f"  so few named at a rate of {sim.NAMED_SHARE:.0%}: p = {p_value:.4f} "
